@@ -1,0 +1,65 @@
+//! `Data`: every work buffer the algorithms need, allocated once per model (Model/Data split).
+
+use crate::model::Model;
+use crate::spatial::{Force, Inertia, Motion, Se3, M6};
+use nalgebra::DMatrix;
+
+#[derive(Clone, Debug)]
+pub struct Data {
+    /// Placement of body i in its parent (joint placement ∘ joint motion).
+    pub li_mi: Vec<Se3>,
+    /// Placement of body i in the inertial frame.
+    pub o_mi: Vec<Se3>,
+    /// Body twists, body frame.
+    pub v: Vec<Motion>,
+    /// Body spatial accelerations, body frame (gravity included as a fictitious base acceleration).
+    pub a: Vec<Motion>,
+    /// Velocity-product accelerations `v_i × S_i q̇_i`.
+    pub c: Vec<Motion>,
+    /// RNEA: force transmitted by each joint to its child; ABA: bias forces.
+    pub f: Vec<Force>,
+    /// Articulated-body inertias (ABA).
+    pub ia: Vec<M6>,
+    /// `U = I^A S`, one 6×nv block per joint (unused columns zero).
+    pub u: Vec<M6>,
+    /// `D⁻¹ = (Sᵀ U)⁻¹`, top-left nv×nv block.
+    pub dinv: Vec<M6>,
+    /// `u = τ - Sᵀ p^A`, first nv entries.
+    pub uu: Vec<[f64; 6]>,
+    /// Composite rigid-body inertias (CRBA, centroidal momentum matrix).
+    pub ic: Vec<Inertia>,
+    /// Joint accelerations (ABA output).
+    pub ddq: Vec<f64>,
+    /// Joint forces (RNEA output; hybrid dynamics: the torques the prescribed joints needed).
+    pub tau: Vec<f64>,
+    /// Joint-space inertia matrix (CRBA output, full symmetric).
+    pub mass_matrix: DMatrix<f64>,
+    /// 6×nv scratch for Jacobians and the centroidal momentum matrix.
+    pub jac: DMatrix<f64>,
+    /// Normalised copy of q when the caller's quaternions were off by round-off.
+    pub qbuf: Vec<f64>,
+}
+
+impl Data {
+    pub fn new(m: &Model) -> Data {
+        let n = m.nbodies();
+        Data {
+            li_mi: vec![Se3::identity(); n],
+            o_mi: vec![Se3::identity(); n],
+            v: vec![Motion::ZERO; n],
+            a: vec![Motion::ZERO; n],
+            c: vec![Motion::ZERO; n],
+            f: vec![Force::ZERO; n],
+            ia: vec![M6::zeros(); n],
+            u: vec![M6::zeros(); n],
+            dinv: vec![M6::zeros(); n],
+            uu: vec![[0.0; 6]; n],
+            ic: vec![Inertia::zero(); n],
+            ddq: vec![0.0; m.nv],
+            tau: vec![0.0; m.nv],
+            mass_matrix: DMatrix::zeros(m.nv, m.nv),
+            jac: DMatrix::zeros(6, m.nv),
+            qbuf: Vec::with_capacity(m.nq),
+        }
+    }
+}

@@ -1,0 +1,28 @@
+//! Recursive dynamics over the tree (Featherstone, body coordinates): RNEA, CRBA, ABA and the hybrid
+//! variant of ABA in which chosen joints follow prescribed accelerations.
+
+mod aba;
+mod crba;
+mod rnea;
+
+pub use aba::{aba, hybrid_aba, Prescribed};
+pub use crba::crba;
+pub use rnea::rnea;
+
+use crate::model::Model;
+use crate::spatial::{Force, Motion};
+
+/// Fictitious acceleration of the inertial frame that accounts for gravity.
+#[inline]
+pub(crate) fn gravity_acceleration(m: &Model) -> Motion {
+    Motion::new(-m.gravity, nalgebra::Vector3::zeros())
+}
+
+/// External force on body i, body frame, or zero.
+#[inline]
+pub(crate) fn fext_of(fext: Option<&[f64]>, i: usize) -> Force {
+    match fext {
+        Some(f) => Force::from_slice(&f[6 * i..6 * i + 6]),
+        None => Force::ZERO,
+    }
+}

@@ -1,0 +1,43 @@
+use crate::data::Data;
+use crate::model::Model;
+use crate::spatial::Motion;
+
+/// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
+/// `q` must already be checked (see `Model::checked_q`).
+pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) {
+    for i in 0..m.nbodies() {
+        let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
+        d.li_mi[i] = m.placements[i].compose(&m.joint_types[i].transform(&m.axes[i], qi));
+        d.o_mi[i] = match m.parents[i] {
+            Some(p) => d.o_mi[p].compose(&d.li_mi[i]),
+            None => d.li_mi[i],
+        };
+    }
+}
+
+/// Joint twist `S q̇` of body i, child frame.
+#[inline]
+pub fn joint_velocity(m: &Model, i: usize, qd: &[f64]) -> Motion {
+    let s = &m.subspaces[i];
+    let k0 = m.idx_v[i];
+    let mut out = [0.0; 6];
+    for c in 0..m.nvs[i] {
+        let x = qd[k0 + c];
+        for r in 0..6 {
+            out[r] += s[(r, c)] * x;
+        }
+    }
+    Motion::from_slice(&out)
+}
+
+/// Placements and body twists (body frame).
+pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
+    forward_kinematics(m, d, q);
+    for i in 0..m.nbodies() {
+        let vj = joint_velocity(m, i, v);
+        d.v[i] = match m.parents[i] {
+            Some(p) => d.li_mi[i].inv_act_motion(&d.v[p]) + vj,
+            None => vj,
+        };
+    }
+}

@@ -1,0 +1,104 @@
+use super::{centroidal_momentum_matrix, forward_kinematics};
+use crate::data::Data;
+use crate::error::{FfError, Result};
+use crate::model::{JointType, Model};
+use crate::spatial::{Motion, Se3};
+use nalgebra::DMatrix;
+
+/// In which axes a frame Jacobian gives the twist of the frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Reference {
+    /// Twist of the frame origin in the frame's own axes (Pinocchio LOCAL).
+    Local,
+    /// Velocity of the frame origin and angular velocity in inertial axes (Pinocchio LOCAL_WORLD_ALIGNED).
+    World,
+}
+
+impl Reference {
+    pub fn from_name(s: &str) -> Result<Reference> {
+        match s {
+            "local" => Ok(Reference::Local),
+            "world" => Ok(Reference::World),
+            other => Err(FfError::arg("reference", format!("expected 'local' or 'world', got '{other}'"))),
+        }
+    }
+}
+
+/// Placement in the inertial frame of body `body` ∘ `placement` (needs forward kinematics).
+pub fn frame_placement(d: &Data, body: usize, placement: &Se3) -> Se3 {
+    d.o_mi[body].compose(placement)
+}
+
+/// Jacobian (6 × nv, into `out`) of the frame `placement` fixed on `body`: its twist is `out · v`.
+/// Runs forward kinematics.
+pub fn frame_jacobian(m: &Model, d: &mut Data, q: &[f64], body: usize, placement: &Se3, reference: Reference, out: &mut DMatrix<f64>) {
+    forward_kinematics(m, d, q);
+    jacobian_from_data(m, d, body, placement, reference, out);
+}
+
+fn jacobian_from_data(m: &Model, d: &Data, body: usize, placement: &Se3, reference: Reference, out: &mut DMatrix<f64>) {
+    out.fill(0.0);
+    let o_mf = frame_placement(d, body, placement);
+    let mut j = Some(body);
+    // Only the joints on the path to the base move the frame.
+    while let Some(i) = j {
+        for c in 0..m.nvs[i] {
+            let s = Motion::from_v6(&m.subspaces[i].column(c).into_owned());
+            let local = o_mf.inv_act_motion(&d.o_mi[i].act_motion(&s));
+            let tw = match reference {
+                Reference::Local => local,
+                Reference::World => Motion::new(o_mf.rot * local.lin, o_mf.rot * local.ang),
+            };
+            let col = m.idx_v[i] + c;
+            for r in 0..3 {
+                out[(r, col)] = tw.lin[r];
+                out[(r + 3, col)] = tw.ang[r];
+            }
+        }
+        j = m.parents[i];
+    }
+}
+
+/// Generalized Jacobian of a free-floating robot (Umetani-Yoshida): with the total momentum held at
+/// `h0`, the frame twist is `Jg q̇_m + offset`, where `q̇_m` are the joint rates after the base.
+/// The base velocity is eliminated through the momentum: `A_b v_b + A_m q̇_m = h0`, so
+/// `Jg = J_m − J_b A_b⁻¹ A_m` and `offset = J_b A_b⁻¹ h0`. For a planar base only the conserved
+/// in-plane momenta (p_x, p_y, L_z) are used; for a fixed base `Jg` is the ordinary Jacobian.
+/// Returns (Jg as 6 × (nv − nv_base), offset).
+pub fn generalized_jacobian(
+    m: &Model,
+    d: &mut Data,
+    q: &[f64],
+    body: usize,
+    placement: &Se3,
+    reference: Reference,
+    h0: &[f64; 6],
+) -> Result<(DMatrix<f64>, [f64; 6])> {
+    let nb = m.nvs[0];
+    let nm = m.nv - nb;
+    centroidal_momentum_matrix(m, d, q);
+    let a = d.jac.clone();
+    let mut j = DMatrix::zeros(6, m.nv);
+    jacobian_from_data(m, d, body, placement, reference, &mut j);
+    let jm = j.columns(nb, nm).into_owned();
+    if nb == 0 {
+        return Ok((jm, [0.0; 6]));
+    }
+    let rows: &[usize] = match m.joint_types[0] {
+        JointType::Free => &[0, 1, 2, 3, 4, 5],
+        JointType::Planar => &[0, 1, 5],
+        _ => unreachable!("a base with velocity coordinates is free or planar"),
+    };
+    let ab = DMatrix::from_fn(nb, nb, |r, c| a[(rows[r], c)]);
+    let am = DMatrix::from_fn(nb, nm, |r, c| a[(rows[r], nb + c)]);
+    let h = nalgebra::DVector::from_fn(nb, |r, _| h0[rows[r]]);
+    let lu = ab.lu();
+    let (Some(x), Some(y)) = (lu.solve(&am), lu.solve(&h)) else {
+        return Err(FfError::Numerical("the base block of the centroidal momentum matrix is singular".into()));
+    };
+    let jb = j.columns(0, nb);
+    let jg = jm - &jb * x;
+    let off = &jb * y;
+    Ok((jg, [off[0], off[1], off[2], off[3], off[4], off[5]]))
+}
+

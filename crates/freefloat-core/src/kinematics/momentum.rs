@@ -1,0 +1,58 @@
+use super::{forward_kinematics, forward_velocities};
+use crate::data::Data;
+use crate::model::Model;
+use crate::spatial::{Force, Motion};
+
+/// Total momentum `[p; L_O]`: linear momentum and angular momentum about the inertial origin, both
+/// in the inertial frame (ARCHITECTURE.md). Runs forward kinematics and velocities.
+pub fn momentum(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) -> Force {
+    forward_velocities(m, d, q, v);
+    momentum_from_data(m, d)
+}
+
+pub fn momentum_from_data(m: &Model, d: &Data) -> Force {
+    let mut h = Force::ZERO;
+    for i in 0..m.nbodies() {
+        h += d.o_mi[i].act_force(&m.inertias[i].mul_motion(&d.v[i]));
+    }
+    h
+}
+
+/// Kinetic energy of the whole system.
+pub fn kinetic_energy(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) -> f64 {
+    forward_velocities(m, d, q, v);
+    kinetic_energy_from_data(m, d)
+}
+
+pub fn kinetic_energy_from_data(m: &Model, d: &Data) -> f64 {
+    (0..m.nbodies()).map(|i| m.inertias[i].kinetic_energy(&d.v[i])).sum()
+}
+
+/// Composite inertia of each body's subtree, in that body's frame (needs `li_mi`).
+pub fn composite_inertias(m: &Model, d: &mut Data) {
+    d.ic.copy_from_slice(&m.inertias);
+    for i in (1..m.nbodies()).rev() {
+        let p = m.parents[i].unwrap();
+        let t = d.ic[i].transformed(&d.li_mi[i]);
+        d.ic[p] = d.ic[p].add(&t);
+    }
+}
+
+/// Centroidal momentum matrix about the inertial origin: `momentum == A v`, written into `d.jac`
+/// (6 × nv). Column block j is the momentum of joint j's subtree moving rigidly with unit joint rate,
+/// `oX*_j Ic_j S_j`.
+pub fn centroidal_momentum_matrix(m: &Model, d: &mut Data, q: &[f64]) {
+    forward_kinematics(m, d, q);
+    composite_inertias(m, d);
+    for j in 0..m.nbodies() {
+        for c in 0..m.nvs[j] {
+            let s = Motion::from_v6(&m.subspaces[j].column(c).into_owned());
+            let h = d.o_mi[j].act_force(&d.ic[j].mul_motion(&s));
+            let col = m.idx_v[j] + c;
+            for r in 0..3 {
+                d.jac[(r, col)] = h.lin[r];
+                d.jac[(r + 3, col)] = h.ang[r];
+            }
+        }
+    }
+}

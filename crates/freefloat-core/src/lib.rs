@@ -1,0 +1,18 @@
+//! freefloat-core: the numerical engine of freefloat — floating-base rigid-body trees for space
+//! robots. Pure Rust, no Python. See docs/architecture.md for the layout and conventions.
+//!
+//! Pattern (Pinocchio/MuJoCo): a `Model` is an immutable description, a `Data` holds every work
+//! buffer, algorithms are free functions `algo(&model, &mut data, ...)` that allocate nothing.
+
+pub mod config;
+pub mod data;
+pub mod dynamics;
+pub mod error;
+pub mod kinematics;
+pub mod model;
+pub mod sim;
+pub mod spatial;
+
+pub use data::Data;
+pub use error::{FfError, Result};
+pub use model::{JointType, Model};

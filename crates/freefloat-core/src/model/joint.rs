@@ -1,0 +1,145 @@
+//! Joint types, their coordinate sizes, their transform and their motion subspace.
+//!
+//! Every joint's motion subspace is constant in the child (= joint) frame, including the free and
+//! planar base joints because their velocities are expressed in the base frame (Pinocchio's
+//! convention). So no joint has a velocity-product bias term and `S` is computed once per model.
+
+use crate::spatial::{quat_normalize, rot_from_quat, rotation_about_axis, Se3, M3, M6, V3};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum JointType {
+    /// 6-DoF base: q = [p; quat xyzw], v = [lin; ang] in the base frame.
+    Free,
+    /// Base moving in the inertial x-y plane: q = [x, y, yaw], v = [vx, vy, yaw rate] in the base frame.
+    Planar,
+    /// Base welded to the inertial frame.
+    FixedBase,
+    Revolute,
+    Prismatic,
+    /// Ball joint: q = quat xyzw of the child relative to the joint frame, v = angular velocity (child frame).
+    Spherical,
+    Fixed,
+}
+
+impl JointType {
+    pub fn nq(self) -> usize {
+        match self {
+            JointType::Free => 7,
+            JointType::Planar => 3,
+            JointType::Spherical => 4,
+            JointType::Revolute | JointType::Prismatic => 1,
+            JointType::FixedBase | JointType::Fixed => 0,
+        }
+    }
+    pub fn nv(self) -> usize {
+        match self {
+            JointType::Free => 6,
+            JointType::Planar | JointType::Spherical => 3,
+            JointType::Revolute | JointType::Prismatic => 1,
+            JointType::FixedBase | JointType::Fixed => 0,
+        }
+    }
+    pub fn is_base(self) -> bool {
+        matches!(self, JointType::Free | JointType::Planar | JointType::FixedBase)
+    }
+    /// The name used in files and in the Python API.
+    pub fn name(self) -> &'static str {
+        match self {
+            JointType::Free => "free",
+            JointType::Planar => "planar",
+            JointType::FixedBase => "fixed",
+            JointType::Revolute => "revolute",
+            JointType::Prismatic => "prismatic",
+            JointType::Spherical => "spherical",
+            JointType::Fixed => "fixed",
+        }
+    }
+    pub fn base_from_name(s: &str) -> Option<JointType> {
+        match s {
+            "free" | "floating" => Some(JointType::Free),
+            "planar" => Some(JointType::Planar),
+            "fixed" => Some(JointType::FixedBase),
+            _ => None,
+        }
+    }
+    pub fn child_from_name(s: &str) -> Option<JointType> {
+        match s {
+            "revolute" | "continuous" => Some(JointType::Revolute),
+            "prismatic" => Some(JointType::Prismatic),
+            "spherical" | "ball" => Some(JointType::Spherical),
+            "fixed" => Some(JointType::Fixed),
+            _ => None,
+        }
+    }
+    /// Whether the joint's q holds a quaternion that must stay unit (its offset inside the joint's q).
+    pub fn quaternion_offset(self) -> Option<usize> {
+        match self {
+            JointType::Free => Some(3),
+            JointType::Spherical => Some(0),
+            _ => None,
+        }
+    }
+
+    /// Motion subspace `S` (6 × nv, stored in a 6×6 with the unused columns zero), child frame.
+    pub fn subspace(self, axis: &V3) -> M6 {
+        let mut s = M6::zeros();
+        match self {
+            JointType::Free => s = M6::identity(),
+            JointType::Planar => {
+                s[(0, 0)] = 1.0;
+                s[(1, 1)] = 1.0;
+                s[(5, 2)] = 1.0;
+            }
+            JointType::Spherical => {
+                s[(3, 0)] = 1.0;
+                s[(4, 1)] = 1.0;
+                s[(5, 2)] = 1.0;
+            }
+            JointType::Revolute => s.fixed_view_mut::<3, 1>(3, 0).copy_from(axis),
+            JointType::Prismatic => s.fixed_view_mut::<3, 1>(0, 0).copy_from(axis),
+            JointType::FixedBase | JointType::Fixed => {}
+        }
+        s
+    }
+
+    /// Placement of the child frame in the joint's rest frame for coordinates `q` (len nq).
+    /// Quaternions are used as given: callers normalise `q` once on entry.
+    #[inline]
+    pub fn transform(self, axis: &V3, q: &[f64]) -> Se3 {
+        match self {
+            JointType::Revolute => Se3::new(rotation_about_axis(axis, q[0]), V3::zeros()),
+            JointType::Prismatic => Se3::new(M3::identity(), axis * q[0]),
+            JointType::Free => Se3::new(rot_from_quat(&q[3..7]), V3::new(q[0], q[1], q[2])),
+            JointType::Planar => {
+                let (s, c) = q[2].sin_cos();
+                Se3::new(M3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0), V3::new(q[0], q[1], 0.0))
+            }
+            JointType::Spherical => Se3::new(rot_from_quat(&q[0..4]), V3::zeros()),
+            JointType::FixedBase | JointType::Fixed => Se3::identity(),
+        }
+    }
+
+    /// Neutral coordinates (identity quaternions, zeros elsewhere).
+    pub fn neutral(self, out: &mut [f64]) {
+        out.fill(0.0);
+        if let Some(k) = self.quaternion_offset() {
+            out[k + 3] = 1.0;
+        }
+    }
+
+    /// Normalise the quaternion part of this joint's q in place.
+    pub fn normalize(self, q: &mut [f64]) {
+        if let Some(k) = self.quaternion_offset() {
+            quat_normalize(&mut q[k..k + 4]);
+        }
+    }
+}
+
+/// Optional joint limits (from URDF/YAML); `None` where the file gives none.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JointLimits {
+    pub lower: Option<f64>,
+    pub upper: Option<f64>,
+    pub velocity: Option<f64>,
+    pub effort: Option<f64>,
+}

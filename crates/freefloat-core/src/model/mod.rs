@@ -1,0 +1,360 @@
+//! `Model`: the immutable description of a rigid-body tree (topology, joint placements, inertial
+//! parameters). Algorithms never change it; their work buffers live in `crate::Data`.
+
+pub mod builtin;
+mod joint;
+mod physics;
+pub mod urdf;
+pub mod yaml;
+
+pub use joint::{JointLimits, JointType};
+pub use physics::{check_finite_nonnegative_mass, check_physical};
+
+use crate::error::{FfError, Result};
+use crate::spatial::{Inertia, Se3, M6, V3};
+
+/// A named frame rigidly attached to a body (end effector, sensor point, thruster).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    pub name: String,
+    pub body: usize,
+    pub placement: Se3,
+}
+
+/// Description of one body as given to `ModelBuilder::add_body`.
+#[derive(Clone, Debug)]
+pub struct BodySpec {
+    pub name: String,
+    pub parent: usize,
+    pub joint_name: String,
+    pub joint_type: JointType,
+    pub axis: V3,
+    pub placement: Se3,
+    pub inertia: Inertia,
+    pub limits: JointLimits,
+    pub tags: Vec<String>,
+    /// Skip the physical-consistency check for this body (published data that is itself
+    /// inconsistent, e.g. seed 001's Table 2). Finite values and mass ≥ 0 are still required.
+    pub allow_nonphysical: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub body_names: Vec<String>,
+    pub joint_names: Vec<String>,
+    /// Parent body of each body; `None` for the base (body 0). Always `parents[i] < i`.
+    pub parents: Vec<Option<usize>>,
+    pub joint_types: Vec<JointType>,
+    /// Joint axis in the joint frame (unit; meaningful for revolute/prismatic only).
+    pub axes: Vec<V3>,
+    /// Rest placement of each joint frame in its parent body frame (the base: in the inertial frame).
+    pub placements: Vec<Se3>,
+    pub inertias: Vec<Inertia>,
+    pub limits: Vec<JointLimits>,
+    pub tags: Vec<Vec<String>>,
+    /// Bodies exempted from the physical-consistency check (see `BodySpec::allow_nonphysical`).
+    pub allow_nonphysical: Vec<bool>,
+    pub frames: Vec<Frame>,
+    /// Gravity in the inertial frame (zero for orbital robots).
+    pub gravity: V3,
+    // Derived layout, filled by `ModelBuilder::build`.
+    pub idx_q: Vec<usize>,
+    pub idx_v: Vec<usize>,
+    pub nqs: Vec<usize>,
+    pub nvs: Vec<usize>,
+    pub nq: usize,
+    pub nv: usize,
+    /// Motion subspace of each joint (constant in the child frame).
+    pub subspaces: Vec<M6>,
+    pub children: Vec<Vec<usize>>,
+}
+
+pub struct ModelBuilder {
+    model: Model,
+}
+
+impl ModelBuilder {
+    /// Start a model whose base body is `base_name`, attached to the inertial frame by `base_joint`
+    /// (free, planar or fixed).
+    pub fn new(name: &str, base_name: &str, base_joint: JointType, base_inertia: Inertia) -> Result<Self> {
+        if !base_joint.is_base() {
+            return Err(FfError::Model(format!(
+                "base joint must be free, planar or fixed, got '{}'",
+                base_joint.name()
+            )));
+        }
+        let model = Model {
+            name: name.to_string(),
+            body_names: vec![base_name.to_string()],
+            joint_names: vec!["root_joint".to_string()],
+            parents: vec![None],
+            joint_types: vec![base_joint],
+            axes: vec![V3::z()],
+            placements: vec![Se3::identity()],
+            inertias: vec![base_inertia],
+            limits: vec![JointLimits::default()],
+            tags: vec![vec![]],
+            allow_nonphysical: vec![false],
+            frames: vec![],
+            gravity: V3::zeros(),
+            idx_q: vec![],
+            idx_v: vec![],
+            nqs: vec![],
+            nvs: vec![],
+            nq: 0,
+            nv: 0,
+            subspaces: vec![],
+            children: vec![],
+        };
+        Ok(ModelBuilder { model })
+    }
+
+    pub fn set_base_tags(&mut self, tags: Vec<String>) {
+        self.model.tags[0] = tags;
+    }
+    pub fn set_base_allow_nonphysical(&mut self, allow: bool) {
+        self.model.allow_nonphysical[0] = allow;
+    }
+    pub fn set_gravity(&mut self, g: V3) {
+        self.model.gravity = g;
+    }
+
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.model.body_names.iter().position(|n| n == name)
+    }
+
+    pub fn add_body(&mut self, b: BodySpec) -> Result<usize> {
+        let m = &mut self.model;
+        let i = m.body_names.len();
+        if b.parent >= i {
+            return Err(FfError::Model(format!("body '{}': parent index {} does not exist yet", b.name, b.parent)));
+        }
+        if b.joint_type.is_base() {
+            return Err(FfError::Model(format!(
+                "body '{}': joint type '{}' is only allowed for the base",
+                b.name,
+                b.joint_type.name()
+            )));
+        }
+        let mut axis = b.axis;
+        if matches!(b.joint_type, JointType::Revolute | JointType::Prismatic) {
+            let n = axis.norm();
+            if !(n > 1e-12) || !n.is_finite() {
+                return Err(FfError::Model(format!("joint '{}': axis {:?} has zero length", b.joint_name, axis.as_slice())));
+            }
+            axis /= n;
+        }
+        m.body_names.push(b.name);
+        m.joint_names.push(b.joint_name);
+        m.parents.push(Some(b.parent));
+        m.joint_types.push(b.joint_type);
+        m.axes.push(axis);
+        m.placements.push(b.placement);
+        m.inertias.push(b.inertia);
+        m.limits.push(b.limits);
+        m.tags.push(b.tags);
+        m.allow_nonphysical.push(b.allow_nonphysical);
+        Ok(i)
+    }
+
+    pub fn add_frame(&mut self, name: &str, body: usize, placement: Se3) -> Result<()> {
+        if body >= self.model.body_names.len() {
+            return Err(FfError::Model(format!("frame '{name}': body index {body} does not exist")));
+        }
+        self.model.frames.push(Frame { name: name.to_string(), body, placement });
+        Ok(())
+    }
+
+    /// Validate everything and compute the derived layout.
+    pub fn build(self) -> Result<Model> {
+        let mut m = self.model;
+        m.finalize()?;
+        Ok(m)
+    }
+}
+
+impl Model {
+    pub fn nbodies(&self) -> usize {
+        self.body_names.len()
+    }
+
+    fn finalize(&mut self) -> Result<()> {
+        let n = self.nbodies();
+        check_unique("body", &self.body_names)?;
+        check_unique("joint", &self.joint_names)?;
+        let frame_names: Vec<String> = self.frames.iter().map(|f| f.name.clone()).collect();
+        check_unique("frame", &frame_names)?;
+        if let Some(f) = self.frames.iter().find(|f| self.body_names.contains(&f.name)) {
+            return Err(FfError::Model(format!("frame name '{}' is also a body name", f.name)));
+        }
+        for (i, name) in self.body_names.iter().enumerate() {
+            if name.is_empty() {
+                return Err(FfError::Model(format!("body {i} has an empty name")));
+            }
+            let p = &self.placements[i];
+            if p.rot.iter().chain(p.trans.iter()).any(|x| !x.is_finite()) {
+                return Err(FfError::Model(format!("joint '{}': placement is not finite", self.joint_names[i])));
+            }
+            if self.allow_nonphysical[i] {
+                check_finite_nonnegative_mass(name, &self.inertias[i])?;
+            } else {
+                check_physical(name, &self.inertias[i])?;
+            }
+        }
+        if !self.gravity.iter().all(|g| g.is_finite()) {
+            return Err(FfError::Model("gravity is not finite".into()));
+        }
+        self.idx_q.clear();
+        self.idx_v.clear();
+        self.nqs.clear();
+        self.nvs.clear();
+        self.subspaces.clear();
+        let (mut nq, mut nv) = (0, 0);
+        for i in 0..n {
+            let jt = self.joint_types[i];
+            self.idx_q.push(nq);
+            self.idx_v.push(nv);
+            self.nqs.push(jt.nq());
+            self.nvs.push(jt.nv());
+            self.subspaces.push(jt.subspace(&self.axes[i]));
+            nq += jt.nq();
+            nv += jt.nv();
+        }
+        self.nq = nq;
+        self.nv = nv;
+        self.children = vec![vec![]; n];
+        for i in 1..n {
+            self.children[self.parents[i].unwrap()].push(i);
+        }
+        self.check_no_massless_subtree()
+    }
+
+    /// A moving joint whose whole subtree has no inertia makes the mass matrix singular: say which.
+    fn check_no_massless_subtree(&self) -> Result<()> {
+        let n = self.nbodies();
+        let mut weight: Vec<f64> = self.inertias.iter().map(|i| i.mass + i.i_o.trace()).collect();
+        for i in (1..n).rev() {
+            let p = self.parents[i].unwrap();
+            weight[p] += weight[i];
+        }
+        for i in 0..n {
+            if self.nvs[i] > 0 && weight[i] <= 0.0 {
+                return Err(FfError::Model(format!(
+                    "joint '{}' moves body '{}' whose subtree has no mass or inertia: the dynamics would be singular \
+                     (give the bodies inertial parameters, or make the joint fixed)",
+                    self.joint_names[i], self.body_names[i]
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn body_index(&self, name: &str) -> Option<usize> {
+        self.body_names.iter().position(|n| n == name)
+    }
+
+    /// Look up a body or a frame by name: returns (body, placement of the frame in that body).
+    pub fn frame_or_body(&self, name: &str) -> Result<(usize, Se3)> {
+        if let Some(b) = self.body_index(name) {
+            return Ok((b, Se3::identity()));
+        }
+        if let Some(f) = self.frames.iter().find(|f| f.name == name) {
+            return Ok((f.body, f.placement));
+        }
+        Err(FfError::arg(
+            "name",
+            format!("'{name}' is neither a body nor a frame of model '{}' (bodies: {})", self.name, self.body_names.join(", ")),
+        ))
+    }
+
+    /// Standard parameters, one row of 10 per body.
+    pub fn parameters(&self) -> Vec<[f64; 10]> {
+        self.inertias.iter().map(|i| i.to_params()).collect()
+    }
+
+    /// A copy with other inertial parameters (validated for physical consistency).
+    pub fn with_parameters(&self, params: &[f64]) -> Result<Model> {
+        let n = self.nbodies();
+        if params.len() != 10 * n {
+            return Err(FfError::arg("parameters", format!("expected ({n}, 10) values, got {}", params.len())));
+        }
+        if let Some(k) = params.iter().position(|x| !x.is_finite()) {
+            return Err(FfError::arg("parameters", format!("row {}, column {} is not finite", k / 10, k % 10)));
+        }
+        let mut m = self.clone();
+        for i in 0..n {
+            m.inertias[i] = Inertia::from_params(&params[10 * i..10 * i + 10]);
+        }
+        m.finalize()?;
+        Ok(m)
+    }
+
+    pub fn with_gravity(&self, g: V3) -> Result<Model> {
+        let mut m = self.clone();
+        m.gravity = g;
+        m.finalize()?;
+        Ok(m)
+    }
+
+    pub fn total_mass(&self) -> f64 {
+        self.inertias.iter().map(|i| i.mass).sum()
+    }
+
+    pub fn neutral(&self) -> Vec<f64> {
+        let mut q = vec![0.0; self.nq];
+        for i in 0..self.nbodies() {
+            self.joint_types[i].neutral(&mut q[self.idx_q[i]..self.idx_q[i] + self.nqs[i]]);
+        }
+        q
+    }
+
+    /// Check `q` (size, finiteness) and return it with every quaternion normalised.
+    /// Policy: a quaternion whose norm is off by more than 1e-6 is rejected, not silently fixed,
+    /// because such an input almost always means a wrong layout (e.g. w first) rather than round-off.
+    pub fn checked_q<'a>(&self, q: &'a [f64], buf: &'a mut Vec<f64>) -> Result<&'a [f64]> {
+        crate::error::check_vec("q", q, self.nq)?;
+        let mut needs_fix = false;
+        for i in 0..self.nbodies() {
+            if let Some(k) = self.joint_types[i].quaternion_offset() {
+                let s = self.idx_q[i] + k;
+                let n2: f64 = q[s..s + 4].iter().map(|x| x * x).sum();
+                let n = n2.sqrt();
+                if (n - 1.0).abs() > 1e-6 {
+                    return Err(FfError::arg(
+                        "q",
+                        format!(
+                            "the quaternion of joint '{}' (q[{}..{}], order x y z w) has norm {n:.6}; it must be a unit quaternion",
+                            self.joint_names[i],
+                            s,
+                            s + 4
+                        ),
+                    ));
+                }
+                if n != 1.0 {
+                    needs_fix = true;
+                }
+            }
+        }
+        if !needs_fix {
+            return Ok(q);
+        }
+        buf.clear();
+        buf.extend_from_slice(q);
+        for i in 0..self.nbodies() {
+            let s = self.idx_q[i];
+            self.joint_types[i].normalize(&mut buf[s..s + self.nqs[i]]);
+        }
+        Ok(&buf[..])
+    }
+}
+
+fn check_unique(what: &str, names: &[String]) -> Result<()> {
+    let mut seen = std::collections::HashSet::new();
+    for n in names {
+        if !seen.insert(n.as_str()) {
+            return Err(FfError::Model(format!("{what} name '{n}' is used twice")));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,288 @@
+//! The project's own YAML model format (docs/model_format.md), including modified Denavit-Hartenberg
+//! rows as the seeds write them.
+
+use super::{BodySpec, JointLimits, JointType, Model, ModelBuilder};
+use crate::error::{FfError, Result};
+use crate::spatial::{rotation_about_axis, rpy_to_rot, Inertia, Se3, M3, V3};
+use serde::Deserialize;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileSpec {
+    name: String,
+    #[allow(dead_code)]
+    description: Option<String>,
+    base: Option<String>,
+    gravity: Option<[f64; 3]>,
+    angles: Option<String>,
+    bodies: Vec<BodyYaml>,
+    frames: Option<Vec<FrameYaml>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BodyYaml {
+    name: String,
+    parent: Option<String>,
+    joint: Option<JointYaml>,
+    origin: Option<OriginYaml>,
+    mdh: Option<MdhYaml>,
+    inertial: Option<InertialYaml>,
+    tags: Option<Vec<String>>,
+    #[serde(default)]
+    allow_nonphysical: bool,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct JointYaml {
+    name: Option<String>,
+    #[serde(rename = "type")]
+    kind: String,
+    axis: Option<[f64; 3]>,
+    limits: Option<LimitsYaml>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct LimitsYaml {
+    lower: Option<f64>,
+    upper: Option<f64>,
+    velocity: Option<f64>,
+    effort: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct OriginYaml {
+    xyz: Option<[f64; 3]>,
+    rpy: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MdhYaml {
+    #[serde(default)]
+    alpha: f64,
+    #[serde(default)]
+    a: f64,
+    #[serde(default)]
+    d: f64,
+    #[serde(default)]
+    theta: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InertialYaml {
+    mass: Option<f64>,
+    com: Option<[f64; 3]>,
+    inertia: Option<InertiaYaml>,
+    inertia_origin: Option<InertiaYaml>,
+    params: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum InertiaYaml {
+    Principal([f64; 3]),
+    Full(InertiaMap),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct InertiaMap {
+    xx: f64,
+    yy: f64,
+    zz: f64,
+    #[serde(default)]
+    xy: f64,
+    #[serde(default)]
+    xz: f64,
+    #[serde(default)]
+    yz: f64,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameYaml {
+    name: String,
+    body: String,
+    origin: Option<OriginYaml>,
+}
+
+impl InertiaYaml {
+    fn matrix(&self) -> M3 {
+        match self {
+            InertiaYaml::Principal(d) => M3::from_diagonal(&V3::new(d[0], d[1], d[2])),
+            InertiaYaml::Full(m) => M3::new(m.xx, m.xy, m.xz, m.xy, m.yy, m.yz, m.xz, m.yz, m.zz),
+        }
+    }
+}
+
+/// Parse a YAML model from text. `source_name` (a path, or "<string>") is used in error messages.
+pub fn from_yaml_str(text: &str, source_name: &str) -> Result<Model> {
+    let spec: FileSpec = serde_norway::from_str(text).map_err(|e| FfError::ModelFile {
+        source_name: source_name.to_string(),
+        line: e.location().map(|l| l.line()),
+        msg: e.to_string(),
+    })?;
+    Loader { text, source_name }.build(spec)
+}
+
+struct Loader<'a> {
+    text: &'a str,
+    source_name: &'a str,
+}
+
+impl Loader<'_> {
+    /// Error located at the line where `name: <key>` first appears (the offending body or frame).
+    fn err_at(&self, key: &str, msg: String) -> FfError {
+        let line = self.text.lines().position(|l| {
+            let t = l.trim_start().trim_start_matches("- ").trim_start_matches('{');
+            t.starts_with("name:") && t["name:".len()..].trim().trim_matches(|c| c == '"' || c == '\'' || c == ',').starts_with(key)
+        });
+        FfError::ModelFile { source_name: self.source_name.to_string(), line: line.map(|l| l + 1), msg }
+    }
+
+    fn build(&self, spec: FileSpec) -> Result<Model> {
+        let deg = match spec.angles.as_deref().unwrap_or("rad") {
+            "rad" => false,
+            "deg" => true,
+            other => return Err(self.err_at(&spec.name, format!("angles must be 'rad' or 'deg', got '{other}'"))),
+        };
+        let ang = |x: f64| if deg { x.to_radians() } else { x };
+        let base_kind = spec.base.as_deref().unwrap_or("free");
+        let base_joint = JointType::base_from_name(base_kind).ok_or_else(|| {
+            self.err_at(&spec.name, format!("base must be one of free, planar, fixed; got '{base_kind}'"))
+        })?;
+        let Some(base) = spec.bodies.first() else {
+            return Err(self.err_at(&spec.name, "the model has no bodies".into()));
+        };
+        if base.parent.is_some() || base.joint.is_some() || base.origin.is_some() || base.mdh.is_some() {
+            return Err(self.err_at(
+                &base.name,
+                format!("the first body '{}' is the base: it takes no parent, joint, origin or mdh", base.name),
+            ));
+        }
+        let mut b = ModelBuilder::new(&spec.name, &base.name, base_joint, self.inertia(base)?)?;
+        b.set_base_tags(base.tags.clone().unwrap_or_default());
+        b.set_base_allow_nonphysical(base.allow_nonphysical);
+        if let Some(g) = spec.gravity {
+            b.set_gravity(V3::from(g));
+        }
+        for body in &spec.bodies[1..] {
+            let parent_name = body.parent.as_deref().ok_or_else(|| {
+                self.err_at(&body.name, format!("body '{}' has no parent (only the first body is the base)", body.name))
+            })?;
+            let parent = b.body_index(parent_name).ok_or_else(|| {
+                self.err_at(
+                    &body.name,
+                    format!("body '{}': parent '{parent_name}' is not a body listed before it", body.name),
+                )
+            })?;
+            let joint = body
+                .joint
+                .as_ref()
+                .ok_or_else(|| self.err_at(&body.name, format!("body '{}' has no joint", body.name)))?;
+            let jt = JointType::child_from_name(&joint.kind).ok_or_else(|| {
+                self.err_at(
+                    &body.name,
+                    format!(
+                        "body '{}': unknown joint type '{}' (expected revolute, prismatic, fixed or spherical)",
+                        body.name, joint.kind
+                    ),
+                )
+            })?;
+            let mut placement = Se3::identity();
+            if let Some(o) = &body.origin {
+                placement = origin_se3(o, &ang);
+            }
+            let mut axis = joint.axis.map(V3::from).unwrap_or_else(V3::z);
+            if let Some(dh) = &body.mdh {
+                // Craig's modified DH: Rx(alpha) Tx(a) Rz(theta) Tz(d); the joint axis is the new z.
+                let rx = Se3::new(rotation_about_axis(&V3::x(), ang(dh.alpha)), V3::zeros());
+                let tx = Se3::new(M3::identity(), V3::new(dh.a, 0.0, 0.0));
+                let rz = Se3::new(rotation_about_axis(&V3::z(), ang(dh.theta)), V3::new(0.0, 0.0, dh.d));
+                placement = placement.compose(&rx).compose(&tx).compose(&rz);
+                if let Some(a) = joint.axis {
+                    if (V3::from(a).normalize() - V3::z()).norm() > 1e-12 {
+                        return Err(self.err_at(
+                            &body.name,
+                            format!("body '{}': with mdh the joint axis is z; remove `axis` or set it to [0, 0, 1]", body.name),
+                        ));
+                    }
+                }
+                axis = V3::z();
+            }
+            let l = joint.limits.as_ref();
+            let ang_lim = |x: Option<f64>| if jt == JointType::Revolute { x.map(ang) } else { x };
+            let limits = JointLimits {
+                lower: ang_lim(l.and_then(|l| l.lower)),
+                upper: ang_lim(l.and_then(|l| l.upper)),
+                velocity: ang_lim(l.and_then(|l| l.velocity)),
+                effort: l.and_then(|l| l.effort),
+            };
+            if let (Some(lo), Some(hi)) = (limits.lower, limits.upper) {
+                if lo > hi {
+                    return Err(self.err_at(&body.name, format!("body '{}': joint lower limit {lo} > upper {hi}", body.name)));
+                }
+            }
+            let spec_b = BodySpec {
+                name: body.name.clone(),
+                parent,
+                joint_name: joint.name.clone().unwrap_or_else(|| format!("{}_joint", body.name)),
+                joint_type: jt,
+                axis,
+                placement,
+                inertia: self.inertia(body)?,
+                limits,
+                tags: body.tags.clone().unwrap_or_default(),
+                allow_nonphysical: body.allow_nonphysical,
+            };
+            b.add_body(spec_b).map_err(|e| self.relocate(&body.name, e))?;
+        }
+        for f in spec.frames.unwrap_or_default() {
+            let body = b
+                .body_index(&f.body)
+                .ok_or_else(|| self.err_at(&f.name, format!("frame '{}': body '{}' does not exist", f.name, f.body)))?;
+            let pl = f.origin.as_ref().map(|o| origin_se3(o, &ang)).unwrap_or_default();
+            b.add_frame(&f.name, body, pl)?;
+        }
+        b.build().map_err(|e| match &e {
+            FfError::Inertia { body, .. } => self.relocate(&body.clone(), e),
+            _ => FfError::ModelFile { source_name: self.source_name.to_string(), line: None, msg: e.to_string() },
+        })
+    }
+
+    fn relocate(&self, body: &str, e: FfError) -> FfError {
+        self.err_at(body, e.to_string())
+    }
+
+    fn inertia(&self, body: &BodyYaml) -> Result<Inertia> {
+        let Some(i) = &body.inertial else { return Ok(Inertia::zero()) };
+        let bad = |msg: &str| self.err_at(&body.name, format!("body '{}': inertial: {msg}", body.name));
+        if let Some(p) = &i.params {
+            if i.mass.is_some() || i.com.is_some() || i.inertia.is_some() || i.inertia_origin.is_some() {
+                return Err(bad("give either `params` or mass/com/inertia, not both"));
+            }
+            if p.len() != 10 {
+                return Err(bad(&format!("params needs 10 numbers [m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], got {}", p.len())));
+            }
+            return Ok(Inertia::from_params(p));
+        }
+        let mass = i.mass.ok_or_else(|| bad("missing `mass`"))?;
+        let com = V3::from(i.com.unwrap_or([0.0; 3]));
+        match (&i.inertia, &i.inertia_origin) {
+            (Some(ic), None) => Ok(Inertia::from_com(mass, com, ic.matrix())),
+            (None, Some(io)) => Ok(Inertia { mass, h: com * mass, i_o: io.matrix() }),
+            (None, None) => Ok(Inertia::from_com(mass, com, M3::zeros())),
+            (Some(_), Some(_)) => Err(bad("give `inertia` (about the CoM) or `inertia_origin`, not both")),
+        }
+    }
+}
+
+fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> Se3 {
+    let rpy = o.rpy.map(|r| V3::new(ang(r[0]), ang(r[1]), ang(r[2]))).unwrap_or_else(V3::zeros);
+    Se3::new(rpy_to_rot(&rpy), V3::from(o.xyz.unwrap_or([0.0; 3])))
+}

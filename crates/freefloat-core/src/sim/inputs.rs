@@ -1,0 +1,81 @@
+//! What drives a simulation: torque sources, a sampled controller, prescribed joint motion.
+
+use crate::error::{FfError, Result};
+
+/// How a torque table is read between its samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Hold {
+    /// Zero-order hold: the last sample at or before t.
+    Zoh,
+    /// Linear interpolation between samples (held constant beyond the table).
+    Linear,
+}
+
+pub type TorqueFn<'a> = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) -> Result<()> + 'a>;
+
+/// Generalized forces (length nv; for a free base the first six are the base-frame thruster
+/// wrench [force; torque]) as a function of time and state.
+pub enum TorqueSource<'a> {
+    Zero,
+    /// `values` is T × nv, row-major, sampled at increasing `times`.
+    Table { times: Vec<f64>, values: Vec<f64>, hold: Hold },
+    Function(TorqueFn<'a>),
+}
+
+impl TorqueSource<'_> {
+    pub fn table(times: Vec<f64>, values: Vec<f64>, nv: usize, hold: Hold) -> Result<Self> {
+        if times.is_empty() || values.len() != times.len() * nv {
+            return Err(FfError::arg("torques", format!("expected a ({}, {nv}) table, got {} values", times.len(), values.len())));
+        }
+        if let Some(k) = times.windows(2).position(|w| !(w[1] > w[0])) {
+            return Err(FfError::arg("torque_times", format!("times must increase strictly; row {} is not after row {k}", k + 1)));
+        }
+        if let Some(k) = values.iter().chain(&times).position(|x| !x.is_finite()) {
+            return Err(FfError::arg("torques", format!("entry {k} is not finite")));
+        }
+        Ok(TorqueSource::Table { times, values, hold })
+    }
+
+    pub fn eval(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        match self {
+            TorqueSource::Zero => out.fill(0.0),
+            TorqueSource::Function(f) => {
+                f(t, q, v, out)?;
+                if let Some(k) = out.iter().position(|x| !x.is_finite()) {
+                    return Err(FfError::Numerical(format!("torque function returned a non-finite value at entry {k}, t = {t}")));
+                }
+            }
+            TorqueSource::Table { times, values, hold } => {
+                let nv = out.len();
+                // Index of the last sample at or before t (binary search: tables can be long).
+                let k = times.partition_point(|&x| x <= t + 1e-12 * t.abs().max(1.0)).saturating_sub(1);
+                let row = |k: usize| &values[k * nv..(k + 1) * nv];
+                if *hold == Hold::Zoh || k + 1 >= times.len() || t <= times[0] {
+                    out.copy_from_slice(row(k));
+                } else {
+                    let s = (t - times[k]) / (times[k + 1] - times[k]);
+                    for (j, o) in out.iter_mut().enumerate() {
+                        *o = (1.0 - s) * row(k)[j] + s * row(k + 1)[j];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A controller sampled every `period` seconds; its output (generalized forces, length nv) is held
+/// until the next sample and added to the torque source.
+pub struct Controller<'a> {
+    pub period: f64,
+    pub f: TorqueFn<'a>,
+}
+
+pub type PrescriptionFn<'a> = Box<dyn FnMut(f64, &mut [f64], &mut [f64], &mut [f64]) -> Result<()> + 'a>;
+
+/// Joints (given by their child body index) that follow a prescribed motion. `f(t, q, v, a)` fills
+/// full-length q (nq), v and a (nv); only the prescribed joints' entries are read.
+pub struct Prescription<'a> {
+    pub bodies: Vec<usize>,
+    pub f: PrescriptionFn<'a>,
+}

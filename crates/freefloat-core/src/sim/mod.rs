@@ -1,0 +1,359 @@
+//! Simulation: explicit Runge-Kutta on the configuration group (RKMK), fixed-step RK4 and adaptive
+//! Dormand-Prince 5(4), with joint torques, base thrusters (the base entries of the generalized
+//! force), prescribed joint motion (hybrid dynamics) and a sampled controller with zero-order hold.
+
+mod inputs;
+mod tableau;
+mod trajectory;
+
+pub use inputs::{Controller, Hold, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
+pub use trajectory::Trajectory;
+
+use crate::config::{dexpinv, retract, tangent_magnitude, tangent_rate};
+use crate::data::Data;
+use crate::dynamics::{hybrid_aba, Prescribed};
+use crate::error::{check_vec, FfError, Result};
+use crate::kinematics::forward_velocities;
+use crate::model::Model;
+use tableau::{Tableau, DOPRI5, RK4};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    /// Classical RK4 with fixed step `dt`.
+    Rk4,
+    /// Dormand-Prince 5(4) with error control; `dt` is then the output interval.
+    Rk45 { rtol: f64, atol: f64, max_step: f64 },
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct SimOptions {
+    pub t_final: f64,
+    /// RK4: the step. RK45: the interval between recorded samples.
+    pub dt: f64,
+    pub method: Method,
+    /// RK4 only: record every n-th step (1 = every step).
+    pub record_every: usize,
+    /// Give up after this many steps (RK45 runaway protection).
+    pub max_steps: usize,
+}
+
+/// Everything that acts on the robot during a simulation.
+pub struct Inputs<'a> {
+    pub torques: TorqueSource<'a>,
+    pub controller: Option<Controller<'a>>,
+    pub prescription: Option<Prescription<'a>>,
+}
+
+impl Default for Inputs<'_> {
+    fn default() -> Self {
+        Inputs { torques: TorqueSource::Zero, controller: None, prescription: None }
+    }
+}
+
+/// Optional progress callback: called with the fraction done, returns false to abort.
+pub type Progress<'a> = &'a mut dyn FnMut(f64) -> bool;
+
+/// Work buffers of one simulation.
+struct Stepper<'m, 'i> {
+    m: &'m Model,
+    d: Data,
+    inputs: Inputs<'i>,
+    held: Vec<f64>,
+    tau: Vec<f64>,
+    presc_mask: Vec<bool>,
+    presc_q: Vec<f64>,
+    presc_v: Vec<f64>,
+    presc_a: Vec<f64>,
+    qs: Vec<f64>,
+    vs: Vec<f64>,
+    kq: Vec<Vec<f64>>,
+    kv: Vec<Vec<f64>>,
+    kw: Vec<f64>,
+    dq: Vec<f64>,
+    dv: Vec<f64>,
+    evals: usize,
+}
+
+/// Result of one derivative evaluation at a stage.
+impl<'m, 'i> Stepper<'m, 'i> {
+    fn new(m: &'m Model, inputs: Inputs<'i>, stages: usize) -> Result<Self> {
+        let mut presc_mask = vec![false; m.nbodies()];
+        if let Some(p) = &inputs.prescription {
+            for &b in &p.bodies {
+                if b >= m.nbodies() || m.nvs[b] == 0 {
+                    return Err(FfError::arg("prescribed", format!("body index {b} has no moving joint to prescribe")));
+                }
+                presc_mask[b] = true;
+            }
+        }
+        Ok(Stepper {
+            m,
+            d: Data::new(m),
+            inputs,
+            held: vec![0.0; m.nv],
+            tau: vec![0.0; m.nv],
+            presc_mask,
+            presc_q: vec![0.0; m.nq],
+            presc_v: vec![0.0; m.nv],
+            presc_a: vec![0.0; m.nv],
+            qs: vec![0.0; m.nq],
+            vs: vec![0.0; m.nv],
+            kq: vec![vec![0.0; m.nv]; stages],
+            kv: vec![vec![0.0; m.nv]; stages],
+            kw: vec![0.0; stages],
+            dq: vec![0.0; m.nv],
+            dv: vec![0.0; m.nv],
+            evals: 0,
+        })
+    }
+
+    /// Overwrite the prescribed joints' q, v with their prescription at time t.
+    fn impose(&mut self, t: f64, q: &mut [f64], v: &mut [f64]) -> Result<()> {
+        let Some(p) = self.inputs.prescription.as_mut() else { return Ok(()) };
+        (p.f)(t, &mut self.presc_q, &mut self.presc_v, &mut self.presc_a)?;
+        let m = self.m;
+        for (i, _) in self.presc_mask.iter().enumerate().filter(|(_, &b)| b) {
+            let (iq, iv) = (m.idx_q[i], m.idx_v[i]);
+            q[iq..iq + m.nqs[i]].copy_from_slice(&self.presc_q[iq..iq + m.nqs[i]]);
+            v[iv..iv + m.nvs[i]].copy_from_slice(&self.presc_v[iv..iv + m.nvs[i]]);
+        }
+        Ok(())
+    }
+
+    /// Derivative at (t, qs, vs) into stage `s`: tangent rate, acceleration, power. Leaves the joint
+    /// accelerations and forces of this evaluation in `self.d`.
+    fn eval(&mut self, t: f64, s: usize) -> Result<()> {
+        let m = self.m;
+        let (mut qs, mut vs) = (std::mem::take(&mut self.qs), std::mem::take(&mut self.vs));
+        self.impose(t, &mut qs, &mut vs)?;
+        self.inputs.torques.eval(t, &qs, &vs, &mut self.tau)?;
+        for (x, h) in self.tau.iter_mut().zip(&self.held) {
+            *x += h;
+        }
+        let presc = self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
+        hybrid_aba(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?;
+        if let Some(k) = self.d.ddq.iter().position(|x| !x.is_finite()) {
+            return Err(FfError::Numerical(format!("acceleration {k} became non-finite at t = {t}")));
+        }
+        tangent_rate(m, &qs, &vs, &mut self.kq[s]);
+        self.kv[s].copy_from_slice(&self.d.ddq);
+        self.kw[s] = self.d.tau.iter().zip(&vs).map(|(a, b)| a * b).sum();
+        self.evals += 1;
+        self.qs = qs;
+        self.vs = vs;
+        Ok(())
+    }
+
+    /// One Runge-Kutta step from (t, q0, v0, w0). Stage 0 must already hold f(y0) (see `eval`).
+    /// Writes the new state into q1, v1 and returns (w1, error norm or 0).
+    #[allow(clippy::too_many_arguments)]
+    fn step(&mut self, tab: &Tableau, t: f64, h: f64, q0: &[f64], v0: &[f64], w0: f64, q1: &mut [f64], v1: &mut [f64], tol: Option<(f64, f64)>) -> Result<(f64, f64)> {
+        let m = self.m;
+        let nv = m.nv;
+        for s in 1..tab.stages() {
+            for k in 0..nv {
+                let (mut sq, mut sv) = (0.0, 0.0);
+                for (j, a) in tab.a[s].iter().enumerate() {
+                    sq += a * self.kq[j][k];
+                    sv += a * self.kv[j][k];
+                }
+                self.dq[k] = h * sq;
+                self.dv[k] = h * sv;
+            }
+            retract(m, q0, &self.dq, &mut self.qs);
+            for k in 0..nv {
+                self.vs[k] = v0[k] + self.dv[k];
+            }
+            self.eval(t + tab.c[s] * h, s)?;
+            dexpinv(m, &self.dq, &mut self.kq[s]);
+        }
+        let mut w1 = w0;
+        for k in 0..nv {
+            let (mut sq, mut sv) = (0.0, 0.0);
+            for (j, b) in tab.b.iter().enumerate() {
+                sq += b * self.kq[j][k];
+                sv += b * self.kv[j][k];
+            }
+            self.dq[k] = h * sq;
+            self.dv[k] = h * sv;
+        }
+        for (j, b) in tab.b.iter().enumerate() {
+            w1 += h * b * self.kw[j];
+        }
+        retract(m, q0, &self.dq, q1);
+        for k in 0..nv {
+            v1[k] = v0[k] + self.dv[k];
+        }
+        let mut err = 0.0;
+        if let (Some(e), Some((rtol, atol))) = (tab.e, tol) {
+            // Hairer's RMS error norm over the tangent coordinates of q and over v.
+            let mut mag0 = vec![0.0; nv];
+            let mut mag1 = vec![0.0; nv];
+            tangent_magnitude(m, q0, &mut mag0);
+            tangent_magnitude(m, q1, &mut mag1);
+            let mut acc = 0.0;
+            for k in 0..nv {
+                let (mut eq, mut ev) = (0.0, 0.0);
+                for (j, ej) in e.iter().enumerate() {
+                    eq += ej * self.kq[j][k];
+                    ev += ej * self.kv[j][k];
+                }
+                let sq = atol + rtol * mag0[k].max(mag1[k]);
+                let sv = atol + rtol * v0[k].abs().max(v1[k].abs());
+                acc += (h * eq / sq).powi(2) + (h * ev / sv).powi(2);
+            }
+            err = (acc / (2 * nv).max(1) as f64).sqrt();
+        }
+        Ok((w1, err))
+    }
+}
+
+/// Simulate from (q0, v0) over [0, t_final].
+pub fn simulate(m: &Model, q0: &[f64], v0: &[f64], opts: &SimOptions, inputs: Inputs, mut progress: Option<Progress>) -> Result<Trajectory> {
+    let mut qbuf = Vec::new();
+    let q0 = m.checked_q(q0, &mut qbuf)?.to_vec();
+    check_vec("v0", v0, m.nv)?;
+    if !(opts.t_final > 0.0) || !opts.t_final.is_finite() {
+        return Err(FfError::arg("t_final", format!("must be positive and finite, got {}", opts.t_final)));
+    }
+    if !(opts.dt > 0.0) || !opts.dt.is_finite() || opts.dt > opts.t_final {
+        return Err(FfError::arg("dt", format!("must be positive and at most t_final, got {}", opts.dt)));
+    }
+    if opts.record_every == 0 {
+        return Err(FfError::arg("record_every", "must be at least 1"));
+    }
+    if let Some(c) = &inputs.controller {
+        if !(c.period > 0.0) || !c.period.is_finite() {
+            return Err(FfError::arg("controller_period", format!("must be positive, got {}", c.period)));
+        }
+    }
+    let tab = match opts.method {
+        Method::Rk4 => &RK4,
+        Method::Rk45 { rtol, atol, .. } => {
+            if !(rtol > 0.0) || !(atol > 0.0) {
+                return Err(FfError::arg("rtol/atol", "tolerances must be positive"));
+            }
+            &DOPRI5
+        }
+    };
+    let mut st = Stepper::new(m, inputs, tab.stages())?;
+    let mut traj = Trajectory::new(m);
+    let (mut q, mut v) = (q0, v0.to_vec());
+    let (mut q1, mut v1) = (vec![0.0; m.nq], vec![0.0; m.nv]);
+    let mut w = 0.0;
+    let mut t = 0.0;
+    let mut next_sample = 0.0;
+    let mut sample_k = 0usize;
+    st.impose(0.0, &mut q, &mut v)?;
+
+    // The controller is sampled at k·period and held in between.
+    let ctrl_update = |st: &mut Stepper, t: f64, q: &[f64], v: &[f64], next: &mut f64, k: &mut usize| -> Result<()> {
+        if let Some(c) = st.inputs.controller.as_mut() {
+            if t >= *next - 1e-9 * c.period {
+                (c.f)(t, q, v, &mut st.held)?;
+                if let Some(i) = st.held.iter().position(|x| !x.is_finite()) {
+                    return Err(FfError::Numerical(format!("controller output {i} is not finite at t = {t}")));
+                }
+                *k += 1;
+                *next = *k as f64 * c.period;
+            }
+        }
+        Ok(())
+    };
+    let eps_t = 1e-12 * opts.t_final.max(1.0);
+    let n_rk4 = (opts.t_final / opts.dt).round() as usize;
+    let mut h = match opts.method {
+        Method::Rk4 => opts.dt,
+        Method::Rk45 { max_step, .. } => opts.dt.min(max_step).min(opts.t_final),
+    };
+    let mut steps = 0usize;
+    let mut rejected = 0usize;
+    let mut next_out = 0.0;
+    let mut out_k = 0usize;
+    loop {
+        ctrl_update(&mut st, t, &q, &v, &mut next_sample, &mut sample_k)?;
+        st.qs.copy_from_slice(&q);
+        st.vs.copy_from_slice(&v);
+        st.eval(t, 0)?;
+        // Record the state together with the accelerations and forces evaluated at it.
+        let record = match opts.method {
+            Method::Rk4 => steps % opts.record_every == 0 || steps == n_rk4,
+            Method::Rk45 { .. } => (t - next_out).abs() <= eps_t,
+        };
+        if record {
+            traj.push(m, &mut st.d, t, &q, &v, w)?;
+            out_k += 1;
+            next_out = out_k as f64 * opts.dt;
+        }
+        let done = match opts.method {
+            Method::Rk4 => steps >= n_rk4,
+            Method::Rk45 { .. } => t >= opts.t_final - eps_t,
+        };
+        if done {
+            break;
+        }
+        if steps >= opts.max_steps {
+            return Err(FfError::Numerical(format!("gave up after {steps} steps at t = {t} (max_steps)")));
+        }
+        match opts.method {
+            Method::Rk4 => {
+                let (w1, _) = st.step(tab, t, h, &q, &v, w, &mut q1, &mut v1, None)?;
+                w = w1;
+                steps += 1;
+                t = steps as f64 * h;
+            }
+            Method::Rk45 { rtol, atol, max_step } => {
+                // Land exactly on output times, controller samples and the end.
+                let mut stop = next_out.min(opts.t_final);
+                if st.inputs.controller.is_some() {
+                    stop = stop.min(next_sample);
+                }
+                loop {
+                    let hh = h.min(stop - t).min(max_step);
+                    let (w1, err) = st.step(tab, t, hh, &q, &v, w, &mut q1, &mut v1, Some((rtol, atol)))?;
+                    let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
+                    if err <= 1.0 {
+                        w = w1;
+                        t = if (stop - (t + hh)).abs() <= eps_t { stop } else { t + hh };
+                        steps += 1;
+                        if hh >= h * 0.999 || factor < 1.0 {
+                            h = (hh * factor).min(max_step);
+                        }
+                        break;
+                    }
+                    rejected += 1;
+                    h = hh * factor;
+                    if h < 1e-14 * opts.t_final.max(1.0) {
+                        return Err(FfError::Numerical(format!("step size underflow at t = {t}: the tolerances cannot be met")));
+                    }
+                    // Stage 0 still holds f(y0): redo from the same state.
+                }
+            }
+        }
+        std::mem::swap(&mut q, &mut q1);
+        std::mem::swap(&mut v, &mut v1);
+        st.impose(t, &mut q, &mut v)?;
+        if let Some(p) = progress.as_mut() {
+            if steps % 256 == 0 && !p(t / opts.t_final) {
+                return Err(FfError::Numerical(format!("simulation aborted at t = {t}")));
+            }
+        }
+    }
+    traj.steps = steps;
+    traj.rejected = rejected;
+    traj.evaluations = st.evals;
+    if let Some(p) = progress.as_mut() {
+        p(1.0);
+    }
+    Ok(traj)
+}
+
+/// Records need momentum and energy at the recorded state; computed once per record.
+pub(crate) fn record_quantities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) -> ([f64; 6], f64) {
+    forward_velocities(m, d, q, v);
+    let h = crate::kinematics::momentum_from_data(m, d);
+    let e = crate::kinematics::kinetic_energy_from_data(m, d);
+    let mut out = [0.0; 6];
+    h.write(&mut out);
+    (out, e)
+}

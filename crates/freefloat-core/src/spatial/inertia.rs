@@ -1,0 +1,126 @@
+use super::{skew, Force, Motion, Se3, M3, M6, V3};
+
+/// Rigid-body inertia in the parameters the whole project uses (ARCHITECTURE.md): mass, first
+/// moment `h = m c` and the rotational inertia `i_o` about the body-frame origin, all in body axes.
+/// With this choice momentum and Newton-Euler equations are linear in the 10 numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inertia {
+    pub mass: f64,
+    pub h: V3,
+    pub i_o: M3,
+}
+
+impl Inertia {
+    pub fn zero() -> Self {
+        Inertia { mass: 0.0, h: V3::zeros(), i_o: M3::zeros() }
+    }
+
+    /// From mass, centre of mass and inertia about the centre of mass (parallel-axis theorem).
+    pub fn from_com(mass: f64, com: V3, i_c: M3) -> Self {
+        let cx = skew(&com);
+        Inertia { mass, h: com * mass, i_o: i_c - cx * cx * mass }
+    }
+
+    /// From the 10 standard parameters `[m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`.
+    pub fn from_params(p: &[f64]) -> Self {
+        Inertia {
+            mass: p[0],
+            h: V3::new(p[1], p[2], p[3]),
+            i_o: M3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]),
+        }
+    }
+
+    pub fn to_params(&self) -> [f64; 10] {
+        let i = &self.i_o;
+        [self.mass, self.h.x, self.h.y, self.h.z, i[(0, 0)], i[(0, 1)], i[(1, 1)], i[(0, 2)], i[(1, 2)], i[(2, 2)]]
+    }
+
+    /// Centre of mass (zero for a massless body).
+    pub fn com(&self) -> V3 {
+        if self.mass > 0.0 {
+            self.h / self.mass
+        } else {
+            V3::zeros()
+        }
+    }
+
+    /// Inertia about the centre of mass.
+    pub fn i_com(&self) -> M3 {
+        if self.mass > 0.0 {
+            let cx = skew(&self.com());
+            self.i_o + cx * cx * self.mass
+        } else {
+            self.i_o
+        }
+    }
+
+    /// Spatial momentum (about the body origin, body axes) of a body moving with twist `v`.
+    #[inline]
+    pub fn mul_motion(&self, v: &Motion) -> Force {
+        Force {
+            lin: v.lin * self.mass - self.h.cross(&v.ang),
+            ang: self.i_o * v.ang + self.h.cross(&v.lin),
+        }
+    }
+
+    /// 6×6 matrix form, mapping `[v; w]` to `[f; n]`.
+    pub fn to_matrix(&self) -> M6 {
+        let hx = skew(&self.h);
+        let mut m = M6::zeros();
+        m.fixed_view_mut::<3, 3>(0, 0).copy_from(&(M3::identity() * self.mass));
+        m.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-hx));
+        m.fixed_view_mut::<3, 3>(3, 0).copy_from(&hx);
+        m.fixed_view_mut::<3, 3>(3, 3).copy_from(&self.i_o);
+        m
+    }
+
+    /// The same inertia seen from the parent frame of `x` (x places this body's frame in the parent).
+    pub fn transformed(&self, x: &Se3) -> Inertia {
+        let h_r = x.rot * self.h;
+        let i_r = x.rot * self.i_o * x.rot.transpose();
+        let p = x.trans;
+        // Shift the origin by p: h' = h + m p, I' = I - [p][h] - [h + m p][p] (tensor parallel-axis form).
+        let h_new = h_r + p * self.mass;
+        let px = skew(&p);
+        let i_new = i_r - px * skew(&h_r) - skew(&h_new) * px;
+        Inertia { mass: self.mass, h: h_new, i_o: i_new }
+    }
+
+    pub fn add(&self, o: &Inertia) -> Inertia {
+        Inertia { mass: self.mass + o.mass, h: self.h + o.h, i_o: self.i_o + o.i_o }
+    }
+
+    /// Kinetic energy of the body moving with twist `v`.
+    pub fn kinetic_energy(&self, v: &Motion) -> f64 {
+        0.5 * v.dot(&self.mul_motion(v))
+    }
+}
+
+/// Express a 6×6 articulated inertia given in a child frame in the parent frame:
+/// `I_p = X* I_c X⁻¹`, computed blockwise (about 40 % cheaper than two dense 6×6 products).
+/// `x` places the child frame in the parent. Blocks: I = [[A, B], [Bᵀ, D]] for [lin; ang].
+pub fn transform_inertia_to_parent(x: &Se3, ic: &M6) -> M6 {
+    let r = &x.rot;
+    let rt = r.transpose();
+    let a = r * ic.fixed_view::<3, 3>(0, 0) * rt;
+    let b = r * ic.fixed_view::<3, 3>(0, 3) * rt;
+    let d = r * ic.fixed_view::<3, 3>(3, 3) * rt;
+    let px = skew(&x.trans);
+    let apx = a * px;
+    let bp = b - apx; // B' - A'[p]
+    let pb = px * b;
+    // D' - [p]A'[p] + [p]B' - B'ᵀ[p]; since [p]ᵀ = -[p], the last term equals ([p]B')ᵀ.
+    let dp = d - px * apx + pb + pb.transpose();
+    let mut out = M6::zeros();
+    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&a);
+    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&bp);
+    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&bp.transpose());
+    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&dp);
+    out
+}
+
+/// Product of a 6×6 (articulated) inertia with a twist, as a wrench.
+#[inline]
+pub fn m6_mul_motion(i: &M6, v: &Motion) -> Force {
+    Force::from_v6(&(i * v.to_v6()))
+}

@@ -1,0 +1,66 @@
+use super::{Force, Motion, M3, V3};
+
+/// Placement of a frame B in a frame A: `x_A = rot * x_B + trans`.
+/// `act_*` map vectors expressed in B to A; `inv_act_*` map A to B.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Se3 {
+    pub rot: M3,
+    pub trans: V3,
+}
+
+impl Default for Se3 {
+    fn default() -> Self {
+        Se3::identity()
+    }
+}
+
+impl Se3 {
+    #[inline]
+    pub fn identity() -> Self {
+        Se3 { rot: M3::identity(), trans: V3::zeros() }
+    }
+    #[inline]
+    pub fn new(rot: M3, trans: V3) -> Self {
+        Se3 { rot, trans }
+    }
+    /// Composition: (self * other) places C in A when self places B in A and other places C in B.
+    #[inline]
+    pub fn compose(&self, o: &Se3) -> Se3 {
+        Se3 { rot: self.rot * o.rot, trans: self.rot * o.trans + self.trans }
+    }
+    #[inline]
+    pub fn inverse(&self) -> Se3 {
+        let rt = self.rot.transpose();
+        Se3 { rot: rt, trans: -(rt * self.trans) }
+    }
+    /// self⁻¹ * o, without forming the inverse.
+    #[inline]
+    pub fn inv_compose(&self, o: &Se3) -> Se3 {
+        let rt = self.rot.transpose();
+        Se3 { rot: rt * o.rot, trans: rt * (o.trans - self.trans) }
+    }
+    #[inline]
+    pub fn act_point(&self, p: &V3) -> V3 {
+        self.rot * p + self.trans
+    }
+    #[inline]
+    pub fn act_motion(&self, m: &Motion) -> Motion {
+        let ang = self.rot * m.ang;
+        Motion { lin: self.rot * m.lin + self.trans.cross(&ang), ang }
+    }
+    #[inline]
+    pub fn inv_act_motion(&self, m: &Motion) -> Motion {
+        let rt = self.rot.transpose();
+        Motion { lin: rt * (m.lin - self.trans.cross(&m.ang)), ang: rt * m.ang }
+    }
+    #[inline]
+    pub fn act_force(&self, f: &Force) -> Force {
+        let lin = self.rot * f.lin;
+        Force { lin, ang: self.rot * f.ang + self.trans.cross(&lin) }
+    }
+    #[inline]
+    pub fn inv_act_force(&self, f: &Force) -> Force {
+        let rt = self.rot.transpose();
+        Force { lin: rt * f.lin, ang: rt * (f.ang - self.trans.cross(&f.lin)) }
+    }
+}

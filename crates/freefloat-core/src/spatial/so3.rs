@@ -1,0 +1,130 @@
+//! Rotations: quaternions in the (x, y, z, w) order used by `q`, rotation matrices, the SO(3)
+//! exponential/logarithm and the inverse right Jacobian that the Lie-group integrator needs.
+
+use super::{skew, M3, V3};
+
+/// Hamilton product of two quaternions stored (x, y, z, w).
+#[inline]
+pub fn quat_mul(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    let (ax, ay, az, aw) = (a[0], a[1], a[2], a[3]);
+    let (bx, by, bz, bw) = (b[0], b[1], b[2], b[3]);
+    [
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+        aw * bw - ax * bx - ay * by - az * bz,
+    ]
+}
+
+#[inline]
+pub fn quat_normalize(q: &mut [f64]) {
+    let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+    for x in q.iter_mut().take(4) {
+        *x /= n;
+    }
+}
+
+/// Rotation matrix of a unit quaternion (x, y, z, w).
+#[inline]
+pub fn rot_from_quat(q: &[f64]) -> M3 {
+    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    let (xx, yy, zz) = (x * x, y * y, z * z);
+    let (xy, xz, yz, wx, wy, wz) = (x * y, x * z, y * z, w * x, w * y, w * z);
+    M3::new(
+        1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy),
+        2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx),
+        2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy),
+    )
+}
+
+/// Unit quaternion (x, y, z, w, with w >= 0) of a rotation matrix (Shepperd's method).
+pub fn quat_from_rot(r: &M3) -> [f64; 4] {
+    let tr = r[(0, 0)] + r[(1, 1)] + r[(2, 2)];
+    let q = if tr > 0.0 {
+        let s = (tr + 1.0).sqrt() * 2.0;
+        [(r[(2, 1)] - r[(1, 2)]) / s, (r[(0, 2)] - r[(2, 0)]) / s, (r[(1, 0)] - r[(0, 1)]) / s, 0.25 * s]
+    } else if r[(0, 0)] > r[(1, 1)] && r[(0, 0)] > r[(2, 2)] {
+        let s = (1.0 + r[(0, 0)] - r[(1, 1)] - r[(2, 2)]).sqrt() * 2.0;
+        [0.25 * s, (r[(0, 1)] + r[(1, 0)]) / s, (r[(0, 2)] + r[(2, 0)]) / s, (r[(2, 1)] - r[(1, 2)]) / s]
+    } else if r[(1, 1)] > r[(2, 2)] {
+        let s = (1.0 + r[(1, 1)] - r[(0, 0)] - r[(2, 2)]).sqrt() * 2.0;
+        [(r[(0, 1)] + r[(1, 0)]) / s, 0.25 * s, (r[(1, 2)] + r[(2, 1)]) / s, (r[(0, 2)] - r[(2, 0)]) / s]
+    } else {
+        let s = (1.0 + r[(2, 2)] - r[(0, 0)] - r[(1, 1)]).sqrt() * 2.0;
+        [(r[(0, 2)] + r[(2, 0)]) / s, (r[(1, 2)] + r[(2, 1)]) / s, 0.25 * s, (r[(1, 0)] - r[(0, 1)]) / s]
+    };
+    let sign = if q[3] < 0.0 { -1.0 } else { 1.0 };
+    let mut q = [q[0] * sign, q[1] * sign, q[2] * sign, q[3] * sign];
+    quat_normalize(&mut q);
+    q
+}
+
+/// Quaternion of the rotation vector `phi` (axis * angle): exp(phi/2) in quaternion form.
+#[inline]
+pub fn quat_exp(phi: &V3) -> [f64; 4] {
+    let th = phi.norm();
+    let half = 0.5 * th;
+    // sin(th/2)/th, with its Taylor series near zero to keep full precision.
+    let k = if th < 1e-4 { 0.5 - th * th / 48.0 } else { half.sin() / th };
+    [k * phi.x, k * phi.y, k * phi.z, half.cos()]
+}
+
+/// Rotation matrix about a unit axis by `angle` (Rodrigues).
+#[inline]
+pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
+    let (s, c) = angle.sin_cos();
+    let k = skew(axis);
+    M3::identity() + k * s + k * k * (1.0 - c)
+}
+
+/// Rotation vector of a rotation matrix (inverse of the exponential), angle in [0, pi].
+pub fn so3_log(r: &M3) -> V3 {
+    let q = quat_from_rot(r);
+    let v = V3::new(q[0], q[1], q[2]);
+    let s = v.norm();
+    if s < 1e-12 {
+        return v * 2.0;
+    }
+    let th = 2.0 * s.atan2(q[3]);
+    v * (th / s)
+}
+
+/// Inverse of the right Jacobian of SO(3): if `R(t) = R0 exp(theta(t))` and `R' = R [w]`, then
+/// `theta' = Jr(theta)^-1 w`. This is the dexp⁻¹ correction that makes Runge-Kutta on the rotation
+/// group fourth order (Munthe-Kaas); without it RK4 on the base attitude is only second order.
+pub fn so3_right_jacobian_inv(theta: &V3, w: &V3) -> V3 {
+    let th2 = theta.norm_squared();
+    let tw = theta.cross(w);
+    let ttw = theta.cross(&tw);
+    // coefficient of [theta]^2: 1/th^2 - (1 + cos th)/(2 th sin th), series 1/12 + th^2/720 near 0.
+    let c2 = if th2 < 1e-6 {
+        1.0 / 12.0 + th2 / 720.0
+    } else {
+        let th = th2.sqrt();
+        1.0 / th2 - (1.0 + th.cos()) / (2.0 * th * th.sin())
+    };
+    w + tw * 0.5 + ttw * c2
+}
+
+/// URDF roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll).
+pub fn rpy_to_rot(rpy: &V3) -> M3 {
+    let (sr, cr) = rpy.x.sin_cos();
+    let (sp, cp) = rpy.y.sin_cos();
+    let (sy, cy) = rpy.z.sin_cos();
+    M3::new(
+        cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr,
+        sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr,
+        -sp, cp * sr, cp * cr,
+    )
+}
+
+/// Inverse of `rpy_to_rot` (pitch in [-pi/2, pi/2]).
+pub fn rot_to_rpy(r: &M3) -> V3 {
+    let pitch = (-r[(2, 0)]).clamp(-1.0, 1.0).asin();
+    if (r[(2, 0)].abs() - 1.0).abs() < 1e-12 {
+        // Gimbal lock: only roll ± yaw is defined; put it all in yaw.
+        let yaw = (-r[(0, 1)]).atan2(r[(1, 1)]);
+        return V3::new(0.0, pitch, yaw);
+    }
+    V3::new(r[(2, 1)].atan2(r[(2, 2)]), pitch, r[(1, 0)].atan2(r[(0, 0)]))
+}

@@ -1,0 +1,109 @@
+use super::{V3, V6};
+use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
+
+/// A twist or spatial acceleration: `lin` is the (classical/spatial) linear part at the frame origin,
+/// `ang` the angular part.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    pub lin: V3,
+    pub ang: V3,
+}
+
+/// A wrench or spatial momentum: `lin` is the force (linear momentum), `ang` the moment about the
+/// frame origin (angular momentum about it).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Force {
+    pub lin: V3,
+    pub ang: V3,
+}
+
+macro_rules! vec6_ops {
+    ($t:ident) => {
+        impl $t {
+            pub const ZERO: $t = $t { lin: V3::new(0.0, 0.0, 0.0), ang: V3::new(0.0, 0.0, 0.0) };
+            #[inline]
+            pub fn new(lin: V3, ang: V3) -> Self {
+                Self { lin, ang }
+            }
+            #[inline]
+            pub fn from_v6(x: &V6) -> Self {
+                Self { lin: V3::new(x[0], x[1], x[2]), ang: V3::new(x[3], x[4], x[5]) }
+            }
+            #[inline]
+            pub fn from_slice(x: &[f64]) -> Self {
+                Self { lin: V3::new(x[0], x[1], x[2]), ang: V3::new(x[3], x[4], x[5]) }
+            }
+            #[inline]
+            pub fn to_v6(&self) -> V6 {
+                V6::new(self.lin.x, self.lin.y, self.lin.z, self.ang.x, self.ang.y, self.ang.z)
+            }
+            #[inline]
+            pub fn write(&self, out: &mut [f64]) {
+                out[..3].copy_from_slice(self.lin.as_slice());
+                out[3..6].copy_from_slice(self.ang.as_slice());
+            }
+        }
+        impl Add for $t {
+            type Output = $t;
+            #[inline]
+            fn add(self, o: $t) -> $t {
+                $t { lin: self.lin + o.lin, ang: self.ang + o.ang }
+            }
+        }
+        impl Sub for $t {
+            type Output = $t;
+            #[inline]
+            fn sub(self, o: $t) -> $t {
+                $t { lin: self.lin - o.lin, ang: self.ang - o.ang }
+            }
+        }
+        impl AddAssign for $t {
+            #[inline]
+            fn add_assign(&mut self, o: $t) {
+                self.lin += o.lin;
+                self.ang += o.ang;
+            }
+        }
+        impl SubAssign for $t {
+            #[inline]
+            fn sub_assign(&mut self, o: $t) {
+                self.lin -= o.lin;
+                self.ang -= o.ang;
+            }
+        }
+        impl Neg for $t {
+            type Output = $t;
+            #[inline]
+            fn neg(self) -> $t {
+                $t { lin: -self.lin, ang: -self.ang }
+            }
+        }
+        impl Mul<f64> for $t {
+            type Output = $t;
+            #[inline]
+            fn mul(self, s: f64) -> $t {
+                $t { lin: self.lin * s, ang: self.ang * s }
+            }
+        }
+    };
+}
+vec6_ops!(Motion);
+vec6_ops!(Force);
+
+impl Motion {
+    /// Motion cross product `self ×m other` (derivative of a moving twist).
+    #[inline]
+    pub fn cross_motion(&self, m: &Motion) -> Motion {
+        Motion { lin: self.ang.cross(&m.lin) + self.lin.cross(&m.ang), ang: self.ang.cross(&m.ang) }
+    }
+    /// Force cross product `self ×* f` (rate of change of a momentum carried by a moving frame).
+    #[inline]
+    pub fn cross_force(&self, f: &Force) -> Force {
+        Force { lin: self.ang.cross(&f.lin), ang: self.ang.cross(&f.ang) + self.lin.cross(&f.lin) }
+    }
+    /// Power of a wrench on this twist.
+    #[inline]
+    pub fn dot(&self, f: &Force) -> f64 {
+        self.lin.dot(&f.lin) + self.ang.dot(&f.ang)
+    }
+}

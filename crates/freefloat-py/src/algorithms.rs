@@ -1,0 +1,342 @@
+//! The engine's algorithms as Python functions. Each accepts one sample or a leading time axis and
+//! loops over samples in Rust with the GIL released.
+
+use crate::batch::{common_rows, output, Batch};
+use crate::errors::{guard, input_err};
+use crate::model::PyModel;
+use freefloat_core::dynamics::{self, Prescribed};
+use freefloat_core::kinematics::{self as kin, Reference};
+use freefloat_core::spatial::quat_from_rot;
+use freefloat_core::{Data, FfError, Model};
+use numpy::PyReadonlyArrayDyn;
+use pyo3::prelude::*;
+
+type Arr<'py> = PyReadonlyArrayDyn<'py, f64>;
+
+fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
+    if !stacked {
+        return e;
+    }
+    match e {
+        FfError::Argument { name, msg } => FfError::Argument { name, msg: format!("sample {k}: {msg}") },
+        FfError::Numerical(msg) => FfError::Numerical(format!("sample {k}: {msg}")),
+        other => other,
+    }
+}
+
+/// Evaluate `f` on every sample, each writing `width` numbers, with the GIL released.
+fn run_rows<F>(py: Python<'_>, model: &PyModel, rows: usize, stacked: bool, width: usize, f: F) -> PyResult<Vec<f64>>
+where
+    F: Fn(&Model, &mut Data, usize, &mut [f64], &mut Vec<f64>) -> Result<(), FfError> + Send + Sync,
+{
+    py.detach(|| {
+        model.with_data(|m, d| {
+            guard(|| {
+                let mut out = vec![0.0; rows * width];
+                let mut buf = Vec::new();
+                for k in 0..rows {
+                    f(m, d, k, &mut out[k * width..(k + 1) * width], &mut buf).map_err(|e| at_row(e, k, stacked))?;
+                }
+                Ok(out)
+            })
+        })
+    })
+}
+
+fn fext_batch(m: &Model, fext: Option<Arr>) -> PyResult<Option<Batch>> {
+    fext.map(|f| Batch::new("fext", &f, &[m.nbodies(), 6])).transpose()
+}
+
+fn name_to_frame(m: &Model, name: &str) -> PyResult<(usize, freefloat_core::spatial::Se3)> {
+    guard(|| m.frame_or_body(name))
+}
+
+/// Placement of every body in the inertial frame: (nbodies, 7) = position, quaternion x y z w.
+#[pyfunction]
+pub fn forward_kinematics<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let nb = m.nbodies();
+    let out = run_rows(py, model, rows, st, nb * 7, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        kin::forward_kinematics(m, d, q);
+        for i in 0..nb {
+            let p = &d.o_mi[i];
+            o[7 * i..7 * i + 3].copy_from_slice(p.trans.as_slice());
+            o[7 * i + 3..7 * i + 7].copy_from_slice(&quat_from_rot(&p.rot));
+        }
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[nb, 7])
+}
+
+/// Placement of a body or frame in the inertial frame: (7,) = position, quaternion x y z w.
+#[pyfunction]
+pub fn frame_placement<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (body, pl) = name_to_frame(m, name)?;
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let out = run_rows(py, model, rows, st, 7, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        kin::forward_kinematics(m, d, q);
+        let p = kin::frame_placement(d, body, &pl);
+        o[..3].copy_from_slice(p.trans.as_slice());
+        o[3..].copy_from_slice(&quat_from_rot(&p.rot));
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[7])
+}
+
+#[pyfunction]
+pub fn center_of_mass<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let out = run_rows(py, model, rows, st, 3, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        o.copy_from_slice(kin::center_of_mass(m, d, q).as_slice());
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[3])
+}
+
+/// Total momentum [linear; angular about the inertial origin], inertial frame.
+#[pyfunction]
+pub fn momentum<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (qb, vb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?);
+    let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
+    let out = run_rows(py, model, rows, st, 6, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        kin::momentum(m, d, q, vb.row(k)).write(o);
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[6])
+}
+
+#[pyfunction]
+pub fn kinetic_energy<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (qb, vb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?);
+    let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
+    let out = run_rows(py, model, rows, st, 1, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        o[0] = kin::kinetic_energy(m, d, q, vb.row(k));
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[])
+}
+
+/// Centroidal momentum matrix about the inertial origin (6, nv): momentum == A @ v.
+#[pyfunction]
+pub fn centroidal_momentum_matrix<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let nv = m.nv;
+    let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        kin::centroidal_momentum_matrix(m, d, q);
+        write_rowmajor(&d.jac, o);
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[6, nv])
+}
+
+fn write_rowmajor(a: &nalgebra::DMatrix<f64>, o: &mut [f64]) {
+    let c = a.ncols();
+    for r in 0..a.nrows() {
+        for j in 0..c {
+            o[r * c + j] = a[(r, j)];
+        }
+    }
+}
+
+/// Jacobian (6, nv) of a body or frame: its twist [linear; angular] is J @ v.
+#[pyfunction]
+#[pyo3(signature = (model, q, name, reference = "local"))]
+pub fn frame_jacobian<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, name: &str, reference: &str) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (body, pl) = name_to_frame(m, name)?;
+    let rf = guard(|| Reference::from_name(reference))?;
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let nv = m.nv;
+    let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        let mut j = std::mem::take(&mut d.jac);
+        kin::frame_jacobian(m, d, q, body, &pl, rf, &mut j);
+        write_rowmajor(&j, o);
+        d.jac = j;
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[6, nv])
+}
+
+/// Generalized Jacobian of a free-floating robot: with total momentum h0 conserved, the frame's
+/// twist is Jg @ qdot_joints + offset. Returns (Jg (6, nv - nv_base), offset (6,)).
+#[pyfunction]
+#[pyo3(signature = (model, q, name, reference = "world", h0 = None))]
+pub fn generalized_jacobian<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: Arr<'py>,
+    name: &str,
+    reference: &str,
+    h0: Option<[f64; 6]>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let m = &model.inner;
+    let (body, pl) = name_to_frame(m, name)?;
+    let rf = guard(|| Reference::from_name(reference))?;
+    let h0 = h0.unwrap_or([0.0; 6]);
+    if h0.iter().any(|x| !x.is_finite()) {
+        return Err(input_err("argument `h0`: must be finite"));
+    }
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let nm = m.nv - m.nvs[0];
+    let out = run_rows(py, model, rows, st, 6 * nm + 6, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        let (jg, off) = kin::generalized_jacobian(m, d, q, body, &pl, rf, &h0)?;
+        write_rowmajor(&jg, &mut o[..6 * nm]);
+        o[6 * nm..].copy_from_slice(&off);
+        Ok(())
+    })?;
+    let (mut jg, mut off) = (Vec::with_capacity(rows * 6 * nm), Vec::with_capacity(rows * 6));
+    for k in 0..rows {
+        let r = &out[k * (6 * nm + 6)..(k + 1) * (6 * nm + 6)];
+        jg.extend_from_slice(&r[..6 * nm]);
+        off.extend_from_slice(&r[6 * nm..]);
+    }
+    Ok((output(py, jg, rows, st, &[6, nm])?, output(py, off, rows, st, &[6])?))
+}
+
+/// Inverse dynamics: generalized forces for accelerations `a`.
+#[pyfunction]
+#[pyo3(signature = (model, q, v, a, fext = None))]
+pub fn rnea<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>, a: Arr<'py>, fext: Option<Arr<'py>>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (qb, vb, ab) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("a", &a, &[m.nv])?);
+    let fb = fext_batch(m, fext)?;
+    let mut args = vec![("q", &qb), ("v", &vb), ("a", &ab)];
+    if let Some(f) = &fb {
+        args.push(("fext", f));
+    }
+    let (rows, st) = common_rows(&args)?;
+    let out = run_rows(py, model, rows, st, m.nv, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        dynamics::rnea(m, d, q, vb.row(k), ab.row(k), fb.as_ref().map(|f| f.row(k)));
+        o.copy_from_slice(&d.tau);
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[m.nv])
+}
+
+/// Joint-space inertia matrix (nv, nv), full symmetric.
+#[pyfunction]
+pub fn crba<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let qb = Batch::new("q", &q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let nv = m.nv;
+    let out = run_rows(py, model, rows, st, nv * nv, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        dynamics::crba(m, d, q);
+        write_rowmajor(&d.mass_matrix, o);
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[nv, nv])
+}
+
+/// Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`.
+#[pyfunction]
+#[pyo3(signature = (model, q, v, tau, fext = None))]
+pub fn aba<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>, tau: Arr<'py>, fext: Option<Arr<'py>>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (qb, vb, tb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("tau", &tau, &[m.nv])?);
+    let fb = fext_batch(m, fext)?;
+    let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
+    if let Some(f) = &fb {
+        args.push(("fext", f));
+    }
+    let (rows, st) = common_rows(&args)?;
+    let out = run_rows(py, model, rows, st, m.nv, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        dynamics::aba(m, d, q, vb.row(k), tb.row(k), fb.as_ref().map(|f| f.row(k)))?;
+        o.copy_from_slice(&d.ddq);
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[m.nv])
+}
+
+/// Body indices of the named joints (or bodies), rejecting joints without velocity coordinates.
+pub fn prescribed_bodies(m: &Model, names: &[String]) -> PyResult<Vec<usize>> {
+    names
+        .iter()
+        .map(|n| {
+            let i = m
+                .joint_names
+                .iter()
+                .position(|j| j == n)
+                .or_else(|| m.body_index(n))
+                .ok_or_else(|| input_err(format!("prescribed joint '{n}' is not a joint of model '{}' (joints: {})", m.name, m.joint_names.join(", "))))?;
+            if m.nvs[i] == 0 {
+                return Err(input_err(format!("joint '{}' is fixed: it has no motion to prescribe", m.joint_names[i])));
+            }
+            Ok(i)
+        })
+        .collect()
+}
+
+/// Hybrid dynamics: joints in `prescribed` follow accelerations `ddq` (their entries of it), the
+/// rest respond to `tau`. Returns (ddq_all, tau_all), tau_all holding the forces the prescribed
+/// joints needed.
+#[pyfunction]
+#[pyo3(signature = (model, q, v, tau, ddq, prescribed, fext = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn hybrid_dynamics<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: Arr<'py>,
+    v: Arr<'py>,
+    tau: Arr<'py>,
+    ddq: Arr<'py>,
+    prescribed: Vec<String>,
+    fext: Option<Arr<'py>>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let m = &model.inner;
+    let bodies = prescribed_bodies(m, &prescribed)?;
+    let mut mask = vec![false; m.nbodies()];
+    for b in bodies {
+        mask[b] = true;
+    }
+    let (qb, vb, tb, ab) = (
+        Batch::new("q", &q, &[m.nq])?,
+        Batch::new("v", &v, &[m.nv])?,
+        Batch::new("tau", &tau, &[m.nv])?,
+        Batch::new("ddq", &ddq, &[m.nv])?,
+    );
+    let fb = fext_batch(m, fext)?;
+    let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb), ("ddq", &ab)];
+    if let Some(f) = &fb {
+        args.push(("fext", f));
+    }
+    let (rows, st) = common_rows(&args)?;
+    let nv = m.nv;
+    let out = run_rows(py, model, rows, st, 2 * nv, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        let p = Prescribed { mask: &mask, ddq: ab.row(k) };
+        dynamics::hybrid_aba(m, d, q, vb.row(k), tb.row(k), fb.as_ref().map(|f| f.row(k)), Some(p))?;
+        o[..nv].copy_from_slice(&d.ddq);
+        o[nv..].copy_from_slice(&d.tau);
+        Ok(())
+    })?;
+    let (mut a, mut t) = (Vec::with_capacity(rows * nv), Vec::with_capacity(rows * nv));
+    for k in 0..rows {
+        a.extend_from_slice(&out[k * 2 * nv..k * 2 * nv + nv]);
+        t.extend_from_slice(&out[k * 2 * nv + nv..(k + 1) * 2 * nv]);
+    }
+    Ok((output(py, a, rows, st, &[nv])?, output(py, t, rows, st, &[nv])?))
+}

@@ -1,0 +1,82 @@
+//! Stacked (time-series) arguments: every function takes one sample or a leading time axis.
+
+use crate::errors::input_err;
+use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+
+/// A validated, contiguous copy of an argument with `rows` samples of `width` numbers each.
+pub struct Batch {
+    pub data: Vec<f64>,
+    pub rows: usize,
+    pub width: usize,
+    pub stacked: bool,
+}
+
+impl Batch {
+    /// `inner` is the shape of one sample, e.g. [nq] or [nbodies, 6].
+    pub fn new(name: &str, a: &PyReadonlyArrayDyn<f64>, inner: &[usize]) -> PyResult<Batch> {
+        let shape = a.shape().to_vec();
+        let expect = || {
+            let s: Vec<String> = inner.iter().map(|x| x.to_string()).collect();
+            format!("({}) or (T, {})", s.join(", "), s.join(", "))
+        };
+        let stacked = if shape.as_slice() == inner {
+            false
+        } else if shape.len() == inner.len() + 1 && &shape[1..] == inner {
+            true
+        } else {
+            return Err(input_err(format!("argument `{name}`: expected shape {}, got {:?}", expect(), shape)));
+        };
+        let data: Vec<f64> = match a.as_slice() {
+            Ok(s) => s.to_vec(),
+            Err(_) => a.as_array().iter().copied().collect(),
+        };
+        let width: usize = inner.iter().product();
+        if let Some(k) = data.iter().position(|x| !x.is_finite()) {
+            let where_ = if stacked { format!("sample {}, entry {}", k / width.max(1), k % width.max(1)) } else { format!("entry {k}") };
+            return Err(input_err(format!("argument `{name}`: {where_} is {} (must be finite)", data[k])));
+        }
+        let rows = if stacked { shape[0] } else { 1 };
+        Ok(Batch { data, rows, width, stacked })
+    }
+
+    #[inline]
+    pub fn row(&self, k: usize) -> &[f64] {
+        let k = if self.stacked { k } else { 0 };
+        &self.data[k * self.width..(k + 1) * self.width]
+    }
+}
+
+/// Number of samples of a set of arguments: single samples broadcast, stacked ones must agree.
+pub fn common_rows(batches: &[(&str, &Batch)]) -> PyResult<(usize, bool)> {
+    let mut rows: Option<(usize, &str)> = None;
+    for (name, b) in batches {
+        if b.stacked {
+            match rows {
+                None => rows = Some((b.rows, name)),
+                Some((r, first)) if r != b.rows => {
+                    return Err(input_err(format!(
+                        "argument `{name}` has {} samples but `{first}` has {r}: stacked arguments must share the time axis",
+                        b.rows
+                    )))
+                }
+                _ => {}
+            }
+        }
+    }
+    Ok(rows.map(|(r, _)| (r, true)).unwrap_or((1, false)))
+}
+
+/// Build the output array: `inner` is the shape of one sample's result.
+pub fn output<'py>(py: Python<'py>, data: Vec<f64>, rows: usize, stacked: bool, inner: &[usize]) -> PyResult<Bound<'py, PyAny>> {
+    let mut shape = vec![];
+    if stacked {
+        shape.push(rows);
+    }
+    shape.extend_from_slice(inner);
+    if shape.is_empty() {
+        return Ok(data[0].into_pyobject(py)?.into_any());
+    }
+    let arr: Bound<'py, PyArrayDyn<f64>> = PyArray1::from_vec(py, data).reshape(shape)?;
+    Ok(arr.into_any())
+}

@@ -1,0 +1,33 @@
+//! Python bindings of the freefloat engine (module `freefloat._core`). Only conversion and
+//! validation live here; every number is computed in freefloat-core.
+
+mod algorithms;
+mod batch;
+mod errors;
+mod model;
+mod simulate;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add_class::<model::PyModel>()?;
+    m.add("ModelError", py.get_type::<errors::ModelError>())?;
+    m.add("InputError", py.get_type::<errors::InputError>())?;
+    m.add("NumericalError", py.get_type::<errors::NumericalError>())?;
+    m.add_function(wrap_pyfunction!(algorithms::forward_kinematics, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::frame_placement, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::center_of_mass, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::momentum, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::kinetic_energy, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::centroidal_momentum_matrix, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::frame_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::generalized_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::rnea, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::crba, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::aba, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::hybrid_dynamics, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,193 @@
+//! `simulate`: the engine's integrators driven from Python. Python callables (torque function,
+//! controller, prescribed motion, progress) are called with the GIL held; without them the whole
+//! run happens with the GIL released.
+
+use crate::algorithms::prescribed_bodies;
+use crate::errors::{guard, input_err};
+use crate::model::PyModel;
+use freefloat_core::sim::{self, Controller, Hold, Inputs, Method, Prescription, SimOptions, TorqueSource};
+use freefloat_core::FfError;
+use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use std::cell::RefCell;
+use std::rc::Rc;
+
+/// The first Python exception raised inside a callback; re-raised when the run stops.
+type Stash = Rc<RefCell<Option<PyErr>>>;
+
+fn stash_err(stash: &Stash, e: PyErr, what: &str) -> FfError {
+    let mut s = stash.borrow_mut();
+    if s.is_none() {
+        *s = Some(e);
+    }
+    FfError::Numerical(format!("{what} raised an exception"))
+}
+
+/// Copy a callback's return value (anything array-like) into `out`, checking its length.
+fn fill(obj: &Bound<'_, PyAny>, out: &mut [f64], what: &str) -> PyResult<()> {
+    let np = obj.py().import("numpy")?;
+    let arr = np.call_method1("asarray", (obj, "float64"))?;
+    let arr: PyReadonlyArrayDyn<f64> = arr.extract()?;
+    if arr.len() != out.len() {
+        return Err(input_err(format!("{what} must return {} numbers, returned shape {:?}", out.len(), arr.shape())));
+    }
+    for (o, x) in out.iter_mut().zip(arr.as_array().iter()) {
+        *o = *x;
+    }
+    Ok(())
+}
+
+fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'static str) -> sim::TorqueFn<'py> {
+    Box::new(move |t, q, v, out| {
+        let r = f
+            .call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, v)))
+            .and_then(|r| fill(&r, out, what));
+        r.map_err(|e| stash_err(&stash, e, what))
+    })
+}
+
+#[pyfunction]
+#[pyo3(signature = (
+    model, q0, v0, t_final, dt, method = "rk4", rtol = 1e-9, atol = 1e-12, max_step = None, record_every = 1,
+    torques = None, torque_times = None, hold = "zoh", controller = None, controller_period = None,
+    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q0: PyReadonlyArray1<'py, f64>,
+    v0: PyReadonlyArray1<'py, f64>,
+    t_final: f64,
+    dt: f64,
+    method: &str,
+    rtol: f64,
+    atol: f64,
+    max_step: Option<f64>,
+    record_every: usize,
+    torques: Option<Bound<'py, PyAny>>,
+    torque_times: Option<PyReadonlyArray1<'py, f64>>,
+    hold: &str,
+    controller: Option<Bound<'py, PyAny>>,
+    controller_period: Option<f64>,
+    prescribed: Option<Vec<String>>,
+    prescription: Option<Bound<'py, PyAny>>,
+    max_steps: usize,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let m = model.inner.clone();
+    let method = match method {
+        "rk4" => Method::Rk4,
+        "rk45" | "dopri5" => Method::Rk45 { rtol, atol, max_step: max_step.unwrap_or(f64::INFINITY) },
+        other => return Err(input_err(format!("method must be 'rk4' or 'rk45', got '{other}'"))),
+    };
+    let opts = SimOptions { t_final, dt, method, record_every, max_steps };
+    let stash: Stash = Rc::new(RefCell::new(None));
+
+    let hold = match hold {
+        "zoh" => Hold::Zoh,
+        "linear" => Hold::Linear,
+        other => return Err(input_err(format!("hold must be 'zoh' or 'linear', got '{other}'"))),
+    };
+    let torque_src = match torques {
+        None => TorqueSource::Zero,
+        Some(t) if t.is_callable() => TorqueSource::Function(state_fn(py, t, stash.clone(), "the torque function")),
+        Some(t) => {
+            let arr: PyReadonlyArrayDyn<f64> = py.import("numpy")?.call_method1("asarray", (t, "float64"))?.extract()?;
+            let shape = arr.shape().to_vec();
+            let rows = match shape.as_slice() {
+                [r, c] if *c == m.nv => *r,
+                [c] if *c == m.nv => 1,
+                _ => return Err(input_err(format!("argument `torques`: expected a callable or an array of shape (T, {}), got {:?}", m.nv, shape))),
+            };
+            let times: Vec<f64> = match &torque_times {
+                Some(tt) => tt.as_array().to_vec(),
+                None => (0..rows).map(|k| k as f64 * dt).collect(),
+            };
+            if times.len() != rows {
+                return Err(input_err(format!("argument `torque_times`: {} times for {rows} torque rows", times.len())));
+            }
+            guard(|| TorqueSource::table(times, arr.as_array().iter().copied().collect(), m.nv, hold))?
+        }
+    };
+    let ctrl = match (controller, controller_period) {
+        (None, _) => None,
+        (Some(c), Some(p)) if c.is_callable() => Some(Controller { period: p, f: state_fn(py, c, stash.clone(), "the controller") }),
+        (Some(_), None) => return Err(input_err("a controller needs `controller_period` (its sample time in seconds)")),
+        (Some(_), Some(_)) => return Err(input_err("argument `controller` must be callable as controller(t, q, v) -> generalized forces (nv,)")),
+    };
+    let presc = match (prescribed, prescription) {
+        (None, None) => None,
+        (Some(names), Some(f)) if f.is_callable() => {
+            let bodies = prescribed_bodies(&m, &names)?;
+            let st = stash.clone();
+            let f = f.clone();
+            let pf: sim::PrescriptionFn = Box::new(move |t, q, v, a| {
+                let r = f.call1((t,)).and_then(|r| {
+                    let (rq, rv, ra): (Bound<PyAny>, Bound<PyAny>, Bound<PyAny>) = r.extract().map_err(|_| {
+                        input_err("prescription(t) must return a tuple (q, v, a) of full-length arrays (nq,), (nv,), (nv,)")
+                    })?;
+                    fill(&rq, q, "prescription q")?;
+                    fill(&rv, v, "prescription v")?;
+                    fill(&ra, a, "prescription a")
+                });
+                r.map_err(|e| stash_err(&st, e, "the prescription"))
+            });
+            Some(Prescription { bodies, f: pf })
+        }
+        (Some(_), Some(_)) => return Err(input_err("argument `prescription` must be callable as prescription(t) -> (q, v, a)")),
+        _ => return Err(input_err("give both `prescribed` (joint names) and `prescription` (a function of t), or neither")),
+    };
+    let has_callbacks = matches!(torque_src, TorqueSource::Function(_)) || ctrl.is_some() || presc.is_some() || progress.is_some();
+    let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc };
+    let q0 = q0.as_array().to_vec();
+    let v0 = v0.as_array().to_vec();
+
+    let result = if has_callbacks {
+        let st = stash.clone();
+        let mut prog = progress.map(|p| {
+            move |frac: f64| -> bool {
+                match p.call1((frac,)) {
+                    Ok(r) => !r.is(&false.into_pyobject(py).unwrap().to_owned().into_any()),
+                    Err(e) => {
+                        stash_err(&st, e, "the progress callback");
+                        false
+                    }
+                }
+            }
+        });
+        let pr: Option<sim::Progress> = prog.as_mut().map(|p| p as &mut dyn FnMut(f64) -> bool);
+        guard(|| sim::simulate(&m, &q0, &v0, &opts, inputs, pr))
+    } else {
+        // No Python code runs during the simulation: release the GIL. The inputs hold no Python
+        // objects in this branch, so they can move to the detached closure.
+        let inputs = SendInputs(inputs);
+        py.detach(move || {
+            let inputs = inputs;
+            guard(|| sim::simulate(&m, &q0, &v0, &opts, inputs.0, None))
+        })
+    };
+    if let Some(e) = stash.borrow_mut().take() {
+        return Err(e);
+    }
+    let tr = result?;
+    let d = PyDict::new(py);
+    let n = tr.len();
+    d.set_item("t", PyArray1::from_slice(py, &tr.t))?;
+    d.set_item("q", PyArray1::from_slice(py, &tr.q).reshape([n, tr.nq])?)?;
+    d.set_item("v", PyArray1::from_slice(py, &tr.v).reshape([n, tr.nv])?)?;
+    d.set_item("ddq", PyArray1::from_slice(py, &tr.ddq).reshape([n, tr.nv])?)?;
+    d.set_item("tau", PyArray1::from_slice(py, &tr.tau).reshape([n, tr.nv])?)?;
+    d.set_item("momentum", PyArray1::from_slice(py, &tr.momentum).reshape([n, 6])?)?;
+    d.set_item("kinetic_energy", PyArray1::from_slice(py, &tr.kinetic_energy))?;
+    d.set_item("work", PyArray1::from_slice(py, &tr.work))?;
+    d.set_item("steps", tr.steps)?;
+    d.set_item("rejected", tr.rejected)?;
+    d.set_item("evaluations", tr.evaluations)?;
+    Ok(d)
+}
+
+/// Inputs with no Python callables (checked by the caller) are safe to send to another thread.
+struct SendInputs<'a>(Inputs<'a>);
+unsafe impl Send for SendInputs<'_> {}

@@ -1,0 +1,38 @@
+"""freefloat: model, simulate, excite, identify and control free-floating space robots.
+
+    import freefloat as ff
+    m = ff.models.load("seed001_dual_arm")
+    q, v = m.neutral(), np.zeros(m.nv)
+    ff.momentum(m, q, v); ff.aba(m, q, v, tau)
+    traj = ff.simulate(m, q, v, t_final=10.0, dt=1e-3)
+
+Conventions are in docs/architecture.md; every number is computed by the Rust engine."""
+
+from . import models
+from ._core import InputError, ModelError, NumericalError
+from .algorithms import (
+    aba,
+    center_of_mass,
+    centroidal_momentum_matrix,
+    crba,
+    forward_kinematics,
+    frame_jacobian,
+    frame_placement,
+    generalized_jacobian,
+    hybrid_dynamics,
+    kinetic_energy,
+    momentum,
+    rnea,
+)
+from .model import Model
+from .simulation import Trajectory, simulate
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Model", "Trajectory", "models", "simulate",
+    "aba", "rnea", "crba", "hybrid_dynamics",
+    "forward_kinematics", "frame_placement", "frame_jacobian", "generalized_jacobian",
+    "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
+    "ModelError", "InputError", "NumericalError",
+]

@@ -1,0 +1,20 @@
+"""Argument conversion shared by the function layer: anything array-like becomes a float64 array,
+and a value that cannot be converted is reported with the argument's name."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._core import InputError
+
+
+def as_f64(x, name: str) -> np.ndarray:
+    """Convert `x` to a C-contiguous float64 array, naming `name` if that fails."""
+    try:
+        return np.ascontiguousarray(x, dtype=np.float64)
+    except (TypeError, ValueError) as e:
+        raise InputError(f"argument `{name}`: cannot be read as an array of numbers ({e})") from None
+
+
+def as_f64_or_none(x, name: str):
+    return None if x is None else as_f64(x, name)

@@ -1,0 +1,145 @@
+"""The `Model` facade: an immutable rigid-body tree, loaded from URDF, YAML or the built-in robots.
+
+The description itself and every algorithm live in the Rust engine (`freefloat._core`); this class
+adds file handling and the conveniences that are naturally Python (random configurations)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from . import _core
+from ._arrays import as_f64
+from ._core import InputError
+
+
+class Model:
+    """A floating-base rigid-body tree. Immutable: `with_parameters` and `with_gravity` return new models.
+
+    Conventions (ARCHITECTURE.md): q = [base position, base quaternion (x, y, z, w), joints...],
+    v = [base linear, base angular velocity (base frame), joint rates...]; standard parameters per body
+    [m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] about the body-frame origin."""
+
+    __slots__ = ("_core",)
+
+    def __init__(self, core: _core.Model):
+        if not isinstance(core, _core.Model):
+            raise TypeError("use Model.from_urdf, Model.from_yaml or freefloat.models.load to make a Model")
+        self._core = core
+
+    # -- loading and saving ---------------------------------------------------------------------------
+    @classmethod
+    def from_urdf(cls, path, base: str = "free") -> "Model":
+        """Load a URDF file; its root link becomes the base, attached by a `base` joint
+        ("free", "planar" or "fixed"). Massless leaf links on fixed joints become frames."""
+        p = Path(path)
+        return cls(_core.Model.from_urdf_string(_read(p), base, str(p)))
+
+    @classmethod
+    def from_urdf_string(cls, text: str, base: str = "free") -> "Model":
+        return cls(_core.Model.from_urdf_string(text, base, "<string>"))
+
+    @classmethod
+    def from_yaml(cls, path) -> "Model":
+        """Load the YAML model format (docs/model_format.md)."""
+        p = Path(path)
+        return cls(_core.Model.from_yaml_string(_read(p), str(p)))
+
+    @classmethod
+    def from_yaml_string(cls, text: str) -> "Model":
+        return cls(_core.Model.from_yaml_string(text, "<string>"))
+
+    def to_urdf(self, path=None) -> str:
+        """Write the model as URDF (to `path` if given) and return the text. The base joint type is not
+        part of URDF: choose it again with `from_urdf(..., base=...)`."""
+        text = self._core.to_urdf_string()
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    # -- description --------------------------------------------------------------------------------
+    name = property(lambda self: self._core.name)
+    nq = property(lambda self: self._core.nq, doc="Size of the configuration q.")
+    nv = property(lambda self: self._core.nv, doc="Size of the velocity v.")
+    nbodies = property(lambda self: self._core.nbodies)
+    body_names = property(lambda self: self._core.body_names)
+    joint_names = property(lambda self: self._core.joint_names, doc="Joint of each body; the base's is 'root_joint'.")
+    joint_types = property(lambda self: self._core.joint_types)
+    parents = property(lambda self: self._core.parents, doc="Parent body index of each body, -1 for the base.")
+    idx_q = property(lambda self: self._core.idx_q, doc="Start of each body's joint coordinates in q.")
+    idx_v = property(lambda self: self._core.idx_v, doc="Start of each body's joint rates in v.")
+    nqs = property(lambda self: self._core.nqs)
+    nvs = property(lambda self: self._core.nvs)
+    joint_axes = property(lambda self: self._core.joint_axes)
+    placements = property(lambda self: self._core.placements, doc="(nbodies, 4, 4) rest placement of each joint frame in its parent.")
+    limits = property(lambda self: self._core.limits)
+    tags = property(lambda self: self._core.tags)
+    frame_names = property(lambda self: self._core.frame_names)
+    frames = property(lambda self: self._core.frames)
+    gravity = property(lambda self: self._core.gravity)
+    total_mass = property(lambda self: self._core.total_mass)
+
+    def parameters(self) -> np.ndarray:
+        """(nbodies, 10) standard inertial parameters, rows in `body_names` order."""
+        return self._core.parameters()
+
+    def with_parameters(self, P) -> "Model":
+        """A new model with parameters P (nbodies, 10), checked for physical consistency."""
+        return Model(self._core.with_parameters(as_f64(P, "P")))
+
+    def with_gravity(self, g) -> "Model":
+        g = as_f64(g, "g")
+        if g.shape != (3,):
+            raise InputError(f"argument `g`: expected 3 numbers, got shape {g.shape}")
+        return Model(self._core.with_gravity(tuple(g)))
+
+    def neutral(self) -> np.ndarray:
+        """Configuration with identity quaternions and zero elsewhere."""
+        return self._core.neutral()
+
+    def random_configuration(self, rng: np.random.Generator | None = None, position_range: float = 1.0) -> np.ndarray:
+        """A random configuration: uniform within joint limits where the model has them (else within
+        ±pi for angles and ±`position_range` for positions), uniformly random unit quaternions."""
+        rng = np.random.default_rng() if rng is None else rng
+        q = self.neutral()
+        lo, hi = self.limits["lower"], self.limits["upper"]
+        for i, jt in enumerate(self.joint_types):
+            s = self.idx_q[i]
+            if i == 0 and jt == "free":
+                q[s:s + 3] = rng.uniform(-position_range, position_range, 3)
+                q[s + 3:s + 7] = _random_quat(rng)
+            elif i == 0 and jt == "planar":
+                q[s:s + 2] = rng.uniform(-position_range, position_range, 2)
+                q[s + 2] = rng.uniform(-np.pi, np.pi)
+            elif jt == "spherical":
+                q[s:s + 4] = _random_quat(rng)
+            elif jt in ("revolute", "prismatic"):
+                default = np.pi if jt == "revolute" else position_range
+                a = lo[i] if np.isfinite(lo[i]) else -default
+                b = hi[i] if np.isfinite(hi[i]) else default
+                q[s] = rng.uniform(a, b)
+        return q
+
+    def body_index(self, name: str) -> int:
+        try:
+            return self.body_names.index(name)
+        except ValueError:
+            raise InputError(f"'{name}' is not a body of model '{self.name}' (bodies: {', '.join(self.body_names)})") from None
+
+    def __repr__(self) -> str:
+        return repr(self._core)
+
+
+def _random_quat(rng) -> np.ndarray:
+    x = rng.normal(size=4)
+    return x / np.linalg.norm(x)
+
+
+def _read(p: Path) -> str:
+    if not p.exists():
+        raise FileNotFoundError(f"model file not found: {p}")
+    try:
+        return p.read_text()
+    except UnicodeDecodeError as e:
+        raise _core.ModelError(f"{p}: not a text file ({e})") from None

@@ -1,0 +1,486 @@
+"""freefloat against Pinocchio, an independent implementation of the same rigid-body algorithms.
+
+Two families:
+
+* random trees (tests/random_trees.py): every tree is rendered to our YAML, loaded by freefloat, and built
+  *directly from the same description* as a Pinocchio model (never from freefloat's model object).  Every
+  kinematic and dynamic entry point is compared body by body, for several random states.
+* real URDF robots from example-robot-data, loaded by `ff.Model.from_urdf` and by `pin.buildModelFromUrdf`;
+  joints are matched by name, so the comparison does not depend on how each library orders a branched tree
+  (the order freefloat promises is checked on its own, against the URDF text).
+
+Comparisons are norm-relative (`random_trees.assert_close`) at 1e-9 with a 1e-12 floor.
+"""
+
+import functools
+import math
+import os
+import sys
+import sysconfig
+import xml.etree.ElementTree as ET
+import zlib
+
+import numpy as np
+import pytest
+
+ff = pytest.importorskip("freefloat", reason="freefloat is not importable yet (the engine is not built)")
+pin = pytest.importorskip("pinocchio", reason="Pinocchio (PyPI `pin`) is needed as the oracle")
+
+import random_trees as rt  # noqa: E402  (tests/ is on sys.path under pytest's default import mode)
+from random_trees import assert_close  # noqa: E402
+
+RTOL = 1e-9
+ATOL = 1e-12
+SEEDS = rt.TREE_SEEDS
+N_STATES = 3
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# random trees
+# ----------------------------------------------------------------------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def case(seed):
+    """(description, freefloat model, Pinocchio tree) for one seed, built once."""
+    d = rt.tree_from_seed(seed)
+    return d, ff.Model.from_yaml_string(d.to_yaml()), rt.build_pinocchio(d)
+
+
+def states(d, seed, n=N_STATES):
+    """Random (q, v, tau-or-a, fext) in our layout; a different stream from the self-checks' on purpose."""
+    rng = np.random.default_rng(20_000 + seed)
+    return [(d.random_q(rng), d.random_v(rng), rng.normal(size=d.nv), d.random_fext(rng)) for _ in range(n)]
+
+
+def close(actual, expected, what):
+    assert_close(actual, expected, rtol=RTOL, atol=ATOL, what=what)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_model_metadata(seed):
+    d, m, p = case(seed)
+    assert (m.nq, m.nv, m.nbodies) == (d.nq, d.nv, d.nbodies)
+    assert list(m.body_names) == [b.name for b in d.bodies]
+    assert list(m.parents) == d.parents
+    assert list(m.joint_types) == [b.joint_type for b in d.bodies]
+    # per-body like parents/joint_types; compare the tail so a list with or without a base entry both pass
+    names = list(m.joint_names)
+    assert len(names) in (d.nbodies, d.nbodies - 1)
+    assert names[len(names) - (d.nbodies - 1):] == [b.effective_joint_name for b in d.bodies[1:]]
+    close(np.asarray(m.gravity, float), d.gravity, "gravity")
+    P = np.asarray(m.parameters(), float)
+    assert P.shape == (d.nbodies, 10)
+    for i, b in enumerate(d.bodies):
+        close(P[i], b.parameters(), f"parameters of {b.name}")
+    q0 = np.asarray(m.neutral(), float)
+    close(p.q_to_pin(q0), pin.neutral(p.model), "neutral")
+    rng = np.random.default_rng(seed)
+    for _ in range(3):
+        q = np.asarray(m.random_configuration(rng), float)
+        assert q.shape == (d.nq,) and np.all(np.isfinite(q))
+        for b, sl in zip(d.bodies, d.q_slices()):
+            if b.joint_type in ("free", "spherical"):
+                assert abs(np.linalg.norm(q[sl][-4:]) - 1.0) < 1e-12, f"{b.name}: quaternion not unit {q[sl]}"
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_forward_kinematics(seed):
+    d, m, p = case(seed)
+    for q, *_ in states(d, seed):
+        X = np.asarray(ff.forward_kinematics(m, q), float)
+        assert X.shape == (d.nbodies, 7)
+        ref = p.forward_kinematics(q)
+        for i, b in enumerate(d.bodies):
+            close(X[i, :3], ref[i, :3], f"position of {b.name}")
+            assert abs(np.linalg.norm(X[i, 3:]) - 1.0) < 1e-12, f"{b.name}: quaternion not unit"
+            # compare rotations, not quaternions: q and -q are the same attitude
+            close(rt.quat_to_matrix(X[i, 3:]), rt.quat_to_matrix(ref[i, 3:]), f"rotation of {b.name}")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_center_of_mass(seed):
+    d, m, p = case(seed)
+    for q, *_ in states(d, seed):
+        close(ff.center_of_mass(m, q), p.center_of_mass(q), "center of mass")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_momentum(seed):
+    d, m, p = case(seed)
+    for q, v, *_ in states(d, seed):
+        close(ff.momentum(m, q, v), p.momentum(q, v), "momentum [p; L_O]")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_centroidal_momentum_matrix(seed):
+    d, m, p = case(seed)
+    for q, v, *_ in states(d, seed):
+        A = np.asarray(ff.centroidal_momentum_matrix(m, q), float)
+        close(A, p.centroidal_momentum_matrix(q), "momentum matrix A_O")
+        close(A @ v, ff.momentum(m, q, v), "A_O v == ff.momentum")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_frame_jacobians(seed):
+    d, m, p = case(seed)
+    names = [b.name for b in d.bodies] + [f.name for f in d.frames]
+    for q, *_ in states(d, seed, n=2):
+        for name in names:
+            for ref in ("local", "world"):
+                J = np.asarray(ff.frame_jacobian(m, q, name, reference=ref), float)
+                close(J, p.frame_jacobian(q, name, ref), f"{ref} Jacobian of {name}")
+        # "local" is the documented default
+        close(ff.frame_jacobian(m, q, names[-1]), p.frame_jacobian(q, names[-1], "local"), "default reference")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_rnea(seed):
+    d, m, p = case(seed)
+    for q, v, a, fext in states(d, seed):
+        close(ff.rnea(m, q, v, a), p.rnea(q, v, a), "rnea")
+        close(ff.rnea(m, q, v, a, fext=fext), p.rnea(q, v, a, fext), "rnea with fext")
+        close(ff.rnea(m, q, v, a, fext=np.zeros((d.nbodies, 6))), p.rnea(q, v, a), "rnea with zero fext")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_crba(seed):
+    d, m, p = case(seed)
+    for q, *_ in states(d, seed):
+        M = np.asarray(ff.crba(m, q), float)
+        close(M, p.crba(q), "crba")
+        close(M, M.T, "crba symmetric")
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_aba(seed):
+    d, m, p = case(seed)
+    for q, v, tau, fext in states(d, seed):
+        ddq = np.asarray(ff.aba(m, q, v, tau), float)
+        close(ddq, p.aba(q, v, tau), "aba")
+        close(ff.aba(m, q, v, tau, fext=fext), p.aba(q, v, tau, fext), "aba with fext")
+        # and freefloat's own forward/inverse dynamics agree
+        close(ff.rnea(m, q, v, ddq), tau, "rnea(aba(tau)) == tau")
+
+
+# ---- stacked (time-series) inputs ------------------------------------------------------------------------------
+
+def _stack_seeds():
+    """A few trees: one per base type, plus the largest tree."""
+    picked = {}
+    for s in SEEDS:
+        picked.setdefault(rt.tree_from_seed(s).base, s)
+    largest = max(SEEDS, key=lambda s: rt.tree_from_seed(s).nbodies)
+    return sorted(set(picked.values()) | {largest})
+
+
+@pytest.mark.parametrize("seed", _stack_seeds())
+def test_stacked_inputs_match_a_loop(seed):
+    d, m, p = case(seed)
+    T = 4
+    rng = np.random.default_rng(30_000 + seed)
+    Q = np.array([d.random_q(rng) for _ in range(T)])
+    V = rng.normal(size=(T, d.nv))
+    U = rng.normal(size=(T, d.nv))
+    F = rng.normal(size=(T, d.nbodies, 6))
+    name = d.bodies[-1].name
+
+    cases = {
+        "forward_kinematics": (lambda *x: ff.forward_kinematics(m, *x), (Q,), (T, d.nbodies, 7), p.forward_kinematics),
+        "center_of_mass": (lambda *x: ff.center_of_mass(m, *x), (Q,), (T, 3), p.center_of_mass),
+        "momentum": (lambda *x: ff.momentum(m, *x), (Q, V), (T, 6), p.momentum),
+        "centroidal_momentum_matrix": (lambda *x: ff.centroidal_momentum_matrix(m, *x), (Q,), (T, 6, d.nv),
+                                       p.centroidal_momentum_matrix),
+        "frame_jacobian local": (lambda *x: ff.frame_jacobian(m, *x, name, reference="local"), (Q,), (T, 6, d.nv),
+                                 lambda q: p.frame_jacobian(q, name, "local")),
+        "frame_jacobian world": (lambda *x: ff.frame_jacobian(m, *x, name, reference="world"), (Q,), (T, 6, d.nv),
+                                 lambda q: p.frame_jacobian(q, name, "world")),
+        "crba": (lambda *x: ff.crba(m, *x), (Q,), (T, d.nv, d.nv), p.crba),
+        "rnea": (lambda *x: ff.rnea(m, *x), (Q, V, U), (T, d.nv), p.rnea),
+        "rnea fext": (lambda *x: ff.rnea(m, *x[:3], fext=x[3]), (Q, V, U, F), (T, d.nv), p.rnea),
+        "aba": (lambda *x: ff.aba(m, *x), (Q, V, U), (T, d.nv), p.aba),
+        "aba fext": (lambda *x: ff.aba(m, *x[:3], fext=x[3]), (Q, V, U, F), (T, d.nv), p.aba),
+    }
+    for what, (fn, args, shape, oracle) in cases.items():
+        out = np.asarray(fn(*args), float)
+        assert out.shape == shape, f"{what}: stacked output shape {out.shape}, expected {shape}"
+        for t in range(T):
+            single = np.asarray(fn(*(x[t] for x in args)), float)
+            if what == "forward_kinematics":
+                # quaternion signs may legitimately differ between code paths; compare positions and rotations
+                close(out[t][:, :3], single[:, :3], f"{what} stacked vs loop, t={t}")
+                for i in range(d.nbodies):
+                    close(rt.quat_to_matrix(out[t, i, 3:]), rt.quat_to_matrix(single[i, 3:]), f"{what} rot t={t}")
+                close(out[t][:, :3], oracle(Q[t])[:, :3], f"{what} vs Pinocchio, t={t}")
+                continue
+            assert_close(out[t], single, rtol=1e-12, atol=1e-14, what=f"{what} stacked vs loop, t={t}")
+            close(out[t], oracle(*(x[t] for x in args)), f"{what} vs Pinocchio, t={t}")
+
+
+@pytest.mark.parametrize("seed", SEEDS[:3])
+def test_from_yaml_file_equals_from_string(seed, tmp_path):
+    d, m, p = case(seed)
+    path = tmp_path / f"{d.name}.yaml"
+    path.write_text(d.to_yaml())
+    m2 = ff.Model.from_yaml(str(path))
+    assert (m2.nq, m2.nv, list(m2.body_names)) == (m.nq, m.nv, list(m.body_names))
+    q = states(d, seed, n=1)[0][0]
+    close(ff.crba(m2, q), p.crba(q), "crba of the file-loaded model")
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# real robots from example-robot-data
+# ----------------------------------------------------------------------------------------------------------------
+
+#: name -> URDF path inside example-robot-data's `robots/` folder.  Chosen to cover a 7-DoF arm with fixed
+#: links and fingers (panda), a 6-DoF arm whose root link is a massless "world" (ur5), continuous joints
+#: (kinova: Pinocchio stores them as cos/sin) and branched trees with many fixed links (solo12, anymal).
+ERD_ROBOTS = {
+    "panda": "panda_description/urdf/panda.urdf",
+    "ur5": "ur_description/urdf/ur5_robot.urdf",
+    "kinova": "kinova_description/robots/kinova.urdf",
+    "solo12": "solo_description/robots/solo12.urdf",
+    "anymal": "anymal_b_simple_description/robots/anymal.urdf",
+}
+
+FF_NQ = rt.JOINT_NQ
+FF_NV = rt.JOINT_NV
+
+
+def erd_urdf(rel):
+    """Absolute path of an example-robot-data URDF, or skip.
+
+    example-robot-data 5.x ships the Python loaders (`example_robot_data.robots_loader.getModelPath`);
+    6.x ships only the data (under <prefix>/share/example-robot-data/robots), so look there as well.
+    """
+    try:
+        from example_robot_data.robots_loader import getModelPath
+        return os.path.join(getModelPath(rel), rel)
+    except (ImportError, OSError):
+        pass
+    roots = {sysconfig.get_paths()["purelib"], sysconfig.get_paths()["data"], *sys.path}
+    for root in roots:
+        for prefix in ("cmeel.prefix/share", "share", "../../../share"):
+            path = os.path.join(root, prefix, "example-robot-data", "robots", rel)
+            if os.path.isfile(path):
+                return os.path.normpath(path)
+    pytest.skip(f"example-robot-data is not installed (no {rel}); pip install example-robot-data")
+
+
+def ff_joint_table(m):
+    """Per non-base body of a freefloat model: (joint name, joint type, q slice, v slice); and the base's."""
+    types = list(m.joint_types)
+    names = list(m.joint_names)
+    names = names[len(names) - (len(types) - 1):]  # with or without a base entry
+    q0 = v0 = 0
+    rows = []
+    for k, t in enumerate(types):
+        qs, vs = slice(q0, q0 + FF_NQ[t]), slice(v0, v0 + FF_NV[t])
+        q0, v0 = qs.stop, vs.stop
+        rows.append((None if k == 0 else names[k - 1], t, qs, vs))
+    return rows[0], rows[1:]
+
+
+class UrdfPair:
+    """freefloat and Pinocchio models of one URDF, with name-matched q/v maps."""
+
+    def __init__(self, path, base):
+        self.path, self.base = path, base
+        self.m = ff.Model.from_urdf(path, base=base)
+        root = {"free": pin.JointModelFreeFlyer(), "planar": pin.JointModelPlanar(), "fixed": None}[base]
+        self.model = pin.buildModelFromUrdf(path) if root is None else pin.buildModelFromUrdf(path, root)
+        # pin defaults to Earth gravity; freefloat's URDF default is zero: use whatever freefloat reports
+        self.model.gravity = pin.Motion(np.asarray(self.m.gravity, float), np.zeros(3))
+        self.data = self.model.createData()
+        (_, base_type, self.base_q, self.base_v), self.rows = ff_joint_table(self.m)
+        assert base_type == base
+        first = 1 if root is None else 2  # Pinocchio joint 1 is the root joint when there is one
+        self.pin_joint = {self.model.names[j]: j for j in range(first, self.model.njoints)}
+        moving = [r for r in self.rows if FF_NV[r[1]] > 0]
+        assert sorted(r[0] for r in moving) == sorted(self.pin_joint), "moving joints differ by name"
+        self.v_perm = np.zeros(self.m.nv, dtype=int)  # v_pin = v_ff[v_perm]
+        if root is not None:
+            jm = self.model.joints[1]
+            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(self.base_v.start, self.base_v.stop)
+        for name, t, qs, vs in moving:
+            jm = self.model.joints[self.pin_joint[name]]
+            assert jm.nv == FF_NV[t], f"{name}: nv {jm.nv} in Pinocchio vs {FF_NV[t]} ({t})"
+            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
+        assert sorted(self.v_perm) == list(range(self.m.nv))
+
+    def q_to_pin(self, q):
+        qp = np.zeros(self.model.nq)
+        if self.base == "free":
+            qp[:7] = q[self.base_q]
+        elif self.base == "planar":
+            x, y, yaw = q[self.base_q]
+            qp[:4] = [x, y, math.cos(yaw), math.sin(yaw)]
+        for name, t, qs, vs in self.rows:
+            if FF_NV[t] == 0:
+                continue
+            jm = self.model.joints[self.pin_joint[name]]
+            if jm.nq == 2 and jm.nv == 1:  # URDF "continuous": Pinocchio stores cos, sin
+                qp[jm.idx_q:jm.idx_q + 2] = [math.cos(q[qs][0]), math.sin(q[qs][0])]
+            else:
+                qp[jm.idx_q:jm.idx_q + jm.nq] = q[qs]
+        return qp
+
+    def v_to_pin(self, v):
+        return np.asarray(v, float)[self.v_perm]
+
+    def v_from_pin(self, vp):
+        out = np.zeros(len(vp))
+        out[self.v_perm] = vp
+        return out
+
+    def cols_from_pin(self, A):
+        A = np.asarray(A, float).reshape(-1, self.m.nv)
+        out = np.zeros_like(A)
+        out[:, self.v_perm] = A
+        return out
+
+    def random_state(self, rng):
+        parts = []
+        types = list(self.m.joint_types)
+        for t in types:
+            if t == "free":
+                parts += [rng.uniform(-1, 1, 3), rt.random_unit_quaternion(rng)]
+            elif t == "planar":
+                parts += [rng.uniform(-1, 1, 2), [rng.uniform(-4, 4)]]
+            elif t == "revolute":
+                parts.append([rng.uniform(-math.pi, math.pi)])
+            elif t == "prismatic":
+                parts.append([rng.uniform(-0.05, 0.05)])
+            elif t == "spherical":
+                parts.append(rt.random_unit_quaternion(rng))
+        q = np.concatenate(parts)
+        return q, rng.normal(size=self.m.nv), rng.normal(size=self.m.nv), rng.normal(size=(self.m.nbodies, 6))
+
+    def body_frame(self, name):
+        """Pinocchio BODY frame of a URDF link: (frame id, carrying joint, placement in that joint)."""
+        fid = self.model.getFrameId(name, pin.FrameType.BODY)
+        assert fid < self.model.nframes, f"no Pinocchio BODY frame named {name!r}"
+        f = self.model.frames[fid]
+        return fid, f.parentJoint, f.placement
+
+    def fext_to_pin(self, fext):
+        out = [pin.Force.Zero() for _ in range(self.model.njoints)]
+        for name, f in zip(self.m.body_names, fext):
+            _, j, X = self.body_frame(name)
+            out[j] = out[j] + X.act(pin.Force(f[:3], f[3:]))
+        return out
+
+
+@functools.lru_cache(maxsize=None)
+def urdf_pair(robot, base):
+    return UrdfPair(erd_urdf(ERD_ROBOTS[robot]), base)
+
+
+URDF_CASES = [(r, "free") for r in ERD_ROBOTS] + [("panda", "fixed"), ("anymal", "fixed"), ("ur5", "planar"),
+                                                    ("solo12", "planar")]
+
+
+def urdf_mass(path):
+    """Total mass read straight from the URDF text."""
+    root = ET.parse(path).getroot()
+    return sum(float(l.find("inertial/mass").get("value")) for l in root.findall("link")
+               if l.find("inertial/mass") is not None)
+
+
+@pytest.mark.parametrize("robot,base", URDF_CASES)
+def test_urdf_whole_system_dynamics(robot, base):
+    u = urdf_pair(robot, base)
+    m, model, data = u.m, u.model, u.data
+    assert (m.nv, m.nq) == (model.nv, model.nq - (base == "planar")
+                            - sum(1 for j in model.joints[1:] if j.nq == 2 and j.nv == 1))
+    P = np.asarray(m.parameters(), float)
+    assert P[:, 0].sum() == pytest.approx(urdf_mass(u.path), rel=1e-12)
+    assert rt.pin_total_mass(model) == pytest.approx(urdf_mass(u.path), rel=1e-12)
+    rng = np.random.default_rng(zlib.crc32(f"{robot}/{base}".encode()))
+    for _ in range(3):
+        q, v, tau, fext = u.random_state(rng)
+        qp, vp = u.q_to_pin(q), u.v_to_pin(v)
+        close(ff.aba(m, q, v, tau), u.v_from_pin(pin.aba(model, data, qp, vp, u.v_to_pin(tau))), f"{robot} aba")
+        close(ff.rnea(m, q, v, tau), u.v_from_pin(pin.rnea(model, data, qp, vp, u.v_to_pin(tau))), f"{robot} rnea")
+        close(ff.rnea(m, q, v, tau, fext=fext),
+              u.v_from_pin(pin.rnea(model, data, qp, vp, u.v_to_pin(tau), u.fext_to_pin(fext))), f"{robot} rnea fext")
+        close(ff.aba(m, q, v, tau, fext=fext),
+              u.v_from_pin(pin.aba(model, data, qp, vp, u.v_to_pin(tau), u.fext_to_pin(fext))), f"{robot} aba fext")
+        Mp = np.array(pin.crba(model, data, qp), float).reshape(model.nv, model.nv)
+        Mp = np.triu(Mp) + np.triu(Mp, 1).T
+        close(ff.crba(m, q), u.cols_from_pin(u.cols_from_pin(Mp).T).T, f"{robot} crba")
+        close(ff.momentum(m, q, v), rt.pin_momentum_at_origin(model, data, qp, vp), f"{robot} momentum")
+        close(ff.centroidal_momentum_matrix(m, q), u.cols_from_pin(rt.pin_momentum_matrix_at_origin(model, data, qp)),
+              f"{robot} momentum matrix")
+        close(ff.center_of_mass(m, q), rt.pin_center_of_mass(model, data, qp), f"{robot} CoM")
+
+
+@pytest.mark.parametrize("robot,base", URDF_CASES)
+def test_urdf_link_placements_and_jacobians(robot, base):
+    """Each freefloat body is a URDF link, i.e. a Pinocchio BODY frame of the same name."""
+    u = urdf_pair(robot, base)
+    m, model, data = u.m, u.model, u.data
+    rng = np.random.default_rng(1 + zlib.crc32(f"{robot}/{base}".encode()))
+    q = u.random_state(rng)[0]
+    qp = u.q_to_pin(q)
+    pin.framesForwardKinematics(model, data, qp)
+    X = np.asarray(ff.forward_kinematics(m, q), float)
+    for i, name in enumerate(m.body_names):
+        fid = u.body_frame(name)[0]
+        M = data.oMf[fid]
+        close(X[i, :3], M.translation, f"{robot}: position of {name}")
+        close(rt.quat_to_matrix(X[i, 3:]), M.rotation, f"{robot}: rotation of {name}")
+    # Jacobians of the last link (an end effector in the serial arms) and of a leaf of each branch
+    leaves = [n for k, n in enumerate(m.body_names) if k not in set(m.parents)]
+    for name in leaves:
+        fid = u.body_frame(name)[0]
+        for ref, rf in (("local", pin.LOCAL), ("world", pin.LOCAL_WORLD_ALIGNED)):
+            Jp = u.cols_from_pin(pin.computeFrameJacobian(model, data, qp, fid, rf))
+            close(ff.frame_jacobian(m, q, name, reference=ref), Jp, f"{robot}: {ref} Jacobian of {name}")
+
+
+def _urdf_depth_first_joint_order(path):
+    """Moving joints depth-first from the root link, children in document order (freefloat's promise)."""
+    root = ET.parse(path).getroot()
+    joints = root.findall("joint")
+    children = {}
+    for j in joints:
+        children.setdefault(j.find("parent").get("link"), []).append(j)
+    child_links = {j.find("child").get("link") for j in joints}
+    (root_link,) = [l.get("name") for l in root.findall("link") if l.get("name") not in child_links]
+    order = []
+
+    def visit(link):
+        for j in children.get(link, []):
+            if j.get("type") != "fixed":
+                order.append(j.get("name"))
+            visit(j.find("child").get("link"))
+
+    visit(root_link)
+    return order
+
+
+@pytest.mark.parametrize("robot", list(ERD_ROBOTS))
+def test_urdf_velocity_order(robot):
+    """v follows the joints depth-first in URDF document order.
+
+    For serial chains this is also Pinocchio's order.  For branched robots it need not be: Pinocchio (through
+    urdfdom) visits sibling joints in *alphabetical* order of joint name (ANYmal: LF, LH, RF, RH, while the file
+    lists LF, RF, LH, RH), which is why the dynamics tests above match joints by name.
+    """
+    u = urdf_pair(robot, "free")
+    moving = [name for name, t, _, _ in u.rows if FF_NV[t] > 0]
+    assert moving == _urdf_depth_first_joint_order(u.path)
+    # where the two conventions coincide (every robot here but the quadrupeds), v is Pinocchio's v
+    if moving == [u.model.names[j] for j in range(2, u.model.njoints)]:
+        assert np.array_equal(u.v_perm, np.arange(u.m.nv))
+
+
+def test_urdf_from_string_equals_from_file():
+    path = erd_urdf(ERD_ROBOTS["panda"])
+    with open(path) as fh:
+        text = fh.read()
+    a = ff.Model.from_urdf(path, base="free")
+    b = ff.Model.from_urdf_string(text, base="free")
+    assert list(a.body_names) == list(b.body_names) and (a.nq, a.nv) == (b.nq, b.nv)
+    q = np.asarray(a.random_configuration(np.random.default_rng(0)), float)
+    assert_close(ff.crba(b, q), ff.crba(a, q), rtol=1e-14, atol=0, what="crba from string vs file")
