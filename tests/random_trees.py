@@ -243,6 +243,11 @@ class TreeDescription:
     def parameters(self) -> np.ndarray:
         return np.array([b.parameters() for b in self.bodies])
 
+    def joint_rows(self):
+        """(joint name, joint type, q slice, v slice) per body, our layout; the base's name is None."""
+        return [(None if b.parent < 0 else b.effective_joint_name, b.joint_type, qs, vs)
+                for b, qs, vs in zip(self.bodies, self.q_slices(), self.v_slices())]
+
     def total_mass(self) -> float:
         return float(sum(b.mass for b in self.bodies))
 
@@ -400,7 +405,8 @@ class TreeDescription:
                     f'    <origin xyz="{vec(T[:3, 3])}" rpy="{vec(matrix_to_rpy(T[:3, :3]))}"/>']
             if b.joint_type in ("revolute", "prismatic"):
                 if not np.array_equal(b.axis, [1.0, 0.0, 0.0]):
-                    body.append(f'    <axis xyz="{vec(b.axis * b.axis_scale)}"/>')
+                    # unit axis: URDF asks for one, and Pinocchio's parser does not normalise it
+                    body.append(f'    <axis xyz="{vec(b.axis)}"/>')
                 if jtype != "continuous":
                     lim = b.limits or {"lower": -3.0, "upper": 3.0, "velocity": 2.0, "effort": 50.0}
                     body.append(f'    <limit lower="{f(lim["lower"])}" upper="{f(lim["upper"])}" '
@@ -515,10 +521,12 @@ def tree_from_seed(seed: int) -> TreeDescription:
 URDF_TREE_SEEDS = tuple(range(100, 120))
 
 
-def urdf_tree_from_seed(seed: int) -> TreeDescription:
+def urdf_tree_from_seed(seed: int, base: str = "free") -> TreeDescription:
+    """A tree for URDF rendering; `base` is how it will be loaded (it does not change the URDF text)."""
     rng = np.random.default_rng(seed)
     d = random_tree(rng, name=f"random_urdf_{seed}", base="free", gravity=np.zeros(3),
                     joint_types=("revolute", "prismatic", "fixed"), joint_p=(0.55, 0.2, 0.25))
+    d.base = d.bodies[0].joint_type = base
     d.frames = []
     for b in d.bodies[1:]:
         # URDF's default axis is +x; give it to some joints so `to_urdf` can leave the axis out
@@ -761,6 +769,122 @@ def build_pinocchio(desc: TreeDescription) -> PinTree:
 
     return PinTree(desc=desc, model=model, data=model.createData(), joint_of_body=joint_of_body,
                    body_in_joint=body_in_joint, frame_id=frame_id, pin_q_slice=pin_q_slice, v_perm=v_perm)
+
+
+class NamedLayout:
+    """q/v maps between a body-ordered layout (ours) and a Pinocchio model whose joints are matched *by name*.
+
+    Used for models Pinocchio builds itself (URDF), whose joint order and joint kinds we do not control:
+    siblings come in urdfdom's (alphabetical) order, and URDF `continuous` joints become Pinocchio's unbounded
+    revolute joints, stored as cos, sin.  `rows` is `joint_rows()`-shaped: the base first (name ignored).
+    """
+
+    def __init__(self, model, rows):
+        self.model = model
+        (_, self.base, self.base_q, self.base_v), self.rows = rows[0], rows[1:]
+        first = 1 if self.base == "fixed" else 2  # Pinocchio joint 1 is the root joint when there is one
+        self.pin_joint = {model.names[j]: j for j in range(first, model.njoints)}
+        moving = [r for r in self.rows if JOINT_NV[r[1]] > 0]
+        ours, theirs = sorted(r[0] for r in moving), sorted(self.pin_joint)
+        assert ours == theirs, f"moving joints differ by name: ours {ours}, Pinocchio {theirs}"
+        nv = sum(JOINT_NV[r[1]] for r in rows)
+        assert nv == model.nv, f"nv {nv} vs Pinocchio {model.nv}"
+        self.v_perm = np.zeros(nv, dtype=int)  # v_pin = v_ours[v_perm]
+        if self.base != "fixed":
+            jm = model.joints[1]
+            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(self.base_v.start, self.base_v.stop)
+        for name, t, qs, vs in moving:
+            jm = model.joints[self.pin_joint[name]]
+            assert jm.nv == JOINT_NV[t], f"{name}: nv {jm.nv} in Pinocchio vs {JOINT_NV[t]} ({t})"
+            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
+        assert sorted(self.v_perm) == list(range(nv))
+
+    def q_to_pin(self, q) -> np.ndarray:
+        q = np.asarray(q, float)
+        qp = np.zeros(self.model.nq)
+        if self.base == "free":
+            qp[:7] = q[self.base_q]
+        elif self.base == "planar":
+            x, y, yaw = q[self.base_q]
+            qp[:4] = [x, y, math.cos(yaw), math.sin(yaw)]
+        for name, t, qs, _ in self.rows:
+            if JOINT_NV[t] == 0:
+                continue
+            jm = self.model.joints[self.pin_joint[name]]
+            if jm.nq == 2 and jm.nv == 1:  # unbounded revolute: cos, sin
+                qp[jm.idx_q:jm.idx_q + 2] = [math.cos(q[qs][0]), math.sin(q[qs][0])]
+            else:
+                qp[jm.idx_q:jm.idx_q + jm.nq] = q[qs]
+        return qp
+
+    def v_to_pin(self, v) -> np.ndarray:
+        return np.asarray(v, float)[self.v_perm].copy()
+
+    def v_from_pin(self, vp) -> np.ndarray:
+        out = np.zeros(len(self.v_perm))
+        out[self.v_perm] = np.asarray(vp, float)
+        return out
+
+    def cols_from_pin(self, A) -> np.ndarray:
+        A = np.asarray(A, float).reshape(-1, len(self.v_perm))
+        out = np.zeros_like(A)
+        out[:, self.v_perm] = A
+        return out
+
+    def matrix_from_pin(self, M) -> np.ndarray:
+        """An nv x nv Pinocchio matrix (e.g. crba, symmetrised) in our layout."""
+        M = np.asarray(M, float).reshape(self.model.nv, self.model.nv)
+        M = np.triu(M) + np.triu(M, 1).T
+        return self.cols_from_pin(self.cols_from_pin(M).T).T
+
+    def body_frame(self, name):
+        """(frame id, carrying joint, placement in that joint) of a URDF link's Pinocchio BODY frame."""
+        import pinocchio as pin
+        assert self.model.existFrame(name, pin.FrameType.BODY), f"no Pinocchio BODY frame named {name!r}"
+        fid = self.model.getFrameId(name, pin.FrameType.BODY)
+        f = self.model.frames[fid]
+        return fid, f.parentJoint, f.placement
+
+    def fext_to_pin(self, body_names, fext):
+        import pinocchio as pin
+        out = [pin.Force.Zero() for _ in range(self.model.njoints)]
+        for name, f in zip(body_names, np.asarray(fext, float)):
+            _, j, X = self.body_frame(name)
+            out[j] = out[j] + X.act(pin.Force(f[:3], f[3:]))
+        return out
+
+
+def urdf_depth_first_joint_order(urdf_text) -> list[str]:
+    """Moving joints depth-first from the root link, children in document order."""
+    import xml.etree.ElementTree as ET
+    root = ET.fromstring(urdf_text)
+    joints = root.findall("joint")
+    children: dict[str, list] = {}
+    for j in joints:
+        children.setdefault(j.find("parent").get("link"), []).append(j)
+    child_links = {j.find("child").get("link") for j in joints}
+    (root_link,) = [link.get("name") for link in root.findall("link") if link.get("name") not in child_links]
+    order = []
+    # iterative DFS (URDF chains can be deeper than Python's recursion limit); children in document order
+    pending = [(root_link, iter(children.get(root_link, [])))]
+    while pending:
+        _, it = pending[-1]
+        j = next(it, None)
+        if j is None:
+            pending.pop()
+            continue
+        if j.get("type") != "fixed":
+            order.append(j.get("name"))
+        child = j.find("child").get("link")
+        pending.append((child, iter(children.get(child, []))))
+    return order
+
+
+def urdf_total_mass(urdf_text) -> float:
+    """Total mass read straight from URDF text."""
+    import xml.etree.ElementTree as ET
+    root = ET.fromstring(urdf_text)
+    return float(sum(float(m.get("value")) for m in root.findall("link/inertial/mass")))
 
 
 # --------------------------------------------------------------------------------------------------------------

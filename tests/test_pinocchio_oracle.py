@@ -17,7 +17,6 @@ import math
 import os
 import sys
 import sysconfig
-import xml.etree.ElementTree as ET
 import zlib
 
 import numpy as np
@@ -242,9 +241,6 @@ ERD_ROBOTS = {
     "anymal": "anymal_b_simple_description/robots/anymal.urdf",
 }
 
-FF_NQ = rt.JOINT_NQ
-FF_NV = rt.JOINT_NV
-
 
 def erd_urdf(rel):
     """Absolute path of an example-robot-data URDF, or skip.
@@ -266,82 +262,41 @@ def erd_urdf(rel):
     pytest.skip(f"example-robot-data is not installed (no {rel}); pip install example-robot-data")
 
 
-def ff_joint_table(m):
-    """Per non-base body of a freefloat model: (joint name, joint type, q slice, v slice); and the base's."""
+def ff_joint_rows(m):
+    """`TreeDescription.joint_rows()` for a freefloat model: (joint name, type, q slice, v slice) per body."""
     types = list(m.joint_types)
     names = list(m.joint_names)
-    names = names[len(names) - (len(types) - 1):]  # with or without a base entry
-    q0 = v0 = 0
-    rows = []
-    for k, t in enumerate(types):
-        qs, vs = slice(q0, q0 + FF_NQ[t]), slice(v0, v0 + FF_NV[t])
+    names = [None] + names[len(names) - (len(types) - 1):]  # with or without a base entry
+    rows, q0, v0 = [], 0, 0
+    for name, t in zip(names, types):
+        qs, vs = slice(q0, q0 + rt.JOINT_NQ[t]), slice(v0, v0 + rt.JOINT_NV[t])
         q0, v0 = qs.stop, vs.stop
-        rows.append((None if k == 0 else names[k - 1], t, qs, vs))
-    return rows[0], rows[1:]
+        rows.append((name, t, qs, vs))
+    return rows
 
 
 class UrdfPair:
-    """freefloat and Pinocchio models of one URDF, with name-matched q/v maps."""
+    """freefloat and Pinocchio models of one URDF, joints matched by name (`random_trees.NamedLayout`)."""
 
-    def __init__(self, path, base):
-        self.path, self.base = path, base
-        self.m = ff.Model.from_urdf(path, base=base)
+    def __init__(self, text, base, path=None):
+        self.text, self.base = text, base
         root = {"free": pin.JointModelFreeFlyer(), "planar": pin.JointModelPlanar(), "fixed": None}[base]
-        self.model = pin.buildModelFromUrdf(path) if root is None else pin.buildModelFromUrdf(path, root)
+        if path is not None:
+            self.m = ff.Model.from_urdf(path, base=base)
+            self.model = pin.buildModelFromUrdf(path) if root is None else pin.buildModelFromUrdf(path, root)
+        else:
+            self.m = ff.Model.from_urdf_string(text, base=base)
+            self.model = pin.buildModelFromXML(text) if root is None else pin.buildModelFromXML(text, root)
         # pin defaults to Earth gravity; freefloat's URDF default is zero: use whatever freefloat reports
         self.model.gravity = pin.Motion(np.asarray(self.m.gravity, float), np.zeros(3))
         self.data = self.model.createData()
-        (_, base_type, self.base_q, self.base_v), self.rows = ff_joint_table(self.m)
-        assert base_type == base
-        first = 1 if root is None else 2  # Pinocchio joint 1 is the root joint when there is one
-        self.pin_joint = {self.model.names[j]: j for j in range(first, self.model.njoints)}
-        moving = [r for r in self.rows if FF_NV[r[1]] > 0]
-        assert sorted(r[0] for r in moving) == sorted(self.pin_joint), "moving joints differ by name"
-        self.v_perm = np.zeros(self.m.nv, dtype=int)  # v_pin = v_ff[v_perm]
-        if root is not None:
-            jm = self.model.joints[1]
-            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(self.base_v.start, self.base_v.stop)
-        for name, t, qs, vs in moving:
-            jm = self.model.joints[self.pin_joint[name]]
-            assert jm.nv == FF_NV[t], f"{name}: nv {jm.nv} in Pinocchio vs {FF_NV[t]} ({t})"
-            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
-        assert sorted(self.v_perm) == list(range(self.m.nv))
-
-    def q_to_pin(self, q):
-        qp = np.zeros(self.model.nq)
-        if self.base == "free":
-            qp[:7] = q[self.base_q]
-        elif self.base == "planar":
-            x, y, yaw = q[self.base_q]
-            qp[:4] = [x, y, math.cos(yaw), math.sin(yaw)]
-        for name, t, qs, vs in self.rows:
-            if FF_NV[t] == 0:
-                continue
-            jm = self.model.joints[self.pin_joint[name]]
-            if jm.nq == 2 and jm.nv == 1:  # URDF "continuous": Pinocchio stores cos, sin
-                qp[jm.idx_q:jm.idx_q + 2] = [math.cos(q[qs][0]), math.sin(q[qs][0])]
-            else:
-                qp[jm.idx_q:jm.idx_q + jm.nq] = q[qs]
-        return qp
-
-    def v_to_pin(self, v):
-        return np.asarray(v, float)[self.v_perm]
-
-    def v_from_pin(self, vp):
-        out = np.zeros(len(vp))
-        out[self.v_perm] = vp
-        return out
-
-    def cols_from_pin(self, A):
-        A = np.asarray(A, float).reshape(-1, self.m.nv)
-        out = np.zeros_like(A)
-        out[:, self.v_perm] = A
-        return out
+        self.rows = ff_joint_rows(self.m)
+        assert self.rows[0][1] == base
+        self.layout = rt.NamedLayout(self.model, self.rows)
 
     def random_state(self, rng):
         parts = []
-        types = list(self.m.joint_types)
-        for t in types:
+        for _, t, _, _ in self.rows:
             if t == "free":
                 parts += [rng.uniform(-1, 1, 3), rt.random_unit_quaternion(rng)]
             elif t == "planar":
@@ -355,124 +310,93 @@ class UrdfPair:
         q = np.concatenate(parts)
         return q, rng.normal(size=self.m.nv), rng.normal(size=self.m.nv), rng.normal(size=(self.m.nbodies, 6))
 
-    def body_frame(self, name):
-        """Pinocchio BODY frame of a URDF link: (frame id, carrying joint, placement in that joint)."""
-        fid = self.model.getFrameId(name, pin.FrameType.BODY)
-        assert fid < self.model.nframes, f"no Pinocchio BODY frame named {name!r}"
-        f = self.model.frames[fid]
-        return fid, f.parentJoint, f.placement
 
-    def fext_to_pin(self, fext):
-        out = [pin.Force.Zero() for _ in range(self.model.njoints)]
-        for name, f in zip(self.m.body_names, fext):
-            _, j, X = self.body_frame(name)
-            out[j] = out[j] + X.act(pin.Force(f[:3], f[3:]))
-        return out
-
-
-@functools.lru_cache(maxsize=None)
-def urdf_pair(robot, base):
-    return UrdfPair(erd_urdf(ERD_ROBOTS[robot]), base)
-
-
-URDF_CASES = [(r, "free") for r in ERD_ROBOTS] + [("panda", "fixed"), ("anymal", "fixed"), ("ur5", "planar"),
-                                                    ("solo12", "planar")]
-
-
-def urdf_mass(path):
-    """Total mass read straight from the URDF text."""
-    root = ET.parse(path).getroot()
-    return sum(float(l.find("inertial/mass").get("value")) for l in root.findall("link")
-               if l.find("inertial/mass") is not None)
-
-
-@pytest.mark.parametrize("robot,base", URDF_CASES)
-def test_urdf_whole_system_dynamics(robot, base):
-    u = urdf_pair(robot, base)
-    m, model, data = u.m, u.model, u.data
-    assert (m.nv, m.nq) == (model.nv, model.nq - (base == "planar")
-                            - sum(1 for j in model.joints[1:] if j.nq == 2 and j.nv == 1))
-    P = np.asarray(m.parameters(), float)
-    assert P[:, 0].sum() == pytest.approx(urdf_mass(u.path), rel=1e-12)
-    assert rt.pin_total_mass(model) == pytest.approx(urdf_mass(u.path), rel=1e-12)
-    rng = np.random.default_rng(zlib.crc32(f"{robot}/{base}".encode()))
-    for _ in range(3):
+def check_urdf_dynamics(u, label, rng, n_states=3):
+    m, model, data, L = u.m, u.model, u.data, u.layout
+    assert (m.nv, m.nq) == (model.nv, model.nq - (u.base == "planar")
+                            - sum(1 for j in model.joints[1:] if j.nq == 2 and j.nv == 1)), f"{label}: nq/nv"
+    mass = rt.urdf_total_mass(u.text)
+    assert np.asarray(m.parameters(), float)[:, 0].sum() == pytest.approx(mass, rel=1e-12), f"{label}: mass"
+    assert rt.pin_total_mass(model) == pytest.approx(mass, rel=1e-12)
+    for _ in range(n_states):
         q, v, tau, fext = u.random_state(rng)
-        qp, vp = u.q_to_pin(q), u.v_to_pin(v)
-        close(ff.aba(m, q, v, tau), u.v_from_pin(pin.aba(model, data, qp, vp, u.v_to_pin(tau))), f"{robot} aba")
-        close(ff.rnea(m, q, v, tau), u.v_from_pin(pin.rnea(model, data, qp, vp, u.v_to_pin(tau))), f"{robot} rnea")
-        close(ff.rnea(m, q, v, tau, fext=fext),
-              u.v_from_pin(pin.rnea(model, data, qp, vp, u.v_to_pin(tau), u.fext_to_pin(fext))), f"{robot} rnea fext")
-        close(ff.aba(m, q, v, tau, fext=fext),
-              u.v_from_pin(pin.aba(model, data, qp, vp, u.v_to_pin(tau), u.fext_to_pin(fext))), f"{robot} aba fext")
-        Mp = np.array(pin.crba(model, data, qp), float).reshape(model.nv, model.nv)
-        Mp = np.triu(Mp) + np.triu(Mp, 1).T
-        close(ff.crba(m, q), u.cols_from_pin(u.cols_from_pin(Mp).T).T, f"{robot} crba")
-        close(ff.momentum(m, q, v), rt.pin_momentum_at_origin(model, data, qp, vp), f"{robot} momentum")
-        close(ff.centroidal_momentum_matrix(m, q), u.cols_from_pin(rt.pin_momentum_matrix_at_origin(model, data, qp)),
-              f"{robot} momentum matrix")
-        close(ff.center_of_mass(m, q), rt.pin_center_of_mass(model, data, qp), f"{robot} CoM")
+        qp, vp, tp = L.q_to_pin(q), L.v_to_pin(v), L.v_to_pin(tau)
+        fp = L.fext_to_pin(m.body_names, fext)
+        close(ff.aba(m, q, v, tau), L.v_from_pin(pin.aba(model, data, qp, vp, tp)), f"{label} aba")
+        close(ff.aba(m, q, v, tau, fext=fext), L.v_from_pin(pin.aba(model, data, qp, vp, tp, fp)), f"{label} aba fext")
+        close(ff.rnea(m, q, v, tau), L.v_from_pin(pin.rnea(model, data, qp, vp, tp)), f"{label} rnea")
+        close(ff.rnea(m, q, v, tau, fext=fext), L.v_from_pin(pin.rnea(model, data, qp, vp, tp, fp)),
+              f"{label} rnea fext")
+        close(ff.crba(m, q), L.matrix_from_pin(pin.crba(model, data, qp)), f"{label} crba")
+        close(ff.momentum(m, q, v), rt.pin_momentum_at_origin(model, data, qp, vp), f"{label} momentum")
+        close(ff.centroidal_momentum_matrix(m, q), L.cols_from_pin(rt.pin_momentum_matrix_at_origin(model, data, qp)),
+              f"{label} momentum matrix")
+        close(ff.center_of_mass(m, q), rt.pin_center_of_mass(model, data, qp), f"{label} CoM")
 
 
-@pytest.mark.parametrize("robot,base", URDF_CASES)
-def test_urdf_link_placements_and_jacobians(robot, base):
+def check_urdf_kinematics(u, label, rng, all_jacobians=False):
     """Each freefloat body is a URDF link, i.e. a Pinocchio BODY frame of the same name."""
-    u = urdf_pair(robot, base)
-    m, model, data = u.m, u.model, u.data
-    rng = np.random.default_rng(1 + zlib.crc32(f"{robot}/{base}".encode()))
+    m, model, data, L = u.m, u.model, u.data, u.layout
     q = u.random_state(rng)[0]
-    qp = u.q_to_pin(q)
+    qp = L.q_to_pin(q)
     pin.framesForwardKinematics(model, data, qp)
     X = np.asarray(ff.forward_kinematics(m, q), float)
     for i, name in enumerate(m.body_names):
-        fid = u.body_frame(name)[0]
-        M = data.oMf[fid]
-        close(X[i, :3], M.translation, f"{robot}: position of {name}")
-        close(rt.quat_to_matrix(X[i, 3:]), M.rotation, f"{robot}: rotation of {name}")
-    # Jacobians of the last link (an end effector in the serial arms) and of a leaf of each branch
-    leaves = [n for k, n in enumerate(m.body_names) if k not in set(m.parents)]
-    for name in leaves:
-        fid = u.body_frame(name)[0]
+        M = data.oMf[L.body_frame(name)[0]]
+        close(X[i, :3], M.translation, f"{label}: position of {name}")
+        close(rt.quat_to_matrix(X[i, 3:]), M.rotation, f"{label}: rotation of {name}")
+    # Jacobians of every leaf link (end effectors, feet), or of every link
+    parents = set(m.parents)
+    names = [n for k, n in enumerate(m.body_names) if all_jacobians or k not in parents]
+    for name in names:
+        fid = L.body_frame(name)[0]
         for ref, rf in (("local", pin.LOCAL), ("world", pin.LOCAL_WORLD_ALIGNED)):
-            Jp = u.cols_from_pin(pin.computeFrameJacobian(model, data, qp, fid, rf))
-            close(ff.frame_jacobian(m, q, name, reference=ref), Jp, f"{robot}: {ref} Jacobian of {name}")
+            Jp = L.cols_from_pin(pin.computeFrameJacobian(model, data, qp, fid, rf))
+            close(ff.frame_jacobian(m, q, name, reference=ref), Jp, f"{label}: {ref} Jacobian of {name}")
 
 
-def _urdf_depth_first_joint_order(path):
-    """Moving joints depth-first from the root link, children in document order (freefloat's promise)."""
-    root = ET.parse(path).getroot()
-    joints = root.findall("joint")
-    children = {}
-    for j in joints:
-        children.setdefault(j.find("parent").get("link"), []).append(j)
-    child_links = {j.find("child").get("link") for j in joints}
-    (root_link,) = [l.get("name") for l in root.findall("link") if l.get("name") not in child_links]
-    order = []
+def check_urdf_velocity_order(u, label):
+    """v follows the joints depth-first in URDF document order.
 
-    def visit(link):
-        for j in children.get(link, []):
-            if j.get("type") != "fixed":
-                order.append(j.get("name"))
-            visit(j.find("child").get("link"))
+    For serial chains this is also Pinocchio's order.  For branched trees it need not be: Pinocchio (through
+    urdfdom) visits sibling joints in *alphabetical* order of joint name (ANYmal: LF, LH, RF, RH, while the file
+    lists LF, RF, LH, RH), which is why the dynamics checks match joints by name.
+    """
+    moving = [name for name, t, _, _ in u.rows[1:] if rt.JOINT_NV[t] > 0]
+    assert moving == rt.urdf_depth_first_joint_order(u.text), f"{label}: joint order"
+    first = 1 if u.base == "fixed" else 2
+    if moving == [u.model.names[j] for j in range(first, u.model.njoints)]:
+        assert np.array_equal(u.layout.v_perm, np.arange(u.m.nv)), f"{label}: v order differs from Pinocchio's"
 
-    visit(root_link)
-    return order
+
+@functools.lru_cache(maxsize=None)
+def erd_pair(robot, base):
+    path = erd_urdf(ERD_ROBOTS[robot])
+    with open(path) as fh:
+        return UrdfPair(fh.read(), base, path=path)
+
+
+ERD_CASES = [(r, "free") for r in ERD_ROBOTS] + [("panda", "fixed"), ("anymal", "fixed"), ("ur5", "planar"),
+                                                   ("solo12", "planar")]
+
+
+def _rng(*key):
+    return np.random.default_rng(zlib.crc32("/".join(map(str, key)).encode()))
+
+
+@pytest.mark.parametrize("robot,base", ERD_CASES)
+def test_example_robot_whole_system_dynamics(robot, base):
+    check_urdf_dynamics(erd_pair(robot, base), f"{robot}/{base}", _rng(robot, base))
+
+
+@pytest.mark.parametrize("robot,base", ERD_CASES)
+def test_example_robot_link_placements_and_jacobians(robot, base):
+    check_urdf_kinematics(erd_pair(robot, base), f"{robot}/{base}", _rng(robot, base, "kin"))
 
 
 @pytest.mark.parametrize("robot", list(ERD_ROBOTS))
-def test_urdf_velocity_order(robot):
-    """v follows the joints depth-first in URDF document order.
-
-    For serial chains this is also Pinocchio's order.  For branched robots it need not be: Pinocchio (through
-    urdfdom) visits sibling joints in *alphabetical* order of joint name (ANYmal: LF, LH, RF, RH, while the file
-    lists LF, RF, LH, RH), which is why the dynamics tests above match joints by name.
-    """
-    u = urdf_pair(robot, "free")
-    moving = [name for name, t, _, _ in u.rows if FF_NV[t] > 0]
-    assert moving == _urdf_depth_first_joint_order(u.path)
-    # where the two conventions coincide (every robot here but the quadrupeds), v is Pinocchio's v
-    if moving == [u.model.names[j] for j in range(2, u.model.njoints)]:
-        assert np.array_equal(u.v_perm, np.arange(u.m.nv))
+def test_example_robot_velocity_order(robot):
+    check_urdf_velocity_order(erd_pair(robot, "free"), robot)
 
 
 def test_urdf_from_string_equals_from_file():
@@ -484,3 +408,18 @@ def test_urdf_from_string_equals_from_file():
     assert list(a.body_names) == list(b.body_names) and (a.nq, a.nv) == (b.nq, b.nv)
     q = np.asarray(a.random_configuration(np.random.default_rng(0)), float)
     assert_close(ff.crba(b, q), ff.crba(a, q), rtol=1e-14, atol=0, what="crba from string vs file")
+
+
+# ---- random trees rendered to URDF -----------------------------------------------------------------------------
+# The example robots leave some of the URDF format unexercised (rotated inertial frames, omitted axes, siblings
+# out of alphabetical order, joints listed before their links).  These trees cover it; the self-checks verify
+# the rendering against a Pinocchio model built directly from the description.
+
+@pytest.mark.parametrize("seed", rt.URDF_TREE_SEEDS)
+def test_random_urdf_tree(seed):
+    base = rt.BASE_TYPES[seed % 3]
+    u = UrdfPair(rt.urdf_tree_from_seed(seed).to_urdf(render_seed=seed), base)
+    label = f"urdf tree {seed}/{base}"
+    check_urdf_velocity_order(u, label)
+    check_urdf_dynamics(u, label, _rng(seed, base))
+    check_urdf_kinematics(u, label, _rng(seed, base, "kin"), all_jacobians=True)

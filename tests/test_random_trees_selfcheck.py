@@ -379,3 +379,69 @@ def test_planar_base_velocity_convention(seed):
         q1 = p.q_from_pin(pin.integrate(p.model, p.q_to_pin(q), p.v_to_pin(v)))
         assert_close(q1[:2] - q[:2], dpos, rtol=1e-14, atol=1e-14, what="planar translation")
         assert abs(math.remainder(q1[2] - q[2] - dyaw, 2 * math.pi)) < 1e-14
+
+
+# ----------------------------------------------------------------------------------------------------------------
+# URDF rendering (used by the oracle's random-URDF tests)
+# ----------------------------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("seed", rt.URDF_TREE_SEEDS)
+def test_urdf_rendering_matches_direct_model(seed):
+    """Pinocchio's own URDF parser on `to_urdf` text == the Pinocchio model built directly from the description."""
+    base = rt.BASE_TYPES[seed % 3]
+    d = rt.urdf_tree_from_seed(seed, base)
+    text = d.to_urdf(render_seed=seed)
+    root = {"free": pin.JointModelFreeFlyer(), "planar": pin.JointModelPlanar(), "fixed": None}[base]
+    model = pin.buildModelFromXML(text) if root is None else pin.buildModelFromXML(text, root)
+    model.gravity = pin.Motion.Zero()
+    data = model.createData()
+    L = rt.NamedLayout(model, d.joint_rows())
+    p = rt.build_pinocchio(d)
+    assert rt.urdf_total_mass(text) == pytest.approx(d.total_mass(), rel=1e-14)
+    assert rt.pin_total_mass(model) == pytest.approx(d.total_mass(), rel=1e-13)
+    names = [b.name for b in d.bodies]
+    for q, v, tau, a, fext in _states(d, seed):
+        qp = L.q_to_pin(q)
+        pin.framesForwardKinematics(model, data, qp)
+        for b, T in zip(d.bodies, d.body_placements(q)):
+            assert_close(data.oMf[L.body_frame(b.name)[0]].homogeneous, T, rtol=1e-12, atol=1e-12,
+                         what=f"placement of link {b.name}")
+        assert_close(L.matrix_from_pin(pin.crba(model, data, qp)), p.crba(q), rtol=1e-12, what="crba")
+        rn = pin.rnea(model, data, qp, L.v_to_pin(v), L.v_to_pin(a), L.fext_to_pin(names, fext))
+        assert_close(L.v_from_pin(rn), p.rnea(q, v, a, fext), rtol=1e-12, what="rnea fext")
+        assert_close(rt.pin_momentum_at_origin(model, data, qp, L.v_to_pin(v)), p.momentum(q, v), rtol=1e-12,
+                     what="momentum")
+        assert_close(rt.pin_center_of_mass(model, data, qp), d.center_of_mass(q), rtol=1e-12, atol=1e-13,
+                     what="CoM")
+
+
+def test_urdf_rendering_covers_the_format():
+    import xml.etree.ElementTree as ET
+    seen = Counter()
+    for seed in rt.URDF_TREE_SEEDS:
+        d = rt.urdf_tree_from_seed(seed)
+        text = d.to_urdf(render_seed=seed)
+        root = ET.fromstring(text)
+        joints = root.findall("joint")
+        seen["continuous"] += sum(j.get("type") == "continuous" for j in joints)
+        seen["fixed"] += sum(j.get("type") == "fixed" for j in joints)
+        seen["prismatic"] += sum(j.get("type") == "prismatic" for j in joints)
+        seen["default_axis"] += sum(j.get("type") != "fixed" and j.find("axis") is None for j in joints)
+        order = rt.urdf_depth_first_joint_order(text)
+        pin_model = pin.buildModelFromXML(text, pin.JointModelFreeFlyer())
+        seen["document_order_is_not_pinocchio_order"] += order != list(pin_model.names)[2:]
+        seen["document_order_is_not_file_order"] += order != [b.effective_joint_name for b in d.bodies[1:]
+                                                              if b.joint_type != "fixed"]
+        tags = [(e.tag, e.get("name")) for e in root]
+        seen["joint_before_its_child_link"] += any(
+            tags.index(("link", j.find("child").get("link"))) > tags.index(("joint", j.get("name"))) for j in joints)
+    missing = [k for k in ("continuous", "fixed", "prismatic", "default_axis", "document_order_is_not_pinocchio_order",
+                           "document_order_is_not_file_order", "joint_before_its_child_link") if not seen[k]]
+    assert not missing, f"no URDF tree exercises {missing}: {dict(seen)}"
+
+
+def test_matrix_to_rpy_inverts_rpy_to_matrix():
+    rng = np.random.default_rng(3)
+    for _ in range(100):
+        R = rt.random_rotation(rng)
+        assert_close(rt.rpy_to_matrix(rt.matrix_to_rpy(R)), R, rtol=1e-13, atol=1e-14, what="rpy round trip")
