@@ -232,13 +232,17 @@ def test_from_yaml_file_equals_from_string(seed, tmp_path):
 
 #: name -> URDF path inside example-robot-data's `robots/` folder.  Chosen to cover a 7-DoF arm with fixed
 #: links and fingers (panda), a 6-DoF arm whose root link is a massless "world" (ur5), continuous joints
-#: (kinova: Pinocchio stores them as cos/sin) and branched trees with many fixed links (solo12, anymal).
+#: (kinova: Pinocchio stores them as cos/sin), branched trees with many fixed links (solo12, a1) and a dual-arm
+#: torso with prismatic fingers (baxter).  A1's file lists its legs FR, FL, RR, RL, which is not the
+#: alphabetical order Pinocchio uses.  Mimic tags (panda, baxter fingers) are ignored by both libraries.
+#: ANYmal is not here: its URDF has a non-physical dummy inertia, which freefloat rejects (tested below).
 ERD_ROBOTS = {
     "panda": "panda_description/urdf/panda.urdf",
     "ur5": "ur_description/urdf/ur5_robot.urdf",
     "kinova": "kinova_description/robots/kinova.urdf",
     "solo12": "solo_description/robots/solo12.urdf",
-    "anymal": "anymal_b_simple_description/robots/anymal.urdf",
+    "a1": "a1_description/urdf/a1.urdf",
+    "baxter": "baxter_description/urdf/baxter.urdf",
 }
 
 
@@ -359,8 +363,8 @@ def check_urdf_velocity_order(u, label):
     """v follows the joints depth-first in URDF document order.
 
     For serial chains this is also Pinocchio's order.  For branched trees it need not be: Pinocchio (through
-    urdfdom) visits sibling joints in *alphabetical* order of joint name (ANYmal: LF, LH, RF, RH, while the file
-    lists LF, RF, LH, RH), which is why the dynamics checks match joints by name.
+    urdfdom) visits sibling joints in *alphabetical* order of joint name (A1: FL, FR, RL, RR, while the file
+    lists FR, FL, RR, RL), which is why the dynamics checks match joints by name.
     """
     moving = [name for name, t, _, _ in u.rows[1:] if rt.JOINT_NV[t] > 0]
     assert moving == rt.urdf_depth_first_joint_order(u.text), f"{label}: joint order"
@@ -376,7 +380,7 @@ def erd_pair(robot, base):
         return UrdfPair(fh.read(), base, path=path)
 
 
-ERD_CASES = [(r, "free") for r in ERD_ROBOTS] + [("panda", "fixed"), ("anymal", "fixed"), ("ur5", "planar"),
+ERD_CASES = [(r, "free") for r in ERD_ROBOTS] + [("panda", "fixed"), ("a1", "fixed"), ("ur5", "planar"),
                                                    ("solo12", "planar")]
 
 
@@ -397,6 +401,14 @@ def test_example_robot_link_placements_and_jacobians(robot, base):
 @pytest.mark.parametrize("robot", list(ERD_ROBOTS))
 def test_example_robot_velocity_order(robot):
     check_urdf_velocity_order(erd_pair(robot, "free"), robot)
+
+
+def test_nonphysical_urdf_inertia_is_rejected():
+    """ANYmal's URDF gives its dummy `base` link the inertia tensor 1e-6 * ones(3, 3) (eigenvalues 0, 0, 3e-6).
+    Pinocchio accepts it; freefloat's loader must refuse it with an error that names the link."""
+    path = erd_urdf("anymal_b_simple_description/robots/anymal.urdf")
+    with pytest.raises(Exception, match="base"):
+        ff.Model.from_urdf(path, base="free")
 
 
 def test_urdf_from_string_equals_from_file():

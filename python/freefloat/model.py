@@ -121,6 +121,22 @@ class Model:
                 q[s] = rng.uniform(a, b)
         return q
 
+    def q_labels(self) -> list[str]:
+        """A name for every entry of q, e.g. base.x … base.qw, J1, ball.qx …"""
+        return self._labels(("x", "y", "z", "qx", "qy", "qz", "qw"), ("x", "y", "yaw"), ("qx", "qy", "qz", "qw"), self.nqs)
+
+    def v_labels(self) -> list[str]:
+        """A name for every entry of v, e.g. base.vx … base.wz, J1, ball.wx …"""
+        return self._labels(("vx", "vy", "vz", "wx", "wy", "wz"), ("vx", "vy", "wz"), ("wx", "wy", "wz"), self.nvs)
+
+    def _labels(self, free, planar, spherical, sizes) -> list[str]:
+        out = []
+        for i, (jt, n) in enumerate(zip(self.joint_types, sizes)):
+            owner = self.body_names[0] if i == 0 else self.joint_names[i]
+            parts = {"free": free, "planar": planar, "spherical": spherical}.get(jt) if n > 1 else None
+            out += [f"{owner}.{p}" for p in parts] if parts else ([owner] if n == 1 else [])
+        return out
+
     def body_index(self, name: str) -> int:
         try:
             return self.body_names.index(name)

@@ -37,7 +37,8 @@ class Trajectory:
     kinetic_energy: np.ndarray
     work: np.ndarray
     model_name: str = ""
-    joint_names: list = field(default_factory=list)
+    q_labels: list = field(default_factory=list)
+    v_labels: list = field(default_factory=list)
     stats: dict = field(default_factory=dict)
 
     def __len__(self) -> int:
@@ -50,11 +51,17 @@ class Trajectory:
     # -- conservation summaries -------------------------------------------------------------------------
     def momentum_drift(self) -> dict:
         """Largest deviation of linear and angular momentum from their initial values, absolute and
-        relative to the initial magnitude (or to the largest magnitude reached, if that is zero)."""
+        relative to a momentum scale: the largest |p| (|L|) reached, or, if larger, the momentum the
+        motion's kinetic energy represents (sqrt(2 M E) and sqrt(2 J E), with M the total mass and
+        J = M R², R the largest distance of a body from the centre of mass at t = 0, both recorded
+        by `simulate` in stats). The second scale keeps the figure meaningful when the momentum
+        itself is zero, as in a robot starting at rest."""
         dp = np.linalg.norm(self.momentum[:, :3] - self.momentum[0, :3], axis=1).max()
         dl = np.linalg.norm(self.momentum[:, 3:] - self.momentum[0, 3:], axis=1).max()
-        sp = max(np.linalg.norm(self.momentum[:, :3], axis=1).max(), 1e-300)
-        sl = max(np.linalg.norm(self.momentum[:, 3:], axis=1).max(), 1e-300)
+        e = np.abs(self.kinetic_energy).max()
+        mass, radius = self.stats.get("total_mass", 0.0), self.stats.get("radius", 0.0)
+        sp = max(np.linalg.norm(self.momentum[:, :3], axis=1).max(), np.sqrt(2 * mass * e), 1e-300)
+        sl = max(np.linalg.norm(self.momentum[:, 3:], axis=1).max(), np.sqrt(2 * mass * radius**2 * e), 1e-300)
         return {"linear_abs": float(dp), "angular_abs": float(dl), "linear_rel": float(dp / sp), "angular_rel": float(dl / sl)}
 
     def energy_balance(self) -> dict:
@@ -71,14 +78,16 @@ class Trajectory:
         import pyarrow.parquet as pq
 
         cols = {"t": self.t}
-        for prefix, arr in (("q", self.q), ("v", self.v), ("ddq", self.ddq), ("tau", self.tau)):
+        ql = self.q_labels or [str(j) for j in range(self.q.shape[1])]
+        vl = self.v_labels or [str(j) for j in range(self.v.shape[1])]
+        for prefix, arr, labels in (("q", self.q, ql), ("v", self.v, vl), ("ddq", self.ddq, vl), ("tau", self.tau, vl)):
             for j in range(arr.shape[1]):
-                cols[f"{prefix}.{j}"] = arr[:, j]
+                cols[f"{prefix}.{labels[j]}"] = arr[:, j]
         for j, n in enumerate(MOMENTUM_NAMES):
             cols[f"momentum.{n}"] = self.momentum[:, j]
         cols["kinetic_energy"] = self.kinetic_energy
         cols["work"] = self.work
-        meta = {"freefloat": json.dumps({"model": self.model_name, "joint_names": self.joint_names, "stats": self.stats})}
+        meta = {"freefloat": json.dumps({"model": self.model_name, "stats": self.stats})}
         table = pa.table(cols).replace_schema_metadata(meta)
         pq.write_table(table, str(path))
 
@@ -98,8 +107,12 @@ class Trajectory:
             raise InputError(f"{p}: not a freefloat trajectory; missing columns {missing}")
 
         def block(prefix):
-            cs = sorted((c for c in names if c.startswith(prefix + ".")), key=lambda c: int(c.split(".")[1]))
+            # Columns keep the file's order, which is q/v order.
+            cs = [c for c in names if c.startswith(prefix + ".")]
             return np.column_stack([table[c].to_numpy() for c in cs]) if cs else np.zeros((table.num_rows, 0))
+
+        def labels(prefix):
+            return [c[len(prefix) + 1:] for c in names if c.startswith(prefix + ".")]
 
         raw = (table.schema.metadata or {}).get(b"freefloat", b"{}")
         meta = json.loads(raw)
@@ -107,7 +120,7 @@ class Trajectory:
             t=table["t"].to_numpy(), q=block("q"), v=block("v"), ddq=block("ddq"), tau=block("tau"),
             momentum=np.column_stack([table[f"momentum.{n}"].to_numpy() for n in MOMENTUM_NAMES]),
             kinetic_energy=table["kinetic_energy"].to_numpy(), work=table["work"].to_numpy(),
-            model_name=meta.get("model", ""), joint_names=meta.get("joint_names", []), stats=meta.get("stats", {}),
+            model_name=meta.get("model", ""), q_labels=labels("q"), v_labels=labels("v"), stats=meta.get("stats", {}),
         )
 
 
@@ -141,8 +154,9 @@ def simulate(
       (T, nv) read at torque_times (default k·dt) with hold="zoh" or "linear". For a free base the
       first six entries are the thruster wrench [force; torque] in the base frame; reaction wheels
       are ordinary joints.
-    controller: controller(t, q, v) -> (nv,) called every controller_period seconds; its output is
-      held (zero-order hold) and added to torques.
+    controller: controller(t, q, v) -> (nv,) called at t = k·controller_period for every such t up to
+      and including t_final; its output is held (zero-order hold) and added to torques. With RK4 the
+      period should be a multiple of dt (otherwise a sample waits for the next step).
     prescribed / prescription: joint names that follow prescription(t) -> (q, v, a) (full-length
       arrays; only the prescribed joints' entries are used) while the rest responds (hybrid
       dynamics); the recorded tau then holds the forces these joints needed.
@@ -175,5 +189,24 @@ def simulate(
         if bar is not None:
             bar.close()
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
-    stats.update(method=method, dt=dt, t_final=t_final)
-    return Trajectory(**out, model_name=model.name, joint_names=model.joint_names, stats=stats)
+    stats.update(method=method, dt=dt, t_final=t_final, total_mass=model.total_mass, radius=_radius(model, q0))
+    return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
+
+
+def _radius(model: Model, q) -> float:
+    """Largest distance of a body's centre of mass from the system's, at q (a length scale)."""
+    from .algorithms import center_of_mass, forward_kinematics
+
+    fk = forward_kinematics(model, q)
+    com = center_of_mass(model, q)
+    P = model.parameters()
+    best = 0.0
+    for i in range(model.nbodies):
+        if P[i, 0] > 0:
+            x, y, z, w = fk[i, 3:]
+            R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                          [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                          [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+            c = fk[i, :3] + R @ (P[i, 1:4] / P[i, 0])
+            best = max(best, float(np.linalg.norm(c - com)))
+    return best

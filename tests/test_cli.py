@@ -1,0 +1,51 @@
+"""The command line, run as a user would."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+
+def run(*args, ok=True):
+    r = subprocess.run([sys.executable, "-m", "freefloat.cli", *args], capture_output=True, text=True, timeout=600)
+    if ok:
+        assert r.returncode == 0, r.stderr
+    return r
+
+
+@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"]])
+def test_every_command_has_help(cmd):
+    r = run(*cmd, "--help")
+    assert "Usage:" in r.stdout and len(r.stdout) > 200
+
+
+def test_models_lists_builtins():
+    r = run("models")
+    assert "seed001_dual_arm" in r.stdout and "thesis_ch7_two_arm" in r.stdout
+    assert "name: seed000_3d" in run("models", "--show", "seed000_3d").stdout
+
+
+def test_simulate_writes_parquet_json_and_figure(tmp_path):
+    out = tmp_path / "run.parquet"
+    r = run("simulate", "thesis_ch5_single_arm", "--t-final", "1", "--out", str(out))
+    assert "momentum drift" in r.stdout
+    res = json.loads(out.with_suffix(".results.json").read_text())
+    assert res["samples"] == 101 and res["momentum_drift_angular_rel"] < 1e-9
+    assert out.exists() and out.with_suffix(".png").stat().st_size > 10_000
+
+
+def test_demo_runs(tmp_path):
+    r = run("demo", "--t-final", "2", "--out", str(tmp_path))
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["momentum_drift_linear_rel"] < 1e-10 and res["energy_minus_work_rel"] < 1e-9
+    assert "peak joint torques" in r.stdout and (tmp_path / "demo.png").exists()
+
+
+def test_bad_model_gives_one_clear_line(tmp_path):
+    r = run("simulate", "no_such_robot", ok=False)
+    assert r.returncode == 2 and "built-in robot" in r.stderr and "Traceback" not in r.stderr
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: x\nbodies:\n  - name: b\n    inertial: {mass: -1}\n")
+    r = run("simulate", str(bad), ok=False)
+    assert r.returncode == 2 and "negative" in r.stderr and "Traceback" not in r.stderr
