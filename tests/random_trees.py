@@ -2,7 +2,8 @@
 
 A `TreeDescription` is plain data (numpy arrays, no freefloat, no Pinocchio).  It renders to
 
-* our YAML model text (`to_yaml`), which freefloat loads, and
+* our YAML model text (`to_yaml`), which freefloat loads,
+* URDF text (`to_urdf`, for trees without spherical joints), which both freefloat and Pinocchio parse, and
 * a Pinocchio model built *directly from the description* (`build_pinocchio`), never from a freefloat
   object, so that Pinocchio is an independent oracle.
 
@@ -10,7 +11,8 @@ Conventions follow docs/model_format.md: body 0 is the base, `parents[i] < i`, t
 frame, q/v concatenate the joints body by body.  Pinocchio has no fixed joint inside the tree, so a body on a
 fixed joint is merged into its nearest moving ancestor (its inertia appended with `appendBodyToJoint`) and
 represented by a BODY frame so its placement and Jacobians can still be compared.  For a fixed base that
-ancestor is Pinocchio's "universe" (joint 0).
+ancestor is Pinocchio's "universe" (joint 0).  Our format allows any topological body order, Pinocchio's CRBA
+needs depth-first order: `PinTree` adds the joints depth-first and permutes q/v (see `depth_first_order`).
 
 The description also carries its own small numpy forward kinematics (`body_placements`): the self-check tests
 compare it with the Pinocchio model, which catches mistakes in how the Pinocchio model is built.
@@ -127,9 +129,9 @@ def yaml_float(x) -> str:
     repr() is the shortest exact representation, but PyYAML (YAML 1.1) reads `1e-05` as a *string*: its float
     pattern needs a dot in the mantissa.  So `1e-05` becomes `1.0e-05`.
     """
-    s = repr(float(x))
     if not np.isfinite(x):
         raise ValueError(f"non-finite value {x!r} in a model description")
+    s = repr(float(x))
     if "e" in s:
         mant, exp = s.split("e")
         if "." not in mant:

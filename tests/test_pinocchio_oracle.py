@@ -7,7 +7,8 @@ Two families:
   kinematic and dynamic entry point is compared body by body, for several random states.
 * real URDF robots from example-robot-data, loaded by `ff.Model.from_urdf` and by `pin.buildModelFromUrdf`;
   joints are matched by name, so the comparison does not depend on how each library orders a branched tree
-  (the order freefloat promises is checked on its own, against the URDF text).
+  (the order freefloat promises is checked on its own, against the URDF text).  Random trees rendered to URDF
+  cover what those robots leave out (rotated inertial frames, default axes, shuffled document order).
 
 Comparisons are norm-relative (`random_trees.assert_close`) at 1e-9 with a 1e-12 floor.
 """
@@ -25,8 +26,8 @@ import pytest
 ff = pytest.importorskip("freefloat", reason="freefloat is not importable yet (the engine is not built)")
 pin = pytest.importorskip("pinocchio", reason="Pinocchio (PyPI `pin`) is needed as the oracle")
 
-import random_trees as rt  # noqa: E402  (tests/ is on sys.path under pytest's default import mode)
-from random_trees import assert_close  # noqa: E402
+import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
+from random_trees import assert_close
 
 RTOL = 1e-9
 ATOL = 1e-12
@@ -38,7 +39,7 @@ N_STATES = 3
 # random trees
 # ----------------------------------------------------------------------------------------------------------------
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def case(seed):
     """(description, freefloat model, Pinocchio tree) for one seed, built once."""
     d = rt.tree_from_seed(seed)
@@ -373,7 +374,7 @@ def check_urdf_velocity_order(u, label):
         assert np.array_equal(u.layout.v_perm, np.arange(u.m.nv)), f"{label}: v order differs from Pinocchio's"
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def erd_pair(robot, base):
     path = erd_urdf(ERD_ROBOTS[robot])
     with open(path) as fh:

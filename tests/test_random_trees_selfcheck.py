@@ -13,8 +13,8 @@ import pytest
 yaml = pytest.importorskip("yaml")
 pin = pytest.importorskip("pinocchio", reason="Pinocchio (PyPI `pin`) is needed for the oracle self-checks")
 
-import random_trees as rt  # noqa: E402  (tests/ is on sys.path under pytest's default import mode)
-from random_trees import assert_close  # noqa: E402
+import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
+from random_trees import assert_close
 
 SEEDS = rt.TREE_SEEDS
 N_STATES = 3

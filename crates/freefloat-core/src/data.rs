@@ -18,8 +18,16 @@ pub struct Data {
     pub c: Vec<Motion>,
     /// RNEA: force transmitted by each joint to its child; ABA: bias forces.
     pub f: Vec<Force>,
-    /// Articulated-body inertias (ABA).
+    /// Articulated-body inertias (ABA; inertial-frame coordinates).
     pub ia: Vec<M6>,
+    /// ABA works in inertial-frame coordinates (twists and accelerations at the inertial origin):
+    /// body twists, accelerations, velocity-product terms and bias forces there.
+    pub ov: Vec<Motion>,
+    pub oa: Vec<Motion>,
+    pub oc: Vec<Motion>,
+    pub of: Vec<Force>,
+    /// Motion subspace of each joint in inertial coordinates (nv columns used).
+    pub os: Vec<M6>,
     /// `U = I^A S`, one 6×nv block per joint (unused columns zero).
     pub u: Vec<M6>,
     /// `D⁻¹ = (Sᵀ U)⁻¹`, top-left nv×nv block.
@@ -51,6 +59,11 @@ impl Data {
             c: vec![Motion::ZERO; n],
             f: vec![Force::ZERO; n],
             ia: vec![M6::zeros(); n],
+            ov: vec![Motion::ZERO; n],
+            oa: vec![Motion::ZERO; n],
+            oc: vec![Motion::ZERO; n],
+            of: vec![Force::ZERO; n],
+            os: vec![M6::zeros(); n],
             u: vec![M6::zeros(); n],
             dinv: vec![M6::zeros(); n],
             uu: vec![[0.0; 6]; n],
