@@ -408,8 +408,27 @@ def test_nonphysical_urdf_inertia_is_rejected():
     """ANYmal's URDF gives its dummy `base` link the inertia tensor 1e-6 * ones(3, 3) (eigenvalues 0, 0, 3e-6).
     Pinocchio accepts it; freefloat's loader must refuse it with an error that names the link."""
     path = erd_urdf("anymal_b_simple_description/robots/anymal.urdf")
-    with pytest.raises(Exception, match="base"):
+    with pytest.raises(ff.ModelError, match=r"'base'.*allow_nonphysical=True"):
         ff.Model.from_urdf(path, base="free")
+    # The opt-out loads it; whole-system dynamics then agree with Pinocchio's model of the same file.
+    m = ff.Model.from_urdf(path, base="free", allow_nonphysical=True)
+    pm = pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
+    pm.gravity = pin.Motion.Zero()
+    assert m.total_mass == pytest.approx(pin.computeTotalMass(pm), rel=1e-12)
+    # Map Pinocchio's joint order (alphabetical siblings) onto ours by joint name.
+    rng = np.random.default_rng(7)
+    q_pin = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+    q_pin[3:7] /= np.linalg.norm(q_pin[3:7])
+    v_pin, tau_pin = rng.normal(size=pm.nv), rng.normal(size=pm.nv)
+    qi, vi = list(range(7)), list(range(6))
+    for name, nq in zip(m.joint_names[1:], m.nqs[1:]):
+        if nq:
+            j = pm.getJointId(name)
+            qi.append(pm.joints[j].idx_q)
+            vi.append(pm.joints[j].idx_v)
+    q, v, tau = q_pin[qi], v_pin[vi], tau_pin[vi]
+    a_pin = pin.aba(pm, pm.createData(), q_pin, v_pin, tau_pin)
+    assert_close(ff.aba(m, q, v, tau), a_pin[vi], rtol=1e-9, atol=0, what="anymal aba")
 
 
 def test_urdf_from_string_equals_from_file():

@@ -30,15 +30,18 @@ class Model:
 
     # -- loading and saving ---------------------------------------------------------------------------
     @classmethod
-    def from_urdf(cls, path, base: str = "free") -> "Model":
+    def from_urdf(cls, path, base: str = "free", allow_nonphysical: bool = False) -> "Model":
         """Load a URDF file; its root link becomes the base, attached by a `base` joint
-        ("free", "planar" or "fixed"). Massless leaf links on fixed joints become frames."""
+        ("free", "planar" or "fixed"). Joints are taken depth-first, children in document order.
+        Massless leaf links on fixed joints become frames. Links with physically impossible inertia
+        are rejected unless `allow_nonphysical` (many published URDFs have dummy links whose inertia
+        is degenerate)."""
         p = Path(path)
-        return cls(_core.Model.from_urdf_string(_read(p), base, str(p)))
+        return cls(_core.Model.from_urdf_string(_read(p), base, str(p), allow_nonphysical))
 
     @classmethod
-    def from_urdf_string(cls, text: str, base: str = "free") -> "Model":
-        return cls(_core.Model.from_urdf_string(text, base, "<string>"))
+    def from_urdf_string(cls, text: str, base: str = "free", allow_nonphysical: bool = False) -> "Model":
+        return cls(_core.Model.from_urdf_string(text, base, "<string>", allow_nonphysical))
 
     @classmethod
     def from_yaml(cls, path) -> "Model":

@@ -39,10 +39,10 @@ fn base_type(base: &str) -> PyResult<JointType> {
 impl PyModel {
     /// Parse URDF text. `source` names it in error messages.
     #[staticmethod]
-    #[pyo3(signature = (text, base = "free", source = "<string>"))]
-    fn from_urdf_string(text: &str, base: &str, source: &str) -> PyResult<PyModel> {
+    #[pyo3(signature = (text, base = "free", source = "<string>", allow_nonphysical = false))]
+    fn from_urdf_string(text: &str, base: &str, source: &str, allow_nonphysical: bool) -> PyResult<PyModel> {
         let b = base_type(base)?;
-        guard(|| urdf::from_urdf_str(text, source, b)).map(PyModel::wrap)
+        guard(|| urdf::from_urdf_str(text, source, b, allow_nonphysical)).map(PyModel::wrap)
     }
 
     /// Parse the YAML model format (docs/model_format.md).

@@ -27,7 +27,9 @@ struct JointInfo<'a> {
     limits: JointLimits,
 }
 
-pub fn from_urdf_str(text: &str, source_name: &str, base: JointType) -> Result<Model> {
+/// `allow_nonphysical` exempts every link from the physical-consistency check (many published URDFs
+/// carry dummy links with degenerate inertia); finite values and mass ≥ 0 are still required.
+pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonphysical: bool) -> Result<Model> {
     let doc = roxmltree::Document::parse(text).map_err(|e| FfError::ModelFile {
         source_name: source_name.to_string(),
         line: Some(e.pos().row as usize),
@@ -84,6 +86,7 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType) -> Result<M
     let root = roots[0].clone();
     let root_info = &links[&root];
     let mut b = ModelBuilder::new(robot_name, &root, base, root_info.inertia)?;
+    b.set_base_allow_nonphysical(allow_nonphysical);
 
     // Depth-first, children in document order.
     let mut stack: Vec<(usize, usize)> = vec![]; // (joint index, parent body index)
@@ -115,7 +118,7 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType) -> Result<M
             inertia: child.inertia,
             limits: j.limits,
             tags: vec![],
-            allow_nonphysical: false,
+            allow_nonphysical,
         };
         let idx = b.add_body(spec).map_err(|e| err(j.node, e.to_string()))?;
         push_children(&j.child, idx, &mut stack);
@@ -128,7 +131,10 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType) -> Result<M
         });
     }
     b.build().map_err(|e| match e {
-        FfError::Inertia { ref body, .. } => err(links[body].node, e.to_string()),
+        FfError::Inertia { ref body, .. } => err(
+            links[body].node,
+            format!("{e} (to load a file with such links anyway, pass allow_nonphysical=True)"),
+        ),
         other => FfError::ModelFile { source_name: source_name.to_string(), line: None, msg: other.to_string() },
     })
 }
