@@ -185,7 +185,18 @@ def environment():
                 break
     except OSError:
         pass
+    git = None
+    try:
+        import subprocess
+        root = Path(__file__).resolve().parent.parent
+        head = subprocess.run(["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True).stdout.strip()
+        git = head + ("+dirty" if dirty else "") if head else None
+    except OSError:
+        pass
     return {
+        "git": git,
         "python": sys.version.split()[0],
         "platform": platform.platform(),
         "cpu": cpu,
@@ -495,7 +506,7 @@ def make_report(env, args, agree, batch, single, sim, ratios, checks):
     L.append(f"Run: {time.strftime('%Y-%m-%d %H:%M:%S')}, {env['cpu']}, {env['nproc']} CPUs, "
              f"load average at start {tuple(round(x, 2) for x in env['loadavg_start'])}, "
              f"at end {tuple(round(x, 2) for x in env['loadavg_end'])}. "
-             f"freefloat {env['freefloat']}, pin {env['pinocchio']}, crocoddyl {env['crocoddyl']}, "
+             f"freefloat {env['freefloat']} (git {env['git']}), pin {env['pinocchio']}, crocoddyl {env['crocoddyl']}, "
              f"numpy {env['numpy']}, Python {env['python']}."
              + (" **--quick run (smoke test; numbers not meaningful).**" if args.quick else "") + "\n")
     L.append(f"Repeats: {args.repeats} (interleaved). Batch N = {args.batch}; single-call loops of {args.calls} calls. "

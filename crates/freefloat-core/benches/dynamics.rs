@@ -187,7 +187,8 @@ fn simulation(c: &mut Criterion) {
         b.iter_batched(
             || (times.clone(), values.clone()),
             |(tt, vv)| {
-                let inputs = Inputs { torques: TorqueSource::table(tt, vv, m.nv, Hold::Linear).unwrap(), ..Default::default() };
+                let inputs =
+                    Inputs { torques: TorqueSource::table(tt, vv, m.nv, Hold::Linear).unwrap(), ..Default::default() };
                 black_box(simulate(&m, &q0, &v0, &opts, inputs, None).unwrap())
             },
             BatchSize::PerIteration,

@@ -4,6 +4,10 @@
 //! Pattern (Pinocchio/MuJoCo): a `Model` is an immutable description, a `Data` holds every work
 //! buffer, algorithms are free functions `algo(&model, &mut data, ...)` that allocate nothing.
 
+// `!(x > 0.0)` is how this crate rejects NaN along with non-positive values; and loops index several
+// joint-aligned arrays at once, which reads better than zipping them.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+
 pub mod config;
 pub mod data;
 pub mod dynamics;

@@ -41,7 +41,8 @@ pub fn random_model(r: &mut StdRng, base: JointType, n: usize, gravity: bool) ->
         let parent = r.gen_range(0..i);
         let kind = kinds[r.gen_range(0..kinds.len())];
         let rpy = V3::new(r.gen_range(-3.0..3.0), r.gen_range(-1.5..1.5), r.gen_range(-3.0..3.0));
-        let pl = Se3::new(rpy_to_rot(&rpy), V3::new(r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)));
+        let pl =
+            Se3::new(rpy_to_rot(&rpy), V3::new(r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)));
         b.add_body(BodySpec {
             name: format!("b{i}"),
             parent,

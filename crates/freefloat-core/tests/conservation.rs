@@ -1,4 +1,5 @@
 //! Conservation laws and convergence order of the integrators on the seed 001 dual-arm robot.
+#![allow(clippy::needless_range_loop)]
 
 use freefloat_core::model::builtin;
 use freefloat_core::sim::{simulate, Inputs, Method, SimOptions, TorqueSource};

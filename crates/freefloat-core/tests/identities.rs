@@ -1,11 +1,15 @@
 //! Identities the recursive algorithms must satisfy with each other, on random trees with every
 //! joint and base type. (The independent check against Pinocchio is in tests/test_pinocchio_oracle.py.)
+#![allow(clippy::needless_range_loop)]
 
 mod common;
 use common::*;
 use freefloat_core::config::{retract, tangent_rate};
 use freefloat_core::dynamics::{aba, crba, hybrid_aba, rnea, Prescribed};
-use freefloat_core::kinematics::{centroidal_momentum_matrix, frame_jacobian, frame_placement, forward_kinematics, kinetic_energy, momentum, Reference};
+use freefloat_core::kinematics::{
+    centroidal_momentum_matrix, forward_kinematics, frame_jacobian, frame_placement, kinetic_energy, momentum,
+    Reference,
+};
 use freefloat_core::Data;
 use nalgebra::{DMatrix, DVector};
 
@@ -72,7 +76,11 @@ fn jacobians_match_finite_differences() {
         let dr = (pp.rot - pm.rot) / (2.0 * eps);
         let w = dr * place(0.0, &mut d).rot.transpose(); // [ω]× in world axes
         let ang = nalgebra::Vector3::new(w[(2, 1)], w[(0, 2)], w[(1, 0)]);
-        assert!((lin - tw.fixed_rows::<3>(0)).norm() < 1e-6, "trial {trial}: linear {lin:?} vs {:?}", tw.fixed_rows::<3>(0));
+        assert!(
+            (lin - tw.fixed_rows::<3>(0)).norm() < 1e-6,
+            "trial {trial}: linear {lin:?} vs {:?}",
+            tw.fixed_rows::<3>(0)
+        );
         assert!((ang - tw.fixed_rows::<3>(3)).norm() < 1e-6, "trial {trial}: angular");
         // Local reference = the world one rotated into the frame.
         let mut jl = DMatrix::zeros(6, m.nv);
@@ -97,7 +105,9 @@ fn hybrid_dynamics_matches_partitioned_crba() {
         let tau = random_vec(m.nv, &mut r);
         let ap_given = random_vec(m.nv, &mut r);
         let mask: Vec<bool> = (0..m.nbodies()).map(|i| m.nvs[i] > 0 && (i + trial) % 2 == 0).collect();
-        let idx: Vec<bool> = (0..m.nv).map(|k| (0..m.nbodies()).any(|i| mask[i] && k >= m.idx_v[i] && k < m.idx_v[i] + m.nvs[i])).collect();
+        let idx: Vec<bool> = (0..m.nv)
+            .map(|k| (0..m.nbodies()).any(|i| mask[i] && k >= m.idx_v[i] && k < m.idx_v[i] + m.nvs[i]))
+            .collect();
         hybrid_aba(&m, &mut d, &q, &v, &tau, None, Some(Prescribed { mask: &mask, ddq: &ap_given })).unwrap();
         let (a_h, tau_h) = (d.ddq.clone(), d.tau.clone());
         crba(&m, &mut d, &q);
@@ -109,7 +119,9 @@ fn hybrid_dynamics_matches_partitioned_crba() {
         let mut a = ap_given.clone();
         if !f.is_empty() {
             let mff = DMatrix::from_fn(f.len(), f.len(), |i, j| mm[(f[i], f[j])]);
-            let rhs = DVector::from_fn(f.len(), |i, _| tau[f[i]] - h[f[i]] - p.iter().map(|&k| mm[(f[i], k)] * ap_given[k]).sum::<f64>());
+            let rhs = DVector::from_fn(f.len(), |i, _| {
+                tau[f[i]] - h[f[i]] - p.iter().map(|&k| mm[(f[i], k)] * ap_given[k]).sum::<f64>()
+            });
             let af = mff.cholesky().unwrap().solve(&rhs);
             for (i, &k) in f.iter().enumerate() {
                 a[k] = af[i];

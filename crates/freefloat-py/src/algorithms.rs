@@ -157,7 +157,13 @@ fn write_rowmajor(a: &nalgebra::DMatrix<f64>, o: &mut [f64]) {
 /// Jacobian (6, nv) of a body or frame: its twist [linear; angular] is J @ v.
 #[pyfunction]
 #[pyo3(signature = (model, q, name, reference = "local"))]
-pub fn frame_jacobian<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, name: &str, reference: &str) -> PyResult<Bound<'py, PyAny>> {
+pub fn frame_jacobian<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: Arr<'py>,
+    name: &str,
+    reference: &str,
+) -> PyResult<Bound<'py, PyAny>> {
     let m = &model.inner;
     let (body, pl) = name_to_frame(m, name)?;
     let rf = guard(|| Reference::from_name(reference))?;
@@ -216,7 +222,14 @@ pub fn generalized_jacobian<'py>(
 /// Inverse dynamics: generalized forces for accelerations `a`.
 #[pyfunction]
 #[pyo3(signature = (model, q, v, a, fext = None))]
-pub fn rnea<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>, a: Arr<'py>, fext: Option<Arr<'py>>) -> PyResult<Bound<'py, PyAny>> {
+pub fn rnea<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: Arr<'py>,
+    v: Arr<'py>,
+    a: Arr<'py>,
+    fext: Option<Arr<'py>>,
+) -> PyResult<Bound<'py, PyAny>> {
     let m = &model.inner;
     let (qb, vb, ab) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("a", &a, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
@@ -253,9 +266,17 @@ pub fn crba<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Boun
 /// Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`.
 #[pyfunction]
 #[pyo3(signature = (model, q, v, tau, fext = None))]
-pub fn aba<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>, tau: Arr<'py>, fext: Option<Arr<'py>>) -> PyResult<Bound<'py, PyAny>> {
+pub fn aba<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: Arr<'py>,
+    v: Arr<'py>,
+    tau: Arr<'py>,
+    fext: Option<Arr<'py>>,
+) -> PyResult<Bound<'py, PyAny>> {
     let m = &model.inner;
-    let (qb, vb, tb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("tau", &tau, &[m.nv])?);
+    let (qb, vb, tb) =
+        (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("tau", &tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
     if let Some(f) = &fb {
@@ -276,12 +297,13 @@ pub fn prescribed_bodies(m: &Model, names: &[String]) -> PyResult<Vec<usize>> {
     names
         .iter()
         .map(|n| {
-            let i = m
-                .joint_names
-                .iter()
-                .position(|j| j == n)
-                .or_else(|| m.body_index(n))
-                .ok_or_else(|| input_err(format!("prescribed joint '{n}' is not a joint of model '{}' (joints: {})", m.name, m.joint_names.join(", "))))?;
+            let i = m.joint_names.iter().position(|j| j == n).or_else(|| m.body_index(n)).ok_or_else(|| {
+                input_err(format!(
+                    "prescribed joint '{n}' is not a joint of model '{}' (joints: {})",
+                    m.name,
+                    m.joint_names.join(", ")
+                ))
+            })?;
             if m.nvs[i] == 0 {
                 return Err(input_err(format!("joint '{}' is fixed: it has no motion to prescribe", m.joint_names[i])));
             }

@@ -33,7 +33,11 @@ impl Batch {
         };
         let width: usize = inner.iter().product();
         if let Some(k) = data.iter().position(|x| !x.is_finite()) {
-            let where_ = if stacked { format!("sample {}, entry {}", k / width.max(1), k % width.max(1)) } else { format!("entry {k}") };
+            let where_ = if stacked {
+                format!("sample {}, entry {}", k / width.max(1), k % width.max(1))
+            } else {
+                format!("entry {k}")
+            };
             return Err(input_err(format!("argument `{name}`: {where_} is {} (must be finite)", data[k])));
         }
         let rows = if stacked { shape[0] } else { 1 };
@@ -68,7 +72,13 @@ pub fn common_rows(batches: &[(&str, &Batch)]) -> PyResult<(usize, bool)> {
 }
 
 /// Build the output array: `inner` is the shape of one sample's result.
-pub fn output<'py>(py: Python<'py>, data: Vec<f64>, rows: usize, stacked: bool, inner: &[usize]) -> PyResult<Bound<'py, PyAny>> {
+pub fn output<'py>(
+    py: Python<'py>,
+    data: Vec<f64>,
+    rows: usize,
+    stacked: bool,
+    inner: &[usize],
+) -> PyResult<Bound<'py, PyAny>> {
     let mut shape = vec![];
     if stacked {
         shape.push(rows);

@@ -7,8 +7,18 @@ use pyo3::prelude::*;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 create_exception!(_core, ModelError, PyValueError, "A model file or model description is malformed or non-physical.");
-create_exception!(_core, InputError, PyValueError, "An argument has the wrong shape, non-finite entries or an invalid value.");
-create_exception!(_core, NumericalError, PyArithmeticError, "The numbers defeat the algorithm (singular matrix, diverging step...).");
+create_exception!(
+    _core,
+    InputError,
+    PyValueError,
+    "An argument has the wrong shape, non-finite entries or an invalid value."
+);
+create_exception!(
+    _core,
+    NumericalError,
+    PyArithmeticError,
+    "The numbers defeat the algorithm (singular matrix, diverging step...)."
+);
 
 pub fn to_py(e: FfError) -> PyErr {
     let msg = e.to_string();

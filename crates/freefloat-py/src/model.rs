@@ -32,7 +32,8 @@ impl PyModel {
 }
 
 fn base_type(base: &str) -> PyResult<JointType> {
-    JointType::base_from_name(base).ok_or_else(|| input_err(format!("base must be 'free', 'planar' or 'fixed', got '{base}'")))
+    JointType::base_from_name(base)
+        .ok_or_else(|| input_err(format!("base must be 'free', 'planar' or 'fixed', got '{base}'")))
 }
 
 #[pymethods]
@@ -136,7 +137,7 @@ impl PyModel {
     #[getter]
     fn joint_axes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let v: Vec<f64> = self.inner.axes.iter().flat_map(|a| a.iter().copied().collect::<Vec<_>>()).collect();
-        Ok(PyArray1::from_vec(py, v).reshape([self.inner.nbodies(), 3])?)
+        PyArray1::from_vec(py, v).reshape([self.inner.nbodies(), 3])
     }
     /// Rest placement of each joint frame in its parent body, as (nbodies, 4, 4) homogeneous matrices.
     #[getter]
@@ -158,7 +159,9 @@ impl PyModel {
     fn limits<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
         let l = &self.inner.limits;
-        let col = |f: &dyn Fn(&freefloat_core::model::JointLimits) -> Option<f64>| -> Vec<f64> { l.iter().map(|x| f(x).unwrap_or(f64::NAN)).collect() };
+        let col = |f: &dyn Fn(&freefloat_core::model::JointLimits) -> Option<f64>| -> Vec<f64> {
+            l.iter().map(|x| f(x).unwrap_or(f64::NAN)).collect()
+        };
         d.set_item("lower", PyArray1::from_vec(py, col(&|x| x.lower)))?;
         d.set_item("upper", PyArray1::from_vec(py, col(&|x| x.upper)))?;
         d.set_item("velocity", PyArray1::from_vec(py, col(&|x| x.velocity)))?;
@@ -177,7 +180,12 @@ impl PyModel {
             .iter()
             .map(|f| {
                 let t = f.placement.trans;
-                (f.name.clone(), self.inner.body_names[f.body].clone(), [t.x, t.y, t.z], quat_from_rot(&f.placement.rot))
+                (
+                    f.name.clone(),
+                    self.inner.body_names[f.body].clone(),
+                    [t.x, t.y, t.z],
+                    quat_from_rot(&f.placement.rot),
+                )
             })
             .collect()
     }
@@ -186,14 +194,18 @@ impl PyModel {
     /// about each body-frame origin, body axes.
     fn parameters<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let v: Vec<f64> = self.inner.parameters().iter().flatten().copied().collect();
-        Ok(PyArray1::from_vec(py, v).reshape([self.inner.nbodies(), 10])?)
+        PyArray1::from_vec(py, v).reshape([self.inner.nbodies(), 10])
     }
 
     /// A new Model with other standard parameters (nbodies, 10); checked for physical consistency.
     fn with_parameters(&self, params: PyReadonlyArray2<f64>) -> PyResult<PyModel> {
         let shape = params.shape();
         if shape != [self.inner.nbodies(), 10] {
-            return Err(input_err(format!("argument `P`: expected shape ({}, 10), got {:?}", self.inner.nbodies(), shape)));
+            return Err(input_err(format!(
+                "argument `P`: expected shape ({}, 10), got {:?}",
+                self.inner.nbodies(),
+                shape
+            )));
         }
         let flat: Vec<f64> = params.as_array().iter().copied().collect();
         guard(|| self.inner.with_parameters(&flat)).map(PyModel::wrap)

@@ -40,9 +40,8 @@ fn fill(obj: &Bound<'_, PyAny>, out: &mut [f64], what: &str) -> PyResult<()> {
 
 fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'static str) -> sim::TorqueFn<'py> {
     Box::new(move |t, q, v, out| {
-        let r = f
-            .call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, v)))
-            .and_then(|r| fill(&r, out, what));
+        let r =
+            f.call1((t, PyArray1::from_slice(py, q), PyArray1::from_slice(py, v))).and_then(|r| fill(&r, out, what));
         r.map_err(|e| stash_err(&stash, e, what))
     })
 }
@@ -94,28 +93,45 @@ pub fn simulate<'py>(
         None => TorqueSource::Zero,
         Some(t) if t.is_callable() => TorqueSource::Function(state_fn(py, t, stash.clone(), "the torque function")),
         Some(t) => {
-            let arr: PyReadonlyArrayDyn<f64> = py.import("numpy")?.call_method1("asarray", (t, "float64"))?.extract()?;
+            let arr: PyReadonlyArrayDyn<f64> =
+                py.import("numpy")?.call_method1("asarray", (t, "float64"))?.extract()?;
             let shape = arr.shape().to_vec();
             let rows = match shape.as_slice() {
                 [r, c] if *c == m.nv => *r,
                 [c] if *c == m.nv => 1,
-                _ => return Err(input_err(format!("argument `torques`: expected a callable or an array of shape (T, {}), got {:?}", m.nv, shape))),
+                _ => {
+                    return Err(input_err(format!(
+                        "argument `torques`: expected a callable or an array of shape (T, {}), got {:?}",
+                        m.nv, shape
+                    )))
+                }
             };
             let times: Vec<f64> = match &torque_times {
                 Some(tt) => tt.as_array().to_vec(),
                 None => (0..rows).map(|k| k as f64 * dt).collect(),
             };
             if times.len() != rows {
-                return Err(input_err(format!("argument `torque_times`: {} times for {rows} torque rows", times.len())));
+                return Err(input_err(format!(
+                    "argument `torque_times`: {} times for {rows} torque rows",
+                    times.len()
+                )));
             }
             guard(|| TorqueSource::table(times, arr.as_array().iter().copied().collect(), m.nv, hold))?
         }
     };
     let ctrl = match (controller, controller_period) {
         (None, _) => None,
-        (Some(c), Some(p)) if c.is_callable() => Some(Controller { period: p, f: state_fn(py, c, stash.clone(), "the controller") }),
-        (Some(_), None) => return Err(input_err("a controller needs `controller_period` (its sample time in seconds)")),
-        (Some(_), Some(_)) => return Err(input_err("argument `controller` must be callable as controller(t, q, v) -> generalized forces (nv,)")),
+        (Some(c), Some(p)) if c.is_callable() => {
+            Some(Controller { period: p, f: state_fn(py, c, stash.clone(), "the controller") })
+        }
+        (Some(_), None) => {
+            return Err(input_err("a controller needs `controller_period` (its sample time in seconds)"))
+        }
+        (Some(_), Some(_)) => {
+            return Err(input_err(
+                "argument `controller` must be callable as controller(t, q, v) -> generalized forces (nv,)",
+            ))
+        }
     };
     let presc = match (prescribed, prescription) {
         (None, None) => None,
@@ -126,7 +142,9 @@ pub fn simulate<'py>(
             let pf: sim::PrescriptionFn = Box::new(move |t, q, v, a| {
                 let r = f.call1((t,)).and_then(|r| {
                     let (rq, rv, ra): (Bound<PyAny>, Bound<PyAny>, Bound<PyAny>) = r.extract().map_err(|_| {
-                        input_err("prescription(t) must return a tuple (q, v, a) of full-length arrays (nq,), (nv,), (nv,)")
+                        input_err(
+                            "prescription(t) must return a tuple (q, v, a) of full-length arrays (nq,), (nv,), (nv,)",
+                        )
                     })?;
                     fill(&rq, q, "prescription q")?;
                     fill(&rv, v, "prescription v")?;
@@ -136,10 +154,17 @@ pub fn simulate<'py>(
             });
             Some(Prescription { bodies, f: pf })
         }
-        (Some(_), Some(_)) => return Err(input_err("argument `prescription` must be callable as prescription(t) -> (q, v, a)")),
-        _ => return Err(input_err("give both `prescribed` (joint names) and `prescription` (a function of t), or neither")),
+        (Some(_), Some(_)) => {
+            return Err(input_err("argument `prescription` must be callable as prescription(t) -> (q, v, a)"))
+        }
+        _ => {
+            return Err(input_err(
+                "give both `prescribed` (joint names) and `prescription` (a function of t), or neither",
+            ))
+        }
     };
-    let has_callbacks = matches!(torque_src, TorqueSource::Function(_)) || ctrl.is_some() || presc.is_some() || progress.is_some();
+    let has_callbacks =
+        matches!(torque_src, TorqueSource::Function(_)) || ctrl.is_some() || presc.is_some() || progress.is_some();
     let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc };
     let q0 = q0.as_array().to_vec();
     let v0 = v0.as_array().to_vec();
@@ -149,7 +174,7 @@ pub fn simulate<'py>(
         let mut prog = progress.map(|p| {
             move |frac: f64| -> bool {
                 match p.call1((frac,)) {
-                    Ok(r) => !r.is(&false.into_pyobject(py).unwrap().to_owned().into_any()),
+                    Ok(r) => !matches!(r.extract::<bool>(), Ok(false)), // only an explicit False aborts
                     Err(e) => {
                         stash_err(&st, e, "the progress callback");
                         false

@@ -31,7 +31,15 @@ pub fn frame_placement(d: &Data, body: usize, placement: &Se3) -> Se3 {
 
 /// Jacobian (6 × nv, into `out`) of the frame `placement` fixed on `body`: its twist is `out · v`.
 /// Runs forward kinematics.
-pub fn frame_jacobian(m: &Model, d: &mut Data, q: &[f64], body: usize, placement: &Se3, reference: Reference, out: &mut DMatrix<f64>) {
+pub fn frame_jacobian(
+    m: &Model,
+    d: &mut Data,
+    q: &[f64],
+    body: usize,
+    placement: &Se3,
+    reference: Reference,
+    out: &mut DMatrix<f64>,
+) {
     forward_kinematics(m, d, q);
     jacobian_from_data(m, d, body, placement, reference, out);
 }
@@ -97,8 +105,7 @@ pub fn generalized_jacobian(
         return Err(FfError::Numerical("the base block of the centroidal momentum matrix is singular".into()));
     };
     let jb = j.columns(0, nb);
-    let jg = jm - &jb * x;
-    let off = &jb * y;
+    let jg = jm - jb * x;
+    let off = jb * y;
     Ok((jg, [off[0], off[1], off[2], off[3], off[4], off[5]]))
 }
-

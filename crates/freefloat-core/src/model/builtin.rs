@@ -12,9 +12,11 @@ pub fn names() -> Vec<&'static str> {
 
 /// The YAML text of a built-in robot.
 pub fn source(name: &str) -> Result<&'static str> {
-    MODELS.iter().find(|(n, _)| *n == name).map(|(_, s)| *s).ok_or_else(|| {
-        FfError::arg("name", format!("no built-in model '{name}'; available: {}", names().join(", ")))
-    })
+    MODELS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| *s)
+        .ok_or_else(|| FfError::arg("name", format!("no built-in model '{name}'; available: {}", names().join(", "))))
 }
 
 pub fn load(name: &str) -> Result<Model> {

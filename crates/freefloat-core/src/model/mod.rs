@@ -141,7 +141,11 @@ impl ModelBuilder {
         if matches!(b.joint_type, JointType::Revolute | JointType::Prismatic) {
             let n = axis.norm();
             if !(n > 1e-12) || !n.is_finite() {
-                return Err(FfError::Model(format!("joint '{}': axis {:?} has zero length", b.joint_name, axis.as_slice())));
+                return Err(FfError::Model(format!(
+                    "joint '{}': axis {:?} has zero length",
+                    b.joint_name,
+                    axis.as_slice()
+                )));
             }
             axis /= n;
         }
@@ -264,7 +268,11 @@ impl Model {
         }
         Err(FfError::arg(
             "name",
-            format!("'{name}' is neither a body nor a frame of model '{}' (bodies: {})", self.name, self.body_names.join(", ")),
+            format!(
+                "'{name}' is neither a body nor a frame of model '{}' (bodies: {})",
+                self.name,
+                self.body_names.join(", ")
+            ),
         ))
     }
 

@@ -80,7 +80,11 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonph
         return Err(FfError::ModelFile {
             source_name: source_name.to_string(),
             line: None,
-            msg: format!("expected exactly one root link (a link that is no joint's child), found {}: {:?}", roots.len(), roots),
+            msg: format!(
+                "expected exactly one root link (a link that is no joint's child), found {}: {:?}",
+                roots.len(),
+                roots
+            ),
         });
     }
     let root = roots[0].clone();
@@ -127,14 +131,16 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonph
         return Err(FfError::ModelFile {
             source_name: source_name.to_string(),
             line: None,
-            msg: format!("{} link(s) are not connected to the root '{root}' (the joint graph has a cycle)", links.len() - visited),
+            msg: format!(
+                "{} link(s) are not connected to the root '{root}' (the joint graph has a cycle)",
+                links.len() - visited
+            ),
         });
     }
     b.build().map_err(|e| match e {
-        FfError::Inertia { ref body, .. } => err(
-            links[body].node,
-            format!("{e} (to load a file with such links anyway, pass allow_nonphysical=True)"),
-        ),
+        FfError::Inertia { ref body, .. } => {
+            err(links[body].node, format!("{e} (to load a file with such links anyway, pass allow_nonphysical=True)"))
+        }
         other => FfError::ModelFile { source_name: source_name.to_string(), line: None, msg: other.to_string() },
     })
 }
@@ -163,7 +169,9 @@ fn number<'a>(node: roxmltree::Node<'a, 'a>, name: &str) -> std::result::Result<
         None => Ok(None),
         Some(s) => match s.trim().parse::<f64>() {
             Ok(x) if x.is_finite() => Ok(Some(x)),
-            _ => Err((node, format!("attribute {name}=\"{s}\" of <{}> is not a finite number", node.tag_name().name()))),
+            _ => {
+                Err((node, format!("attribute {name}=\"{s}\" of <{}> is not a finite number", node.tag_name().name())))
+            }
         },
     }
 }
@@ -201,7 +209,10 @@ fn parse_joint<'a>(node: roxmltree::Node<'a, 'a>) -> std::result::Result<JointIn
         "prismatic" => JointType::Prismatic,
         "fixed" => JointType::Fixed,
         "floating" | "planar" => {
-            return Err((node, format!("joint '{name}': type '{t}' is only supported for the base (choose it with base=...)")))
+            return Err((
+                node,
+                format!("joint '{name}': type '{t}' is only supported for the base (choose it with base=...)"),
+            ))
         }
         other => return Err((node, format!("joint '{name}': unknown joint type '{other}'"))),
     };
@@ -302,7 +313,12 @@ pub fn to_urdf_string(m: &Model) -> Result<String> {
     for f in &m.frames {
         let _ = writeln!(s, "  <link name=\"{}\"/>", xml_escape(&f.name));
         let _ = writeln!(s, "  <joint name=\"{}_fixed\" type=\"fixed\">", xml_escape(&f.name));
-        let _ = writeln!(s, "    <parent link=\"{}\"/>\n    <child link=\"{}\"/>", xml_escape(&m.body_names[f.body]), xml_escape(&f.name));
+        let _ = writeln!(
+            s,
+            "    <parent link=\"{}\"/>\n    <child link=\"{}\"/>",
+            xml_escape(&m.body_names[f.body]),
+            xml_escape(&f.name)
+        );
         let _ = writeln!(
             s,
             "    <origin xyz=\"{}\" rpy=\"{}\"/>\n  </joint>",

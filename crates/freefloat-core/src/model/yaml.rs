@@ -140,7 +140,8 @@ impl Loader<'_> {
     fn err_at(&self, key: &str, msg: String) -> FfError {
         let line = self.text.lines().position(|l| {
             let t = l.trim_start().trim_start_matches("- ").trim_start_matches('{');
-            t.starts_with("name:") && t["name:".len()..].trim().trim_matches(|c| c == '"' || c == '\'' || c == ',').starts_with(key)
+            t.starts_with("name:")
+                && t["name:".len()..].trim().trim_matches(|c| c == '"' || c == '\'' || c == ',').starts_with(key)
         });
         FfError::ModelFile { source_name: self.source_name.to_string(), line: line.map(|l| l + 1), msg }
     }
@@ -209,7 +210,10 @@ impl Loader<'_> {
                     if (V3::from(a).normalize() - V3::z()).norm() > 1e-12 {
                         return Err(self.err_at(
                             &body.name,
-                            format!("body '{}': with mdh the joint axis is z; remove `axis` or set it to [0, 0, 1]", body.name),
+                            format!(
+                                "body '{}': with mdh the joint axis is z; remove `axis` or set it to [0, 0, 1]",
+                                body.name
+                            ),
                         ));
                     }
                 }
@@ -225,7 +229,9 @@ impl Loader<'_> {
             };
             if let (Some(lo), Some(hi)) = (limits.lower, limits.upper) {
                 if lo > hi {
-                    return Err(self.err_at(&body.name, format!("body '{}': joint lower limit {lo} > upper {hi}", body.name)));
+                    return Err(
+                        self.err_at(&body.name, format!("body '{}': joint lower limit {lo} > upper {hi}", body.name))
+                    );
                 }
             }
             let spec_b = BodySpec {
@@ -267,7 +273,10 @@ impl Loader<'_> {
                 return Err(bad("give either `params` or mass/com/inertia, not both"));
             }
             if p.len() != 10 {
-                return Err(bad(&format!("params needs 10 numbers [m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], got {}", p.len())));
+                return Err(bad(&format!(
+                    "params needs 10 numbers [m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], got {}",
+                    p.len()
+                )));
             }
             return Ok(Inertia::from_params(p));
         }

@@ -18,17 +18,27 @@ pub type TorqueFn<'a> = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) -> Result
 pub enum TorqueSource<'a> {
     Zero,
     /// `values` is T × nv, row-major, sampled at increasing `times`.
-    Table { times: Vec<f64>, values: Vec<f64>, hold: Hold },
+    Table {
+        times: Vec<f64>,
+        values: Vec<f64>,
+        hold: Hold,
+    },
     Function(TorqueFn<'a>),
 }
 
 impl TorqueSource<'_> {
     pub fn table(times: Vec<f64>, values: Vec<f64>, nv: usize, hold: Hold) -> Result<Self> {
         if times.is_empty() || values.len() != times.len() * nv {
-            return Err(FfError::arg("torques", format!("expected a ({}, {nv}) table, got {} values", times.len(), values.len())));
+            return Err(FfError::arg(
+                "torques",
+                format!("expected a ({}, {nv}) table, got {} values", times.len(), values.len()),
+            ));
         }
         if let Some(k) = times.windows(2).position(|w| !(w[1] > w[0])) {
-            return Err(FfError::arg("torque_times", format!("times must increase strictly; row {} is not after row {k}", k + 1)));
+            return Err(FfError::arg(
+                "torque_times",
+                format!("times must increase strictly; row {} is not after row {k}", k + 1),
+            ));
         }
         if let Some(k) = values.iter().chain(&times).position(|x| !x.is_finite()) {
             return Err(FfError::arg("torques", format!("entry {k} is not finite")));
@@ -42,7 +52,9 @@ impl TorqueSource<'_> {
             TorqueSource::Function(f) => {
                 f(t, q, v, out)?;
                 if let Some(k) = out.iter().position(|x| !x.is_finite()) {
-                    return Err(FfError::Numerical(format!("torque function returned a non-finite value at entry {k}, t = {t}")));
+                    return Err(FfError::Numerical(format!(
+                        "torque function returned a non-finite value at entry {k}, t = {t}"
+                    )));
                 }
             }
             TorqueSource::Table { times, values, hold } => {

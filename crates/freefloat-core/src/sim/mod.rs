@@ -130,7 +130,8 @@ impl<'m, 'i> Stepper<'m, 'i> {
         for (x, h) in self.tau.iter_mut().zip(&self.held) {
             *x += h;
         }
-        let presc = self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
+        let presc =
+            self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
         hybrid_aba(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?;
         if let Some(k) = self.d.ddq.iter().position(|x| !x.is_finite()) {
             return Err(FfError::Numerical(format!("acceleration {k} became non-finite at t = {t}")));
@@ -147,7 +148,18 @@ impl<'m, 'i> Stepper<'m, 'i> {
     /// One Runge-Kutta step from (t, q0, v0, w0). Stage 0 must already hold f(y0) (see `eval`).
     /// Writes the new state into q1, v1 and returns (w1, error norm or 0).
     #[allow(clippy::too_many_arguments)]
-    fn step(&mut self, tab: &Tableau, t: f64, h: f64, q0: &[f64], v0: &[f64], w0: f64, q1: &mut [f64], v1: &mut [f64], tol: Option<(f64, f64)>) -> Result<(f64, f64)> {
+    fn step(
+        &mut self,
+        tab: &Tableau,
+        t: f64,
+        h: f64,
+        q0: &[f64],
+        v0: &[f64],
+        w0: f64,
+        q1: &mut [f64],
+        v1: &mut [f64],
+        tol: Option<(f64, f64)>,
+    ) -> Result<(f64, f64)> {
         let m = self.m;
         let nv = m.nv;
         for s in 1..tab.stages() {
@@ -209,7 +221,14 @@ impl<'m, 'i> Stepper<'m, 'i> {
 }
 
 /// Simulate from (q0, v0) over [0, t_final].
-pub fn simulate(m: &Model, q0: &[f64], v0: &[f64], opts: &SimOptions, inputs: Inputs, mut progress: Option<Progress>) -> Result<Trajectory> {
+pub fn simulate(
+    m: &Model,
+    q0: &[f64],
+    v0: &[f64],
+    opts: &SimOptions,
+    inputs: Inputs,
+    mut progress: Option<Progress>,
+) -> Result<Trajectory> {
     let mut qbuf = Vec::new();
     let q0 = m.checked_q(q0, &mut qbuf)?.to_vec();
     check_vec("v0", v0, m.nv)?;
@@ -277,7 +296,7 @@ pub fn simulate(m: &Model, q0: &[f64], v0: &[f64], opts: &SimOptions, inputs: In
         st.eval(t, 0)?;
         // Record the state together with the accelerations and forces evaluated at it.
         let record = match opts.method {
-            Method::Rk4 => steps % opts.record_every == 0 || steps == n_rk4,
+            Method::Rk4 => steps.is_multiple_of(opts.record_every) || steps == n_rk4,
             Method::Rk45 { .. } => (t - next_out).abs() <= eps_t,
         };
         if record {
@@ -324,7 +343,9 @@ pub fn simulate(m: &Model, q0: &[f64], v0: &[f64], opts: &SimOptions, inputs: In
                     rejected += 1;
                     h = hh * factor;
                     if h < 1e-14 * opts.t_final.max(1.0) {
-                        return Err(FfError::Numerical(format!("step size underflow at t = {t}: the tolerances cannot be met")));
+                        return Err(FfError::Numerical(format!(
+                            "step size underflow at t = {t}: the tolerances cannot be met"
+                        )));
                     }
                     // Stage 0 still holds f(y0): redo from the same state.
                 }
@@ -334,7 +355,7 @@ pub fn simulate(m: &Model, q0: &[f64], v0: &[f64], opts: &SimOptions, inputs: In
         std::mem::swap(&mut v, &mut v1);
         st.impose(t, &mut q, &mut v)?;
         if let Some(p) = progress.as_mut() {
-            if steps % 256 == 0 && !p(t / opts.t_final) {
+            if steps.is_multiple_of(256) && !p(t / opts.t_final) {
                 return Err(FfError::Numerical(format!("simulation aborted at t = {t}")));
             }
         }

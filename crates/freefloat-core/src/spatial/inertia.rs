@@ -57,10 +57,7 @@ impl Inertia {
     /// Spatial momentum (about the body origin, body axes) of a body moving with twist `v`.
     #[inline]
     pub fn mul_motion(&self, v: &Motion) -> Force {
-        Force {
-            lin: v.lin * self.mass - self.h.cross(&v.ang),
-            ang: self.i_o * v.ang + self.h.cross(&v.lin),
-        }
+        Force { lin: v.lin * self.mass - self.h.cross(&v.ang), ang: self.i_o * v.ang + self.h.cross(&v.lin) }
     }
 
     /// 6×6 matrix form, mapping `[v; w]` to `[f; n]`.
