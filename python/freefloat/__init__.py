@@ -12,6 +12,8 @@ from . import models
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
+    body_accelerations,
+    body_velocities,
     center_of_mass,
     centroidal_momentum_matrix,
     crba,
@@ -32,7 +34,7 @@ __version__ = "0.1.0"
 __all__ = [
     "Model", "Trajectory", "models", "simulate",
     "aba", "rnea", "crba", "hybrid_dynamics",
-    "forward_kinematics", "frame_placement", "frame_jacobian", "generalized_jacobian",
+    "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
     "ModelError", "InputError", "NumericalError",
 ]

@@ -30,6 +30,19 @@ def frame_placement(model: Model, q, name: str) -> np.ndarray:
     return _core.frame_placement(_m(model), as_f64(q, "q"), name)
 
 
+def body_velocities(model: Model, q, v) -> np.ndarray:
+    """(nbodies, 6): twist [linear; angular] of every body, in its own body frame."""
+    return _core.body_velocities(_m(model), as_f64(q, "q"), as_f64(v, "v"))
+
+
+def body_accelerations(model: Model, q, v, a, classical: bool = False) -> np.ndarray:
+    """(nbodies, 6): acceleration of every body in its own frame, gravity not included.
+
+    Spatial (default): time derivative of the body-frame twist components (Pinocchio LOCAL).
+    classical=True: acceleration of the body origin, a_lin + ω × v_lin, and the angular acceleration."""
+    return _core.body_accelerations(_m(model), as_f64(q, "q"), as_f64(v, "v"), as_f64(a, "a"), bool(classical))
+
+
 def center_of_mass(model: Model, q) -> np.ndarray:
     """(3,): centre of mass of the whole system, inertial frame."""
     return _core.center_of_mass(_m(model), as_f64(q, "q"))

@@ -129,6 +129,53 @@ pub fn kinetic_energy<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr
     output(py, out, rows, st, &[])
 }
 
+/// Body twists (nbodies, 6) [linear; angular], each in its own body frame (Pinocchio LOCAL).
+#[pyfunction]
+pub fn body_velocities<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (qb, vb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?);
+    let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
+    let nb = m.nbodies();
+    let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        kin::forward_velocities(m, d, q, vb.row(k));
+        for i in 0..nb {
+            d.v[i].write(&mut o[6 * i..6 * i + 6]);
+        }
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[nb, 6])
+}
+
+/// Body accelerations (nbodies, 6) in body frames: spatial (d/dt of the body-frame twist
+/// components, Pinocchio LOCAL) or, with `classical`, the acceleration of each body origin.
+/// Gravity is not included.
+#[pyfunction]
+#[pyo3(signature = (model, q, v, a, classical = false))]
+pub fn body_accelerations<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    q: Arr<'py>,
+    v: Arr<'py>,
+    a: Arr<'py>,
+    classical: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    let m = &model.inner;
+    let (qb, vb, ab) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("a", &a, &[m.nv])?);
+    let (rows, st) = common_rows(&[("q", &qb), ("v", &vb), ("a", &ab)])?;
+    let nb = m.nbodies();
+    let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        kin::forward_accelerations(m, d, q, vb.row(k), ab.row(k));
+        for i in 0..nb {
+            let acc = if classical { kin::classical_acceleration(&d.a[i], &d.v[i]) } else { d.a[i] };
+            acc.write(&mut o[6 * i..6 * i + 6]);
+        }
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[nb, 6])
+}
+
 /// Centroidal momentum matrix about the inertial origin (6, nv): momentum == A @ v.
 #[pyfunction]
 pub fn centroidal_momentum_matrix<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -19,6 +19,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(algorithms::forward_kinematics, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::frame_placement, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::center_of_mass, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::body_velocities, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::body_accelerations, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::momentum, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::kinetic_energy, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::centroidal_momentum_matrix, m)?)?;

@@ -41,3 +41,26 @@ pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
         };
     }
 }
+
+/// Placements, body twists and body spatial accelerations (body frame; gravity NOT included, unlike
+/// the accelerations RNEA uses internally). The classical acceleration of a body origin in body
+/// axes is given by `classical_acceleration`.
+pub fn forward_accelerations(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64]) {
+    forward_kinematics(m, d, q);
+    for i in 0..m.nbodies() {
+        let vj = joint_velocity(m, i, v);
+        let aj = joint_velocity(m, i, a);
+        let (vp, ap) = match m.parents[i] {
+            Some(p) => (d.li_mi[i].inv_act_motion(&d.v[p]), d.li_mi[i].inv_act_motion(&d.a[p])),
+            None => (Motion::ZERO, Motion::ZERO),
+        };
+        d.v[i] = vp + vj;
+        d.a[i] = ap + aj + d.v[i].cross_motion(&vj);
+    }
+}
+
+/// Classical acceleration of a frame origin from its spatial acceleration and twist (same axes):
+/// `a_lin + ω × v_lin`.
+pub fn classical_acceleration(a: &Motion, v: &Motion) -> Motion {
+    Motion::new(a.lin + v.ang.cross(&v.lin), a.ang)
+}
