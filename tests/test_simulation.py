@@ -44,6 +44,9 @@ def test_internal_torques_conserve_momentum_and_energy(robot):
         return out
 
     tr = ff.simulate(m, q, v, 5.0, 1e-3, torques=torques, record_every=50)
+    # The recorded momentum and energy (by-products of the dynamics) equal the kinematic functions'.
+    np.testing.assert_allclose(tr.momentum, ff.momentum(m, tr.q, tr.v), rtol=1e-13, atol=1e-12)
+    np.testing.assert_allclose(tr.kinetic_energy, ff.kinetic_energy(m, tr.q, tr.v), rtol=1e-13)
     d = tr.momentum_drift()
     assert d["linear_rel"] < 1e-10 and d["angular_rel"] < 1e-10, d
     assert tr.energy_balance()["rel"] < 1e-9

@@ -28,13 +28,17 @@ pub struct Data {
     pub of: Vec<Force>,
     /// Motion subspace of each joint in inertial coordinates (nv columns used).
     pub os: Vec<M6>,
+    /// By-products of ABA's first pass: total momentum (about the inertial origin, inertial frame)
+    /// and kinetic energy at the state it was called with.
+    pub aba_momentum: Force,
+    pub aba_kinetic_energy: f64,
     /// `U = I^A S`, one 6×nv block per joint (unused columns zero).
     pub u: Vec<M6>,
-    /// `D⁻¹ = (Sᵀ U)⁻¹`, top-left nv×nv block.
+    /// `D⁻¹ = (Sᵀ U)⁻¹`, top-left nv×nv block (for a multi-DoF root: D itself, solved in place).
     pub dinv: Vec<M6>,
     /// `u = τ - Sᵀ p^A`, first nv entries.
     pub uu: Vec<[f64; 6]>,
-    /// Composite rigid-body inertias (CRBA, centroidal momentum matrix).
+    /// Composite rigid-body inertias of subtrees, inertial frame (CRBA, centroidal momentum matrix).
     pub ic: Vec<Inertia>,
     /// Joint accelerations (ABA output).
     pub ddq: Vec<f64>,
@@ -64,6 +68,8 @@ impl Data {
             oc: vec![Motion::ZERO; n],
             of: vec![Force::ZERO; n],
             os: vec![M6::zeros(); n],
+            aba_momentum: Force::ZERO,
+            aba_kinetic_energy: 0.0,
             u: vec![M6::zeros(); n],
             dinv: vec![M6::zeros(); n],
             uu: vec![[0.0; 6]; n],

@@ -1,17 +1,17 @@
 //! The engine's algorithms as Python functions. Each accepts one sample or a leading time axis and
 //! loops over samples in Rust with the GIL released.
 
-use crate::batch::{common_rows, output, Batch};
+use crate::batch::{common_rows, model_arg, output, Batch};
 use crate::errors::{guard, input_err};
 use crate::model::PyModel;
 use freefloat_core::dynamics::{self, Prescribed};
 use freefloat_core::kinematics::{self as kin, Reference};
 use freefloat_core::spatial::quat_from_rot;
 use freefloat_core::{Data, FfError, Model};
-use numpy::PyReadonlyArrayDyn;
 use pyo3::prelude::*;
 
-type Arr<'py> = PyReadonlyArrayDyn<'py, f64>;
+/// An argument that is read as an array of float64 (anything numpy can convert).
+type Arr<'a, 'py> = &'a Bound<'py, PyAny>;
 
 fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
     if !stacked {
@@ -24,12 +24,14 @@ fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
     }
 }
 
-/// Evaluate `f` on every sample, each writing `width` numbers, with the GIL released.
+/// Evaluate `f` on every sample, each writing `width` numbers. Stacked inputs run with the GIL
+/// released; a single sample does not, since releasing and retaking it costs more than most
+/// single evaluations.
 fn run_rows<F>(py: Python<'_>, model: &PyModel, rows: usize, stacked: bool, width: usize, f: F) -> PyResult<Vec<f64>>
 where
     F: Fn(&Model, &mut Data, usize, &mut [f64], &mut Vec<f64>) -> Result<(), FfError> + Send + Sync,
 {
-    py.detach(|| {
+    let work = || {
         model.with_data(|m, d| {
             guard(|| {
                 let mut out = vec![0.0; rows * width];
@@ -40,11 +42,16 @@ where
                 Ok(out)
             })
         })
-    })
+    };
+    if stacked {
+        py.detach(work)
+    } else {
+        work()
+    }
 }
 
 fn fext_batch(m: &Model, fext: Option<Arr>) -> PyResult<Option<Batch>> {
-    fext.map(|f| Batch::new("fext", &f, &[m.nbodies(), 6])).transpose()
+    fext.map(|f| Batch::new("fext", f, &[m.nbodies(), 6])).transpose()
 }
 
 fn name_to_frame(m: &Model, name: &str) -> PyResult<(usize, freefloat_core::spatial::Se3)> {
@@ -53,9 +60,15 @@ fn name_to_frame(m: &Model, name: &str) -> PyResult<(usize, freefloat_core::spat
 
 /// Placement of every body in the inertial frame: (nbodies, 7) = position, quaternion x y z w.
 #[pyfunction]
-pub fn forward_kinematics<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn forward_kinematics<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nb = m.nbodies();
     let out = run_rows(py, model, rows, st, nb * 7, |m, d, k, o, buf| {
@@ -73,10 +86,17 @@ pub fn forward_kinematics<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) ->
 
 /// Placement of a body or frame in the inertial frame: (7,) = position, quaternion x y z w.
 #[pyfunction]
-pub fn frame_placement<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, name: &str) -> PyResult<Bound<'py, PyAny>> {
+pub fn frame_placement<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    name: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
     let (body, pl) = name_to_frame(m, name)?;
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let out = run_rows(py, model, rows, st, 7, |m, d, k, o, buf| {
         let q = m.checked_q(qb.row(k), buf)?;
@@ -90,9 +110,11 @@ pub fn frame_placement<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, name:
 }
 
 #[pyfunction]
-pub fn center_of_mass<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn center_of_mass<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, q: Arr<'_, 'py>) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let out = run_rows(py, model, rows, st, 3, |m, d, k, o, buf| {
         let q = m.checked_q(qb.row(k), buf)?;
@@ -104,9 +126,16 @@ pub fn center_of_mass<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyR
 
 /// Total momentum [linear; angular about the inertial origin], inertial frame.
 #[pyfunction]
-pub fn momentum<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn momentum<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?);
+    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
     let out = run_rows(py, model, rows, st, 6, |m, d, k, o, buf| {
         let q = m.checked_q(qb.row(k), buf)?;
@@ -117,9 +146,16 @@ pub fn momentum<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>)
 }
 
 #[pyfunction]
-pub fn kinetic_energy<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn kinetic_energy<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?);
+    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
     let out = run_rows(py, model, rows, st, 1, |m, d, k, o, buf| {
         let q = m.checked_q(qb.row(k), buf)?;
@@ -131,9 +167,16 @@ pub fn kinetic_energy<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr
 
 /// Body twists (nbodies, 6) [linear; angular], each in its own body frame (Pinocchio LOCAL).
 #[pyfunction]
-pub fn body_velocities<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn body_velocities<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?);
+    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
     let nb = m.nbodies();
     let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o, buf| {
@@ -154,14 +197,16 @@ pub fn body_velocities<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>, v: Ar
 #[pyo3(signature = (model, q, v, a, classical = false))]
 pub fn body_accelerations<'py>(
     py: Python<'py>,
-    model: &PyModel,
-    q: Arr<'py>,
-    v: Arr<'py>,
-    a: Arr<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    a: Arr<'_, 'py>,
     classical: bool,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, ab) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("a", &a, &[m.nv])?);
+    let (qb, vb, ab) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("a", a, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb), ("a", &ab)])?;
     let nb = m.nbodies();
     let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o, buf| {
@@ -178,9 +223,15 @@ pub fn body_accelerations<'py>(
 
 /// Centroidal momentum matrix about the inertial origin (6, nv): momentum == A @ v.
 #[pyfunction]
-pub fn centroidal_momentum_matrix<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn centroidal_momentum_matrix<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nv = m.nv;
     let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o, buf| {
@@ -206,15 +257,17 @@ fn write_rowmajor(a: &nalgebra::DMatrix<f64>, o: &mut [f64]) {
 #[pyo3(signature = (model, q, name, reference = "local"))]
 pub fn frame_jacobian<'py>(
     py: Python<'py>,
-    model: &PyModel,
-    q: Arr<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
     name: &str,
     reference: &str,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
     let (body, pl) = name_to_frame(m, name)?;
     let rf = guard(|| Reference::from_name(reference))?;
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nv = m.nv;
     let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o, buf| {
@@ -234,12 +287,14 @@ pub fn frame_jacobian<'py>(
 #[pyo3(signature = (model, q, name, reference = "world", h0 = None))]
 pub fn generalized_jacobian<'py>(
     py: Python<'py>,
-    model: &PyModel,
-    q: Arr<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
     name: &str,
     reference: &str,
     h0: Option<[f64; 6]>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
     let (body, pl) = name_to_frame(m, name)?;
     let rf = guard(|| Reference::from_name(reference))?;
@@ -247,7 +302,7 @@ pub fn generalized_jacobian<'py>(
     if h0.iter().any(|x| !x.is_finite()) {
         return Err(input_err("argument `h0`: must be finite"));
     }
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nm = m.nv - m.nvs[0];
     let out = run_rows(py, model, rows, st, 6 * nm + 6, |m, d, k, o, buf| {
@@ -271,14 +326,16 @@ pub fn generalized_jacobian<'py>(
 #[pyo3(signature = (model, q, v, a, fext = None))]
 pub fn rnea<'py>(
     py: Python<'py>,
-    model: &PyModel,
-    q: Arr<'py>,
-    v: Arr<'py>,
-    a: Arr<'py>,
-    fext: Option<Arr<'py>>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    a: Arr<'_, 'py>,
+    fext: Option<Arr<'_, 'py>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, ab) = (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("a", &a, &[m.nv])?);
+    let (qb, vb, ab) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("a", a, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("a", &ab)];
     if let Some(f) = &fb {
@@ -296,9 +353,11 @@ pub fn rnea<'py>(
 
 /// Joint-space inertia matrix (nv, nv), full symmetric.
 #[pyfunction]
-pub fn crba<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Bound<'py, PyAny>> {
+pub fn crba<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, q: Arr<'_, 'py>) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", &q, &[m.nq])?;
+    let qb = Batch::new("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nv = m.nv;
     let out = run_rows(py, model, rows, st, nv * nv, |m, d, k, o, buf| {
@@ -315,15 +374,16 @@ pub fn crba<'py>(py: Python<'py>, model: &PyModel, q: Arr<'py>) -> PyResult<Boun
 #[pyo3(signature = (model, q, v, tau, fext = None))]
 pub fn aba<'py>(
     py: Python<'py>,
-    model: &PyModel,
-    q: Arr<'py>,
-    v: Arr<'py>,
-    tau: Arr<'py>,
-    fext: Option<Arr<'py>>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    tau: Arr<'_, 'py>,
+    fext: Option<Arr<'_, 'py>>,
 ) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, tb) =
-        (Batch::new("q", &q, &[m.nq])?, Batch::new("v", &v, &[m.nv])?, Batch::new("tau", &tau, &[m.nv])?);
+    let (qb, vb, tb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("tau", tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
     if let Some(f) = &fb {
@@ -367,14 +427,16 @@ pub fn prescribed_bodies(m: &Model, names: &[String]) -> PyResult<Vec<usize>> {
 #[allow(clippy::too_many_arguments)]
 pub fn hybrid_dynamics<'py>(
     py: Python<'py>,
-    model: &PyModel,
-    q: Arr<'py>,
-    v: Arr<'py>,
-    tau: Arr<'py>,
-    ddq: Arr<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    tau: Arr<'_, 'py>,
+    ddq: Arr<'_, 'py>,
     prescribed: Vec<String>,
-    fext: Option<Arr<'py>>,
+    fext: Option<Arr<'_, 'py>>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
     let m = &model.inner;
     let bodies = prescribed_bodies(m, &prescribed)?;
     let mut mask = vec![false; m.nbodies()];
@@ -382,10 +444,10 @@ pub fn hybrid_dynamics<'py>(
         mask[b] = true;
     }
     let (qb, vb, tb, ab) = (
-        Batch::new("q", &q, &[m.nq])?,
-        Batch::new("v", &v, &[m.nv])?,
-        Batch::new("tau", &tau, &[m.nv])?,
-        Batch::new("ddq", &ddq, &[m.nv])?,
+        Batch::new("q", q, &[m.nq])?,
+        Batch::new("v", v, &[m.nv])?,
+        Batch::new("tau", tau, &[m.nv])?,
+        Batch::new("ddq", ddq, &[m.nv])?,
     );
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb), ("ddq", &ab)];

@@ -1,8 +1,37 @@
 //! Stacked (time-series) arguments: every function takes one sample or a leading time axis.
 
 use crate::errors::input_err;
-use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use crate::model::PyModel;
+use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
+
+/// A `freefloat.Model` (the Python facade, which holds the engine model in `_core`) or the engine
+/// model itself.
+pub fn model_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyModel>> {
+    if let Ok(m) = obj.downcast::<PyModel>() {
+        return Ok(m.clone());
+    }
+    obj.getattr("_core").ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(|| {
+        PyTypeError::new_err(format!(
+            "expected a freefloat.Model, got {}",
+            obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+        ))
+    })
+}
+
+/// Any array-like as a float64 numpy array (no copy when it already is one), naming the argument
+/// when it cannot be read as numbers.
+pub fn array_arg<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    if let Ok(a) = obj.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+        return Ok(a);
+    }
+    let np = obj.py().import("numpy")?;
+    let converted = np
+        .call_method1("ascontiguousarray", (obj, "float64"))
+        .map_err(|e| input_err(format!("argument `{name}`: cannot be read as an array of numbers ({e})")))?;
+    converted.extract().map_err(|e| input_err(format!("argument `{name}`: {e}")))
+}
 
 /// A validated, contiguous copy of an argument with `rows` samples of `width` numbers each.
 pub struct Batch {
@@ -14,7 +43,8 @@ pub struct Batch {
 
 impl Batch {
     /// `inner` is the shape of one sample, e.g. [nq] or [nbodies, 6].
-    pub fn new(name: &str, a: &PyReadonlyArrayDyn<f64>, inner: &[usize]) -> PyResult<Batch> {
+    pub fn new(name: &str, obj: &Bound<'_, PyAny>, inner: &[usize]) -> PyResult<Batch> {
+        let a = array_arg(obj, name)?;
         let shape = a.shape().to_vec();
         let expect = || {
             let s: Vec<String> = inner.iter().map(|x| x.to_string()).collect();
@@ -87,6 +117,9 @@ pub fn output<'py>(
     if shape.is_empty() {
         return Ok(data[0].into_pyobject(py)?.into_any());
     }
-    let arr: Bound<'py, PyArrayDyn<f64>> = PyArray1::from_vec(py, data).reshape(shape)?;
+    // Build the array with its final shape directly (a reshape would be a second numpy call).
+    let arr = numpy::ndarray::ArrayD::from_shape_vec(shape, data)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("internal shape error: {e}")))?;
+    let arr: Bound<'py, PyArrayDyn<f64>> = arr.into_pyarray(py);
     Ok(arr.into_any())
 }

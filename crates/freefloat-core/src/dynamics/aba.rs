@@ -41,6 +41,8 @@ pub fn hybrid_aba(
     forward_kinematics(m, d, q);
 
     // Pass 1: subspaces, twists, velocity-product accelerations and bias forces, inertial frame.
+    // Each body's momentum oIᵢ vᵢ is formed here anyway, so the totals come for free.
+    let (mut h_total, mut ke) = (Force::ZERO, 0.0);
     for i in 0..n {
         let omi = d.o_mi[i];
         let k = m.nvs[i];
@@ -60,12 +62,17 @@ pub fn hybrid_aba(
         d.oc[i] = vi.cross_motion(&vj);
         let oi = m.inertias[i].transformed(&omi);
         d.ia[i] = oi.to_matrix();
-        let mut f = vi.cross_force(&oi.mul_motion(&vi));
+        let hi = oi.mul_motion(&vi);
+        h_total += hi;
+        ke += 0.5 * vi.dot(&hi);
+        let mut f = vi.cross_force(&hi);
         if let Some(fe) = fext {
             f -= omi.act_force(&Force::from_slice(&fe[6 * i..6 * i + 6]));
         }
         d.of[i] = f;
     }
+    d.aba_momentum = h_total;
+    d.aba_kinetic_energy = ke;
 
     // Pass 2: articulated inertias and bias forces, leaves to root.
     for i in (0..n).rev() {
@@ -74,11 +81,13 @@ pub fn hybrid_aba(
         let parent = m.parents[i];
         if k > 0 && !is_presc(i) {
             let s = &d.os[i];
-            let ia = d.ia[i];
             let pa6 = d.of[i].to_v6();
             if k == 1 {
-                // Single-DoF joint: rank-one update.
+                // Single-DoF joint: rank-one update, fused into the parent's accumulation
+                // (I^a = I^A − u uᵀ/d and I^a c = I^A c − u (u·c)/d, with no 6×6 temporaries).
                 let s0 = s.column(0).into_owned();
+                let (lo, hi) = d.ia.split_at_mut(i);
+                let ia = &hi[0];
                 let u = ia * s0;
                 let dd = s0.dot(&u);
                 if !(dd > 0.0) || !dd.is_finite() {
@@ -89,49 +98,60 @@ pub fn hybrid_aba(
                 d.dinv[i][(0, 0)] = 1.0 / dd;
                 d.uu[i][0] = uu;
                 if let Some(p) = parent {
-                    let ia_a = ia - u * (u.transpose() / dd);
-                    let pa = pa6 + ia_a * d.oc[i].to_v6() + u * (uu / dd);
-                    d.ia[p] += ia_a;
+                    let oc = d.oc[i].to_v6();
+                    let pa = pa6 + ia * oc + u * ((uu - u.dot(&oc)) / dd);
+                    let iap = &mut lo[p];
+                    *iap += ia;
+                    iap.ger(-1.0 / dd, &u, &u, 1.0);
                     d.of[p] += Force::from_v6(&pa);
                 }
                 continue;
             }
-            let mut u = M6::zeros();
-            for c in 0..k {
-                u.set_column(c, &(ia * s.column(c)));
+            // Multi-DoF joint (k = 3: spherical or planar; k = 6: free), with fixed-size products.
+            let ia = d.ia[i];
+            if k == 6 {
+                let u = ia * s;
+                let dm = s.transpose() * u;
+                let uu = V6::from_column_slice(&tau[iv..iv + 6]) - s.transpose() * pa6;
+                d.u[i] = u;
+                d.uu[i].copy_from_slice(uu.as_slice());
+                let Some(p) = parent else {
+                    // The root needs no reduction: keep D itself and solve with it in pass 3, which
+                    // is cheaper than forming D⁻¹.
+                    d.dinv[i] = dm;
+                    continue;
+                };
+                let dinv = small_spd_inverse(&dm, 6).ok_or_else(|| singular(m, i))?;
+                let ud = u * dinv;
+                let ia_a = ia - ud * u.transpose();
+                let pa = pa6 + ia_a * d.oc[i].to_v6() + ud * uu;
+                d.dinv[i] = dinv;
+                d.ia[p] += ia_a;
+                d.of[p] += Force::from_v6(&pa);
+                continue;
             }
-            let mut dm = M6::zeros();
-            for r in 0..k {
-                for c in 0..k {
-                    dm[(r, c)] = s.column(r).dot(&u.column(c));
-                }
-            }
-            let dinv = small_spd_inverse(&dm, k).ok_or_else(|| singular(m, i))?;
-            let mut uu = [0.0; 6];
-            for c in 0..k {
-                uu[c] = tau[iv + c] - s.column(c).dot(&pa6);
-            }
-            d.u[i] = u;
-            d.dinv[i] = dinv;
-            d.uu[i] = uu;
-            let Some(p) = parent else { continue };
-            // U D⁻¹ (6 × k), then I^a = I^A − U D⁻¹ Uᵀ and p^a = p^A + I^a c + U D⁻¹ u.
-            let mut ud = M6::zeros();
-            for r in 0..6 {
-                for c in 0..k {
-                    ud[(r, c)] = (0..k).map(|t| u[(r, t)] * dinv[(t, c)]).sum();
-                }
-            }
-            let mut ia_a = ia;
-            for r in 0..6 {
-                for c in 0..6 {
-                    ia_a[(r, c)] -= (0..k).map(|t| ud[(r, t)] * u[(c, t)]).sum::<f64>();
-                }
-            }
-            let mut pa = pa6 + ia_a * d.oc[i].to_v6();
-            for t in 0..k {
-                pa += ud.column(t) * uu[t];
-            }
+            let s3 = s.fixed_columns::<3>(0);
+            let u3 = ia * s3;
+            let dm3 = s3.transpose() * u3;
+            let uu3 = nalgebra::Vector3::new(tau[iv], tau[iv + 1], tau[iv + 2]) - s3.transpose() * pa6;
+            d.u[i] = M6::zeros();
+            d.u[i].fixed_columns_mut::<3>(0).copy_from(&u3);
+            d.uu[i][..3].copy_from_slice(uu3.as_slice());
+            let Some(p) = parent else {
+                d.dinv[i] = M6::zeros();
+                d.dinv[i].fixed_view_mut::<3, 3>(0, 0).copy_from(&dm3);
+                continue;
+            };
+            let dinv3 = dm3
+                .cholesky()
+                .map(|c| c.inverse())
+                .filter(|x| x.iter().all(|v| v.is_finite()))
+                .ok_or_else(|| singular(m, i))?;
+            let ud = u3 * dinv3;
+            let ia_a = ia - ud * u3.transpose();
+            let pa = pa6 + ia_a * d.oc[i].to_v6() + ud * uu3;
+            d.dinv[i] = M6::zeros();
+            d.dinv[i].fixed_view_mut::<3, 3>(0, 0).copy_from(&dinv3);
             d.ia[p] += ia_a;
             d.of[p] += Force::from_v6(&pa);
         } else if let Some(p) = parent {
@@ -176,6 +196,17 @@ pub fn hybrid_aba(
             for c in 0..k {
                 rhs[c] = d.uu[i][c] - d.u[i].column(c).dot(&a);
             }
+            if m.parents[i].is_none() && k > 1 {
+                // Root with several DoF: d.dinv holds D itself (see pass 2).
+                let x = solve_spd(&d.dinv[i], k, &rhs).ok_or_else(|| singular(m, i))?;
+                for r in 0..k {
+                    d.ddq[iv + r] = x[r];
+                    d.tau[iv + r] = tau[iv + r];
+                    a += s.column(r) * x[r];
+                }
+                d.oa[i] = Motion::from_v6(&a);
+                continue;
+            }
             for r in 0..k {
                 let x: f64 = (0..k).map(|c| d.dinv[i][(r, c)] * rhs[c]).sum();
                 d.ddq[iv + r] = x;
@@ -193,6 +224,24 @@ fn singular(m: &Model, i: usize) -> FfError {
         "joint '{}': its articulated inertia about the joint is singular (massless or degenerate subtree)",
         m.joint_names[i]
     ))
+}
+
+/// Solve `D x = b` for the leading k×k block (k ∈ {3, 6}) of a symmetric positive-definite D.
+fn solve_spd(dm: &M6, k: usize, b: &[f64; 6]) -> Option<[f64; 6]> {
+    let mut x = [0.0; 6];
+    match k {
+        3 => {
+            let m3: Matrix3<f64> = dm.fixed_view::<3, 3>(0, 0).into_owned();
+            let r = m3.cholesky()?.solve(&nalgebra::Vector3::new(b[0], b[1], b[2]));
+            x[..3].copy_from_slice(r.as_slice());
+        }
+        6 => {
+            let r = dm.cholesky()?.solve(&V6::from_column_slice(b));
+            x.copy_from_slice(r.as_slice());
+        }
+        _ => unreachable!("a multi-DoF root has 3 or 6 velocity coordinates"),
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
 /// Inverse of the leading k×k block (k ∈ {1, 3, 6}) of a symmetric positive-definite matrix, by

@@ -28,26 +28,34 @@ pub fn kinetic_energy_from_data(m: &Model, d: &Data) -> f64 {
     (0..m.nbodies()).map(|i| m.inertias[i].kinetic_energy(&d.v[i])).sum()
 }
 
-/// Composite inertia of each body's subtree, in that body's frame (needs `li_mi`).
-pub fn composite_inertias(m: &Model, d: &mut Data) {
-    d.ic.copy_from_slice(&m.inertias);
-    for i in (1..m.nbodies()).rev() {
+/// Inertial-frame composite inertia of each body's subtree (`d.ic`) and each joint's motion
+/// subspace in inertial coordinates (`d.os`), after forward kinematics. In inertial coordinates a
+/// subtree's inertia is a plain sum, which is what CRBA and the momentum matrix need.
+pub fn world_composite_inertias(m: &Model, d: &mut Data) {
+    let n = m.nbodies();
+    for i in 0..n {
+        d.ic[i] = m.inertias[i].transformed(&d.o_mi[i]);
+        for c in 0..m.nvs[i] {
+            let s = d.o_mi[i].act_motion(&Motion::from_v6(&m.subspaces[i].column(c).into_owned()));
+            d.os[i].set_column(c, &s.to_v6());
+        }
+    }
+    for i in (1..n).rev() {
         let p = m.parents[i].unwrap();
-        let t = d.ic[i].transformed(&d.li_mi[i]);
-        d.ic[p] = d.ic[p].add(&t);
+        let ci = d.ic[i];
+        d.ic[p] = d.ic[p].add(&ci);
     }
 }
 
 /// Centroidal momentum matrix about the inertial origin: `momentum == A v`, written into `d.jac`
-/// (6 × nv). Column block j is the momentum of joint j's subtree moving rigidly with unit joint rate,
-/// `oX*_j Ic_j S_j`.
+/// (6 × nv). Column block j is the momentum of joint j's subtree moving rigidly with unit joint
+/// rate, `oIcⱼ oSⱼ`, already about the inertial origin in inertial axes.
 pub fn centroidal_momentum_matrix(m: &Model, d: &mut Data, q: &[f64]) {
     forward_kinematics(m, d, q);
-    composite_inertias(m, d);
+    world_composite_inertias(m, d);
     for j in 0..m.nbodies() {
         for c in 0..m.nvs[j] {
-            let s = Motion::from_v6(&m.subspaces[j].column(c).into_owned());
-            let h = d.o_mi[j].act_force(&d.ic[j].mul_motion(&s));
+            let h = d.ic[j].mul_motion(&Motion::from_v6(&d.os[j].column(c).into_owned()));
             let col = m.idx_v[j] + c;
             for r in 0..3 {
                 d.jac[(r, col)] = h.lin[r];

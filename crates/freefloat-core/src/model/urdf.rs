@@ -298,15 +298,16 @@ pub fn to_urdf_string(m: &Model) -> Result<String> {
         let _ = writeln!(s, "    <origin xyz=\"{}\" rpy=\"{}\"/>", fmt3(&p.trans), fmt3(&rot_to_rpy(&p.rot)));
         if t != "fixed" {
             let _ = writeln!(s, "    <axis xyz=\"{}\"/>", fmt3(&m.axes[i]));
+            // Only the limits the model has; a missing one is not "zero".
             let l = &m.limits[i];
-            let _ = writeln!(
-                s,
-                "    <limit lower=\"{:?}\" upper=\"{:?}\" velocity=\"{:?}\" effort=\"{:?}\"/>",
-                l.lower.unwrap_or(0.0),
-                l.upper.unwrap_or(0.0),
-                l.velocity.unwrap_or(0.0),
-                l.effort.unwrap_or(0.0)
-            );
+            let attrs: Vec<String> =
+                [("lower", l.lower), ("upper", l.upper), ("velocity", l.velocity), ("effort", l.effort)]
+                    .iter()
+                    .filter_map(|(k, v)| v.map(|x| format!("{k}=\"{x:?}\"")))
+                    .collect();
+            if !attrs.is_empty() {
+                let _ = writeln!(s, "    <limit {}/>", attrs.join(" "));
+            }
         }
         let _ = writeln!(s, "  </joint>");
     }

@@ -13,7 +13,6 @@ use crate::config::{dexpinv, retract, tangent_magnitude, tangent_rate};
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba, Prescribed};
 use crate::error::{check_vec, FfError, Result};
-use crate::kinematics::forward_velocities;
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
 
@@ -256,7 +255,11 @@ pub fn simulate(
         }
     };
     let mut st = Stepper::new(m, inputs, tab.stages())?;
-    let mut traj = Trajectory::new(m);
+    let expected = match opts.method {
+        Method::Rk4 => (opts.t_final / opts.dt).round() as usize / opts.record_every + 2,
+        Method::Rk45 { .. } => (opts.t_final / opts.dt).ceil() as usize + 2,
+    };
+    let mut traj = Trajectory::with_capacity(m, expected.min(10_000_000));
     let (mut q, mut v) = (q0, v0.to_vec());
     let (mut q1, mut v1) = (vec![0.0; m.nq], vec![0.0; m.nv]);
     let mut w = 0.0;
@@ -300,7 +303,7 @@ pub fn simulate(
             Method::Rk45 { .. } => (t - next_out).abs() <= eps_t,
         };
         if record {
-            traj.push(m, &mut st.d, t, &q, &v, w)?;
+            traj.push(&st.d, t, &q, &v, w);
             out_k += 1;
             next_out = out_k as f64 * opts.dt;
         }
@@ -367,14 +370,4 @@ pub fn simulate(
         p(1.0);
     }
     Ok(traj)
-}
-
-/// Records need momentum and energy at the recorded state; computed once per record.
-pub(crate) fn record_quantities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) -> ([f64; 6], f64) {
-    forward_velocities(m, d, q, v);
-    let h = crate::kinematics::momentum_from_data(m, d);
-    let e = crate::kinematics::kinetic_energy_from_data(m, d);
-    let mut out = [0.0; 6];
-    h.write(&mut out);
-    (out, e)
 }

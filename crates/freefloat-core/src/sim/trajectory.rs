@@ -1,7 +1,6 @@
 //! The recorded result of a simulation.
 
 use crate::data::Data;
-use crate::error::Result;
 use crate::model::Model;
 
 /// Samples stored row-major: `q` is T × nq, `v`, `ddq`, `tau` are T × nv, `momentum` T × 6.
@@ -27,8 +26,23 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
-    pub fn new(m: &Model) -> Self {
-        Trajectory { nq: m.nq, nv: m.nv, ..Default::default() }
+    /// An empty trajectory with room for `samples` records (growing the arrays during a run costs
+    /// several percent of a simulation).
+    pub fn with_capacity(m: &Model, samples: usize) -> Self {
+        let (nq, nv) = (m.nq, m.nv);
+        Trajectory {
+            nq,
+            nv,
+            t: Vec::with_capacity(samples),
+            q: Vec::with_capacity(samples * nq),
+            v: Vec::with_capacity(samples * nv),
+            ddq: Vec::with_capacity(samples * nv),
+            tau: Vec::with_capacity(samples * nv),
+            momentum: Vec::with_capacity(samples * 6),
+            kinetic_energy: Vec::with_capacity(samples),
+            work: Vec::with_capacity(samples),
+            ..Default::default()
+        }
     }
 
     pub fn len(&self) -> usize {
@@ -39,17 +53,18 @@ impl Trajectory {
         self.t.is_empty()
     }
 
-    /// Append a sample; `d` must hold `ddq` and `tau` evaluated at (t, q, v).
-    pub(crate) fn push(&mut self, m: &Model, d: &mut Data, t: f64, q: &[f64], v: &[f64], work: f64) -> Result<()> {
+    /// Append a sample; `d` must hold the results of the dynamics evaluated at (t, q, v): `ddq`,
+    /// `tau`, and the momentum and kinetic energy ABA forms on the way.
+    pub(crate) fn push(&mut self, d: &Data, t: f64, q: &[f64], v: &[f64], work: f64) {
         self.t.push(t);
         self.q.extend_from_slice(q);
         self.v.extend_from_slice(v);
         self.ddq.extend_from_slice(&d.ddq);
         self.tau.extend_from_slice(&d.tau);
-        let (h, e) = super::record_quantities(m, d, q, v);
+        let mut h = [0.0; 6];
+        d.aba_momentum.write(&mut h);
         self.momentum.extend_from_slice(&h);
-        self.kinetic_energy.push(e);
+        self.kinetic_energy.push(d.aba_kinetic_energy);
         self.work.push(work);
-        Ok(())
     }
 }
