@@ -111,7 +111,7 @@ def test_wrong_sizes_and_nan():
 
 def test_quaternion_policy():
     m = ff.models.load("seed000_3d")
-    q, v = m.neutral(), np.zeros(m.nv)
+    q = m.neutral()
     q2 = q.copy()
     q2[3:7] = [0.1, 0.2, 0.3, 0.9]
     q2[3:7] /= np.linalg.norm(q2[3:7])

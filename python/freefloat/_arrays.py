@@ -14,7 +14,3 @@ def as_f64(x, name: str) -> np.ndarray:
         return np.ascontiguousarray(x, dtype=np.float64)
     except (TypeError, ValueError) as e:
         raise InputError(f"argument `{name}`: cannot be read as an array of numbers ({e})") from None
-
-
-def as_f64_or_none(x, name: str):
-    return None if x is None else as_f64(x, name)

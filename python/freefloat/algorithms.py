@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from . import _core
 from ._arrays import as_f64
-from ._core import (  # noqa: F401  (re-exported)
+from ._core import (
     aba,
     body_accelerations,
     body_velocities,
@@ -26,6 +26,12 @@ from ._core import (  # noqa: F401  (re-exported)
     momentum,
     rnea,
 )
+
+__all__ = [
+    "aba", "body_accelerations", "body_velocities", "center_of_mass", "centroidal_momentum_matrix", "crba",
+    "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian", "hybrid_dynamics",
+    "kinetic_energy", "momentum", "rnea",
+]
 
 
 def generalized_jacobian(model, q, name: str, reference: str = "world", h0=None):

@@ -166,17 +166,13 @@ def simulate(
     if isinstance(prescribed, str):
         prescribed = [prescribed]
     bar = None
-    cb = None
     if progress is True:
         from tqdm.auto import tqdm
 
         bar = tqdm(total=1000, desc=f"simulate {model.name}", unit="‰", leave=False)
-
-        def cb(frac):
-            bar.update(int(frac * 1000) - bar.n)
-            return True
-    elif callable(progress):
-        cb = progress
+        cb = _bar_callback(bar)
+    else:
+        cb = progress if callable(progress) else None
     tt = None if torque_times is None else as_f64(torque_times, "torque_times")
     if torques is not None and not callable(torques):
         torques = as_f64(torques, "torques")
@@ -191,6 +187,14 @@ def simulate(
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
     stats.update(method=method, dt=dt, t_final=t_final, total_mass=model.total_mass, radius=_radius(model, q0))
     return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
+
+
+def _bar_callback(bar):
+    """Progress callback that advances a tqdm bar counting per mille."""
+    def cb(frac):
+        bar.update(int(frac * 1000) - bar.n)
+        return True
+    return cb
 
 
 def _radius(model: Model, q) -> float:

@@ -10,13 +10,12 @@ pub struct Data {
     pub li_mi: Vec<Se3>,
     /// Placement of body i in the inertial frame.
     pub o_mi: Vec<Se3>,
-    /// Body twists, body frame.
+    /// Body twists, body frame (forward velocities, RNEA).
     pub v: Vec<Motion>,
-    /// Body spatial accelerations, body frame (gravity included as a fictitious base acceleration).
+    /// Body spatial accelerations, body frame (RNEA: gravity included as a fictitious base
+    /// acceleration; `forward_accelerations`: without gravity).
     pub a: Vec<Motion>,
-    /// Velocity-product accelerations `v_i × S_i q̇_i`.
-    pub c: Vec<Motion>,
-    /// RNEA: force transmitted by each joint to its child; ABA: bias forces.
+    /// RNEA: force transmitted by each joint to its child, body frame.
     pub f: Vec<Force>,
     /// Articulated-body inertias (ABA; inertial-frame coordinates).
     pub ia: Vec<M6>,
@@ -26,7 +25,7 @@ pub struct Data {
     pub oa: Vec<Motion>,
     pub oc: Vec<Motion>,
     pub of: Vec<Force>,
-    /// Motion subspace of each joint in inertial coordinates (nv columns used).
+    /// Motion subspace of each joint in inertial coordinates (nv columns used; ABA, CRBA).
     pub os: Vec<M6>,
     /// By-products of ABA's first pass: total momentum (about the inertial origin, inertial frame)
     /// and kinetic energy at the state it was called with.
@@ -60,7 +59,6 @@ impl Data {
             o_mi: vec![Se3::identity(); n],
             v: vec![Motion::ZERO; n],
             a: vec![Motion::ZERO; n],
-            c: vec![Motion::ZERO; n],
             f: vec![Force::ZERO; n],
             ia: vec![M6::zeros(); n],
             ov: vec![Motion::ZERO; n],

@@ -110,24 +110,15 @@ pub fn hybrid_aba(
             // Multi-DoF joint (k = 3: spherical or planar; k = 6: free), with fixed-size products.
             let ia = d.ia[i];
             if k == 6 {
+                // Only the base can have a free joint (the model builder enforces it), so there is
+                // no reduction to pass on: keep D itself and solve with it in pass 3, which is
+                // cheaper than forming D⁻¹.
+                debug_assert!(parent.is_none(), "a 6-DoF joint is always the root");
                 let u = ia * s;
-                let dm = s.transpose() * u;
+                d.dinv[i] = s.transpose() * u;
                 let uu = V6::from_column_slice(&tau[iv..iv + 6]) - s.transpose() * pa6;
                 d.u[i] = u;
                 d.uu[i].copy_from_slice(uu.as_slice());
-                let Some(p) = parent else {
-                    // The root needs no reduction: keep D itself and solve with it in pass 3, which
-                    // is cheaper than forming D⁻¹.
-                    d.dinv[i] = dm;
-                    continue;
-                };
-                let dinv = small_spd_inverse(&dm, 6).ok_or_else(|| singular(m, i))?;
-                let ud = u * dinv;
-                let ia_a = ia - ud * u.transpose();
-                let pa = pa6 + ia_a * d.oc[i].to_v6() + ud * uu;
-                d.dinv[i] = dinv;
-                d.ia[p] += ia_a;
-                d.of[p] += Force::from_v6(&pa);
                 continue;
             }
             let s3 = s.fixed_columns::<3>(0);
@@ -242,30 +233,4 @@ fn solve_spd(dm: &M6, k: usize, b: &[f64; 6]) -> Option<[f64; 6]> {
         _ => unreachable!("a multi-DoF root has 3 or 6 velocity coordinates"),
     }
     x.iter().all(|v| v.is_finite()).then_some(x)
-}
-
-/// Inverse of the leading k×k block (k ∈ {1, 3, 6}) of a symmetric positive-definite matrix, by
-/// Cholesky; `None` if it is not positive definite.
-fn small_spd_inverse(dm: &M6, k: usize) -> Option<M6> {
-    let mut out = M6::zeros();
-    match k {
-        1 => {
-            if !(dm[(0, 0)] > 0.0) {
-                return None;
-            }
-            out[(0, 0)] = 1.0 / dm[(0, 0)];
-        }
-        3 => {
-            let m3: Matrix3<f64> = dm.fixed_view::<3, 3>(0, 0).into_owned();
-            let inv = m3.cholesky()?.inverse();
-            out.fixed_view_mut::<3, 3>(0, 0).copy_from(&inv);
-        }
-        6 => out = dm.cholesky()?.inverse(),
-        _ => unreachable!("joints have 1, 3 or 6 velocity coordinates"),
-    }
-    if out.iter().all(|x| x.is_finite()) {
-        Some(out)
-    } else {
-        None
-    }
 }
