@@ -773,6 +773,19 @@ def build_pinocchio(desc: TreeDescription) -> PinTree:
                    body_in_joint=body_in_joint, frame_id=frame_id, pin_q_slice=pin_q_slice, v_perm=v_perm)
 
 
+def ff_joint_rows(m):
+    """`TreeDescription.joint_rows()` for a freefloat model: (joint name, type, q slice, v slice) per body."""
+    types = list(m.joint_types)
+    names = list(m.joint_names)
+    names = [None] + names[len(names) - (len(types) - 1):]  # with or without a base entry
+    rows, q0, v0 = [], 0, 0
+    for name, t in zip(names, types):
+        qs, vs = slice(q0, q0 + JOINT_NQ[t]), slice(v0, v0 + JOINT_NV[t])
+        q0, v0 = qs.stop, vs.stop
+        rows.append((name, t, qs, vs))
+    return rows
+
+
 class NamedLayout:
     """q/v maps between a body-ordered layout (ours) and a Pinocchio model whose joints are matched *by name*.
 

@@ -267,19 +267,6 @@ def erd_urdf(rel):
     pytest.skip(f"example-robot-data is not installed (no {rel}); pip install example-robot-data")
 
 
-def ff_joint_rows(m):
-    """`TreeDescription.joint_rows()` for a freefloat model: (joint name, type, q slice, v slice) per body."""
-    types = list(m.joint_types)
-    names = list(m.joint_names)
-    names = [None] + names[len(names) - (len(types) - 1):]  # with or without a base entry
-    rows, q0, v0 = [], 0, 0
-    for name, t in zip(names, types):
-        qs, vs = slice(q0, q0 + rt.JOINT_NQ[t]), slice(v0, v0 + rt.JOINT_NV[t])
-        q0, v0 = qs.stop, vs.stop
-        rows.append((name, t, qs, vs))
-    return rows
-
-
 class UrdfPair:
     """freefloat and Pinocchio models of one URDF, joints matched by name (`random_trees.NamedLayout`)."""
 
@@ -295,7 +282,7 @@ class UrdfPair:
         # pin defaults to Earth gravity; freefloat's URDF default is zero: use whatever freefloat reports
         self.model.gravity = pin.Motion(np.asarray(self.m.gravity, float), np.zeros(3))
         self.data = self.model.createData()
-        self.rows = ff_joint_rows(self.m)
+        self.rows = rt.ff_joint_rows(self.m)
         assert self.rows[0][1] == base
         self.layout = rt.NamedLayout(self.model, self.rows)
 

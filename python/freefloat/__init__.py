@@ -17,6 +17,7 @@ from .algorithms import (
     center_of_mass,
     centroidal_momentum_matrix,
     crba,
+    dynamics_regressor,
     forward_kinematics,
     frame_jacobian,
     frame_placement,
@@ -24,6 +25,7 @@ from .algorithms import (
     hybrid_dynamics,
     kinetic_energy,
     momentum,
+    momentum_regressor,
     rnea,
 )
 from .model import Model
@@ -36,5 +38,6 @@ __all__ = [
     "aba", "rnea", "crba", "hybrid_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
+    "momentum_regressor", "dynamics_regressor",
     "ModelError", "InputError", "NumericalError",
 ]

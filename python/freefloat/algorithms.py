@@ -19,18 +19,20 @@ from ._core import (
     center_of_mass,
     centroidal_momentum_matrix,
     crba,
+    dynamics_regressor,
     forward_kinematics,
     frame_jacobian,
     frame_placement,
     kinetic_energy,
     momentum,
+    momentum_regressor,
     rnea,
 )
 
 __all__ = [
     "aba", "body_accelerations", "body_velocities", "center_of_mass", "centroidal_momentum_matrix", "crba",
-    "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian", "hybrid_dynamics",
-    "kinetic_energy", "momentum", "rnea",
+    "dynamics_regressor", "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian",
+    "hybrid_dynamics", "kinetic_energy", "momentum", "momentum_regressor", "rnea",
 ]
 
 

@@ -12,6 +12,7 @@
 use criterion::{black_box, criterion_group, criterion_main, BatchSize, Criterion};
 use freefloat_core::dynamics::{aba, crba, rnea};
 use freefloat_core::kinematics::{centroidal_momentum_matrix, momentum};
+use freefloat_core::regressors::{dynamics_regressor, momentum_regressor};
 use freefloat_core::sim::{simulate, Hold, Inputs, Method, SimOptions, TorqueSource};
 use freefloat_core::{Data, Model};
 use rand::rngs::StdRng;
@@ -109,6 +110,22 @@ fn algorithms(c: &mut Criterion) {
             let s = &xs[next()];
             centroidal_momentum_matrix(&m, &mut d, black_box(&s.q));
             black_box(d.jac[(0, 0)]);
+        })
+    });
+    let mut y = nalgebra::DMatrix::zeros(m.nv, 10 * m.nbodies());
+    g.bench_function("dynamics_regressor", |b| {
+        b.iter(|| {
+            let s = &xs[next()];
+            dynamics_regressor(&m, &mut d, black_box(&s.q), black_box(&s.v), black_box(&s.u), &mut y);
+            black_box(y[(0, 0)]);
+        })
+    });
+    let mut kr = nalgebra::DMatrix::zeros(6, 10 * m.nbodies());
+    g.bench_function("momentum_regressor", |b| {
+        b.iter(|| {
+            let s = &xs[next()];
+            momentum_regressor(&m, &mut d, black_box(&s.q), black_box(&s.v), &mut kr);
+            black_box(kr[(0, 0)]);
         })
     });
     g.finish();

@@ -14,6 +14,7 @@ pub mod dynamics;
 pub mod error;
 pub mod kinematics;
 pub mod model;
+pub mod regressors;
 pub mod sim;
 pub mod spatial;
 

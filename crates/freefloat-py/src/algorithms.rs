@@ -6,8 +6,10 @@ use crate::errors::{guard, input_err};
 use crate::model::PyModel;
 use freefloat_core::dynamics::{self, Prescribed};
 use freefloat_core::kinematics::{self as kin, Reference};
+use freefloat_core::regressors;
 use freefloat_core::spatial::quat_from_rot;
 use freefloat_core::{Data, FfError, Model};
+use nalgebra::{Dyn, MatrixViewMut};
 use pyo3::prelude::*;
 
 /// An argument that is read as an array of float64 (anything numpy can convert).
@@ -250,6 +252,59 @@ fn write_rowmajor(a: &nalgebra::DMatrix<f64>, o: &mut [f64]) {
             o[r * c + j] = a[(r, j)];
         }
     }
+}
+
+/// A row-major matrix view over one sample's output, so the engine writes numpy's layout directly.
+fn rowmajor_view(o: &mut [f64], rows: usize, cols: usize) -> MatrixViewMut<'_, f64, Dyn, Dyn, Dyn, Dyn> {
+    MatrixViewMut::from_slice_with_strides_generic(o, Dyn(rows), Dyn(cols), Dyn(cols), Dyn(1))
+}
+
+/// Momentum regressor (6, 10·nbodies): momentum(q, v) == K @ P.ravel() with P = m.parameters().
+/// Seed 001's link kinematic matrix (Eq. 10) per body, in our parameter order.
+#[pyfunction]
+pub fn momentum_regressor<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
+    let m = &model.inner;
+    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
+    let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
+    let np = 10 * m.nbodies();
+    let out = run_rows(py, model, rows, st, 6 * np, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        regressors::momentum_regressor(m, d, q, vb.row(k), &mut rowmajor_view(o, 6, np));
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[6, np])
+}
+
+/// Inverse-dynamics regressor (nv, 10·nbodies): rnea(q, v, a) == Y @ P.ravel(), gravity included.
+/// Per body the thesis' regressor R (Eqs. 4.3, 9.7), the Newton-Euler counterpart of seed 001's Eq. 10,
+/// projected on every joint between the body and the root.
+#[pyfunction]
+pub fn dynamics_regressor<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    a: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
+    let m = &model.inner;
+    let (qb, vb, ab) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("a", a, &[m.nv])?);
+    let (rows, st) = common_rows(&[("q", &qb), ("v", &vb), ("a", &ab)])?;
+    let (nv, np) = (m.nv, 10 * m.nbodies());
+    let out = run_rows(py, model, rows, st, nv * np, |m, d, k, o, buf| {
+        let q = m.checked_q(qb.row(k), buf)?;
+        regressors::dynamics_regressor(m, d, q, vb.row(k), ab.row(k), &mut rowmajor_view(o, nv, np));
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[nv, np])
 }
 
 /// Jacobian (6, nv) of a body or frame: its twist [linear; angular] is J @ v.

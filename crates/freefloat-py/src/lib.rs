@@ -26,6 +26,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(algorithms::centroidal_momentum_matrix, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::frame_jacobian, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::generalized_jacobian, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::momentum_regressor, m)?)?;
+    m.add_function(wrap_pyfunction!(algorithms::dynamics_regressor, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::rnea, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::crba, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::aba, m)?)?;

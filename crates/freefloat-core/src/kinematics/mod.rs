@@ -10,5 +10,5 @@ pub use fk::{classical_acceleration, forward_accelerations, forward_kinematics, 
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};
 pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,
-    world_composite_inertias,
+    world_composite_inertias, world_motion_subspaces,
 };

@@ -33,17 +33,25 @@ pub fn kinetic_energy_from_data(m: &Model, d: &Data) -> f64 {
 /// subtree's inertia is a plain sum, which is what CRBA and the momentum matrix need.
 pub fn world_composite_inertias(m: &Model, d: &mut Data) {
     let n = m.nbodies();
+    world_motion_subspaces(m, d);
     for i in 0..n {
         d.ic[i] = m.inertias[i].transformed(&d.o_mi[i]);
-        for c in 0..m.nvs[i] {
-            let s = d.o_mi[i].act_motion(&Motion::from_v6(&m.subspaces[i].column(c).into_owned()));
-            d.os[i].set_column(c, &s.to_v6());
-        }
     }
     for i in (1..n).rev() {
         let p = m.parents[i].unwrap();
         let ci = d.ic[i];
         d.ic[p] = d.ic[p].add(&ci);
+    }
+}
+
+/// Each joint's motion subspace in inertial coordinates (`d.os`, nv columns), after forward
+/// kinematics.
+pub fn world_motion_subspaces(m: &Model, d: &mut Data) {
+    for i in 0..m.nbodies() {
+        for c in 0..m.nvs[i] {
+            let s = d.o_mi[i].act_motion(&Motion::from_v6(&m.subspaces[i].column(c).into_owned()));
+            d.os[i].set_column(c, &s.to_v6());
+        }
     }
 }
 

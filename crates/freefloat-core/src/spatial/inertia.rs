@@ -60,6 +60,29 @@ impl Inertia {
         Force { lin: v.lin * self.mass - self.h.cross(&v.ang), ang: self.i_o * v.ang + self.h.cross(&v.lin) }
     }
 
+    /// `mul_motion` as a linear map of the parameters: column k is the momentum contributed by
+    /// parameter k of `to_params`, so `self.mul_motion(v) == Σₖ self.to_params()[k] · cols[k]`.
+    /// From `[m v − h × ω; I_o ω + h × v]` with `v = (v, ω)`: the body block of every regressor.
+    pub fn mul_motion_columns(v: &Motion) -> [Force; 10] {
+        let (lin, w) = (v.lin, v.ang);
+        let z = V3::zeros();
+        // h × (−ω) = ω × h and h × v = −v × h: the columns of h are ω × eₖ and −v × eₖ.
+        let h = |e: V3| Force::new(w.cross(&e), -lin.cross(&e));
+        let i = |x: V3| Force::new(z, x);
+        [
+            Force::new(lin, z),
+            h(V3::x()),
+            h(V3::y()),
+            h(V3::z()),
+            i(V3::new(w.x, 0.0, 0.0)),
+            i(V3::new(w.y, w.x, 0.0)),
+            i(V3::new(0.0, w.y, 0.0)),
+            i(V3::new(w.z, 0.0, w.x)),
+            i(V3::new(0.0, w.z, w.y)),
+            i(V3::new(0.0, 0.0, w.z)),
+        ]
+    }
+
     /// 6×6 matrix form, mapping `[v; w]` to `[f; n]`.
     pub fn to_matrix(&self) -> M6 {
         let hx = skew(&self.h);

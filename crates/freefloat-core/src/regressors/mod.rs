@@ -1,0 +1,36 @@
+//! Regressors: matrices that are exactly linear in the standard parameters, so that a quantity
+//! equals `Y · vec(P)` with `P = model.parameters()` (nbodies × 10, row-major: body i owns
+//! columns `10i..10i + 10`). The regressor depends on the state only, never on `P`.
+
+mod dynamics;
+mod momentum;
+
+pub use dynamics::dynamics_regressor;
+pub use momentum::momentum_regressor;
+
+use crate::model::Model;
+use crate::spatial::Force;
+use nalgebra::{Dyn, Matrix, StorageMut};
+
+/// Any dynamically sized matrix the regressors can write into: a `DMatrix` or a view of one,
+/// e.g. a row-major view over a numpy buffer.
+pub type RegressorOut<S> = Matrix<f64, Dyn, Dyn, S>;
+
+fn check_shape<S: StorageMut<f64, Dyn, Dyn>>(m: &Model, out: &RegressorOut<S>, rows: usize, what: &str) {
+    let cols = 10 * m.nbodies();
+    assert!(
+        out.nrows() == rows && out.ncols() == cols,
+        "{what}: output must be {rows} × {cols}, got {} × {}",
+        out.nrows(),
+        out.ncols()
+    );
+}
+
+/// Write a force as rows 0..6 of column `col`.
+#[inline]
+fn write_column<S: StorageMut<f64, Dyn, Dyn>>(out: &mut RegressorOut<S>, col: usize, f: &Force) {
+    for r in 0..3 {
+        out[(r, col)] = f.lin[r];
+        out[(r + 3, col)] = f.ang[r];
+    }
+}
