@@ -14,7 +14,7 @@ def run(*args, ok=True):
     return r
 
 
-@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"]])
+@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["params"], ["params", "minimal"]])
 def test_every_command_has_help(cmd):
     r = run(*cmd, "--help")
     assert "Usage:" in r.stdout and len(r.stdout) > 200
@@ -49,3 +49,18 @@ def test_bad_model_gives_one_clear_line(tmp_path):
     bad.write_text("name: x\nbodies:\n  - name: b\n    inertial: {mass: -1}\n")
     r = run("simulate", str(bad), ok=False)
     assert r.returncode == 2 and "negative" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_params_minimal_prints_and_writes_table4(tmp_path):
+    r = run("params", "minimal", "seed001_dual_arm", "--method", "closed-form", "--out", str(tmp_path))
+    assert "52 minimal parameters" in r.stdout and "0.09*L4.m" in r.stdout
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["rank"] == 52 and len(res["names"]) == len(res["expressions"]) == len(res["values"]) == 52
+    assert abs(res["values"][3] - (-96.63)) < 1e-9 and res["known_bodies"] == ["wheel_x", "wheel_y", "wheel_z"]
+    r = run("params", "minimal", "seed001_dual_arm", "--known", "")
+    assert "73 minimal parameters" in r.stdout
+
+
+def test_params_minimal_closed_form_refuses_prismatic():
+    r = run("params", "minimal", "thesis_ch7_two_arm", "--method", "closed-form", ok=False)
+    assert r.returncode == 2 and 'method="numeric"' in r.stderr and "Traceback" not in r.stderr

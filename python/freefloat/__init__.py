@@ -28,6 +28,7 @@ from .algorithms import (
     momentum_regressor,
     rnea,
 )
+from .minimal import MinimalParameters, minimal_parameters
 from .model import Model
 from .simulation import Trajectory, simulate
 
@@ -39,5 +40,6 @@ __all__ = [
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
     "momentum_regressor", "dynamics_regressor",
+    "minimal_parameters", "MinimalParameters",
     "ModelError", "InputError", "NumericalError",
 ]

@@ -89,9 +89,11 @@ pub fn simulate<'py>(
         "linear" => Hold::Linear,
         other => return Err(input_err(format!("hold must be 'zoh' or 'linear', got '{other}'"))),
     };
-    let torque_src = match torques {
-        None => TorqueSource::Zero,
-        Some(t) if t.is_callable() => TorqueSource::Function(state_fn(py, t, stash.clone(), "the torque function")),
+    // Parse the torques into plain data first: without Python callbacks the run moves to a thread
+    // that does not hold the GIL, and only plain data may go there.
+    let torque_spec = match torques {
+        None => TorqueSpec::Zero,
+        Some(t) if t.is_callable() => TorqueSpec::Callable(t),
         Some(t) => {
             let arr: PyReadonlyArrayDyn<f64> =
                 py.import("numpy")?.call_method1("asarray", (t, "float64"))?.extract()?;
@@ -116,7 +118,10 @@ pub fn simulate<'py>(
                     times.len()
                 )));
             }
-            guard(|| TorqueSource::table(times, arr.as_array().iter().copied().collect(), m.nv, hold))?
+            let values: Vec<f64> = arr.as_array().iter().copied().collect();
+            // Validate now (clear errors before any work), build again where it runs.
+            guard(|| TorqueSource::table(times.clone(), values.clone(), m.nv, hold))?;
+            TorqueSpec::Table(times, values)
         }
     };
     let ctrl = match (controller, controller_period) {
@@ -164,12 +169,18 @@ pub fn simulate<'py>(
         }
     };
     let has_callbacks =
-        matches!(torque_src, TorqueSource::Function(_)) || ctrl.is_some() || presc.is_some() || progress.is_some();
-    let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc };
+        matches!(torque_spec, TorqueSpec::Callable(_)) || ctrl.is_some() || presc.is_some() || progress.is_some();
     let q0 = q0.as_array().to_vec();
     let v0 = v0.as_array().to_vec();
+    let nv = m.nv;
 
     let result = if has_callbacks {
+        let torque_src = match torque_spec {
+            TorqueSpec::Zero => TorqueSource::Zero,
+            TorqueSpec::Table(times, values) => guard(|| TorqueSource::table(times, values, nv, hold))?,
+            TorqueSpec::Callable(f) => TorqueSource::Function(state_fn(py, f, stash.clone(), "the torque function")),
+        };
+        let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc };
         let st = stash.clone();
         let mut prog = progress.map(|p| {
             move |frac: f64| -> bool {
@@ -185,12 +196,20 @@ pub fn simulate<'py>(
         let pr: Option<sim::Progress> = prog.as_mut().map(|p| p as &mut dyn FnMut(f64) -> bool);
         guard(|| sim::simulate(&m, &q0, &v0, &opts, inputs, pr))
     } else {
-        // No Python code runs during the simulation: release the GIL. The inputs hold no Python
-        // objects in this branch, so they can move to the detached closure.
-        let inputs = SendInputs(inputs);
+        // No Python code runs during the simulation: release the GIL; the inputs are built from
+        // plain data on the detached side.
+        let table = match torque_spec {
+            TorqueSpec::Table(times, values) => Some((times, values)),
+            _ => None,
+        };
         py.detach(move || {
-            let inputs = inputs;
-            guard(|| sim::simulate(&m, &q0, &v0, &opts, inputs.0, None))
+            guard(|| {
+                let torques = match table {
+                    Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
+                    None => TorqueSource::Zero,
+                };
+                sim::simulate(&m, &q0, &v0, &opts, Inputs { torques, ..Default::default() }, None)
+            })
         })
     };
     if let Some(e) = stash.borrow_mut().take() {
@@ -213,6 +232,9 @@ pub fn simulate<'py>(
     Ok(d)
 }
 
-/// Inputs with no Python callables (checked by the caller) are safe to send to another thread.
-struct SendInputs<'a>(Inputs<'a>);
-unsafe impl Send for SendInputs<'_> {}
+/// What the caller gave as torques, before it becomes an engine `TorqueSource`.
+enum TorqueSpec<'py> {
+    Zero,
+    Table(Vec<f64>, Vec<f64>),
+    Callable(Bound<'py, PyAny>),
+}
