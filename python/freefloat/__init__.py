@@ -8,7 +8,7 @@
 
 Conventions are in docs/architecture.md; every number is computed by the Rust engine."""
 
-from . import models, telemetry, trajectories
+from . import estimation, models, telemetry, trajectories
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
@@ -36,7 +36,7 @@ from .telemetry import Telemetry
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Trajectory", "models", "simulate", "telemetry", "trajectories", "Telemetry",
+    "Model", "Trajectory", "models", "simulate", "telemetry", "trajectories", "Telemetry", "estimation",
     "aba", "rnea", "crba", "hybrid_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",

@@ -12,6 +12,7 @@ pub mod config;
 pub mod data;
 pub mod dynamics;
 pub mod error;
+pub mod estimation;
 pub mod kinematics;
 pub mod model;
 pub mod regressors;

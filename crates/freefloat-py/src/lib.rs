@@ -4,6 +4,7 @@
 mod algorithms;
 mod batch;
 mod errors;
+mod estimation;
 mod model;
 mod simulate;
 
@@ -33,5 +34,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(algorithms::aba, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::hybrid_dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
+    m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
     Ok(())
 }

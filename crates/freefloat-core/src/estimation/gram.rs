@@ -1,0 +1,74 @@
+//! Gram-matrix accumulation: the fast first pass of [`super::identify_momentum`].
+
+use nalgebra::{DMatrix, DVector, Dyn, MatrixView};
+
+/// Accumulates `[A y]ᵀ[A y]` ((n+1)², holding AᵀA, Aᵀy and yᵀy) with cache-blocked products.
+#[derive(Debug, Clone)]
+pub struct GramLs {
+    n: usize,
+    g: DMatrix<f64>,
+    rows: usize,
+}
+
+/// Cholesky factor of the normal equations, computed on equilibrated columns.
+#[derive(Debug, Clone)]
+pub struct GramFactor {
+    /// R with AᵀA = RᵀR (unscaled columns)
+    pub r: DMatrix<f64>,
+    /// semi-normal-equation solution of RᵀR x = Aᵀy
+    pub x: DVector<f64>,
+    /// κ of the column-equilibrated regressor, from the singular values of its R: what governs
+    /// the accuracy of normal equations (van der Sluis)
+    pub kappa_scaled: f64,
+}
+
+/// A `rows × cols` view of `s` with element (i, j) at `s[i·rs + j·cs]`.
+pub(super) fn strided(s: &[f64], rows: usize, cols: usize, rs: usize, cs: usize) -> StridedView<'_> {
+    MatrixView::from_slice_with_strides_generic(s, Dyn(rows), Dyn(cols), Dyn(rs), Dyn(cs))
+}
+
+pub(super) type StridedView<'a> = MatrixView<'a, f64, Dyn, Dyn, Dyn, Dyn>;
+
+impl GramLs {
+    pub fn new(n: usize) -> Self {
+        GramLs { n, g: DMatrix::zeros(n + 1, n + 1), rows: 0 }
+    }
+
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Add the first `rows` rows of `block` = `[A_b | y_b]` (column-major, n+1 columns, weighted).
+    pub fn add_augmented(&mut self, block: &DMatrix<f64>, rows: usize) {
+        let cap = block.nrows();
+        let n1 = self.n + 1;
+        let s = block.as_slice();
+        // B (rows × n1) and Bᵀ as strided views of the same buffer: one gemm, no copy
+        let b = strided(s, rows, n1, 1, cap);
+        let bt = strided(s, n1, rows, cap, 1);
+        self.g.gemm(1.0, &bt, &b, 1.0);
+        self.rows += rows;
+    }
+
+    pub fn merge(&mut self, other: &GramLs) {
+        self.g += &other.g;
+        self.rows += other.rows;
+    }
+
+    /// Factor the normal equations, or None if the Cholesky fails (numerically singular).
+    pub fn factor(&self) -> Option<GramFactor> {
+        let n = self.n;
+        let ata = self.g.view((0, 0), (n, n));
+        // equilibrate: D = √diag(AᵀA); an all-zero column is left unscaled and fails below
+        let d: Vec<f64> = (0..n).map(|k| if ata[(k, k)] > 0.0 { ata[(k, k)].sqrt() } else { 1.0 }).collect();
+        let gs = DMatrix::from_fn(n, n, |i, j| ata[(i, j)] / (d[i] * d[j]));
+        let chol = gs.cholesky()?;
+        let rs = chol.l().transpose();
+        let kappa_scaled = super::analysis::condition_number(&rs);
+        let aty = DVector::from_fn(n, |i, _| self.g[(i, n)] / d[i]);
+        let xs = chol.solve(&aty);
+        let x = DVector::from_fn(n, |i, _| xs[i] / d[i]);
+        let r = DMatrix::from_fn(n, n, |i, j| rs[(i, j)] * d[j]);
+        Some(GramFactor { r, x, kappa_scaled })
+    }
+}

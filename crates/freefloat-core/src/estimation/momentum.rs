@@ -1,0 +1,263 @@
+//! Identification from momentum (seed 001 eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
+
+use super::analysis::{check_rank, finish};
+use super::gram::{strided, GramLs};
+use super::{LsResult, StreamingLs};
+use crate::data::Data;
+use crate::error::{check_vec, FfError, Result};
+use crate::model::Model;
+use crate::regressors::momentum_regressor;
+use nalgebra::{DMatrix, DVector};
+
+/// Samples per block: 64 samples = 384 rows × (n+1) columns (≈160 kB for n = 52), big enough for
+/// the blocked Gram product to run at full speed, small enough to stay in L2.
+const BLOCK_SAMPLES: usize = 64;
+/// Normal equations are kept when the equilibrated κ is at most this: then κ²ε ≈ 2e-6, and one
+/// refinement step on the true residual brings the error down to the QR level (∝ κε).
+pub const GRAM_KAPPA_MAX: f64 = 1e5;
+/// Below this many samples a single thread is used (thread start-up would dominate).
+const PARALLEL_MIN_SAMPLES: usize = 4096;
+
+/// Which solver produced the estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// normal equations on equilibrated columns + one refinement pass (well-conditioned problems)
+    GramRefined,
+    /// streaming Householder QR (ill-conditioned problems, or when asked directly)
+    StreamingQr,
+}
+
+/// A momentum identification problem, all arrays flat and row-major over samples.
+#[derive(Debug, Clone, Copy)]
+pub struct MomentumProblem<'a> {
+    /// T·nq configurations
+    pub q: &'a [f64],
+    /// T·nv velocities
+    pub v: &'a [f64],
+    /// T·6 measured momenta [p; L] (inertial frame, about the inertial origin)
+    pub h: &'a [f64],
+    /// columns of the 6 × 10·nbodies regressor to identify (unknown bodies' kept columns)
+    pub unknown_cols: &'a [usize],
+    /// 10·nbodies standard parameters; the known bodies' momentum K·P (over the columns not in
+    /// `unknown_cols`) is moved to the right-hand side
+    pub known_params: &'a [f64],
+    /// inverse variances of the 6 momentum components (None: all 1)
+    pub weights: Option<[f64; 6]>,
+}
+
+impl MomentumProblem<'_> {
+    fn samples(&self, m: &Model) -> Result<usize> {
+        let t = self.h.len() / 6;
+        check_vec("h", self.h, 6 * t)?;
+        check_vec("q", self.q, m.nq * t)?;
+        check_vec("v", self.v, m.nv * t)?;
+        check_vec("known_params", self.known_params, 10 * m.nbodies())?;
+        let np = 10 * m.nbodies();
+        let mut seen = vec![false; np];
+        for &c in self.unknown_cols {
+            if c >= np || std::mem::replace(&mut seen[c], true) {
+                return Err(FfError::arg("unknown_cols", format!("column {c} is out of range 0..{np} or repeated")));
+            }
+        }
+        if self.unknown_cols.is_empty() {
+            return Err(FfError::arg("unknown_cols", "no parameter to identify"));
+        }
+        if let Some(w) = self.weights {
+            if w.iter().any(|x| !(*x > 0.0) || !x.is_finite()) {
+                return Err(FfError::arg("weights", "the 6 weights must be finite and > 0"));
+            }
+        }
+        if 6 * t < self.unknown_cols.len() {
+            return Err(FfError::arg("h", format!("{} rows for {} unknowns", 6 * t, self.unknown_cols.len())));
+        }
+        Ok(t)
+    }
+}
+
+/// Per-thread work buffers that turn samples into weighted blocks `[A_b | y_b]`.
+struct BlockBuilder<'a> {
+    m: &'a Model,
+    p: &'a MomentumProblem<'a>,
+    d: Data,
+    /// the 6 × 10·nbodies regressor of one sample, column-major
+    k: Vec<f64>,
+    qbuf: Vec<f64>,
+    block: DMatrix<f64>,
+    /// (column, parameter) of the known, nonzero standard parameters
+    known: Vec<(usize, f64)>,
+    sw: [f64; 6],
+}
+
+impl<'a> BlockBuilder<'a> {
+    fn new(m: &'a Model, p: &'a MomentumProblem<'a>) -> Self {
+        let n = p.unknown_cols.len();
+        let known = (0..p.known_params.len())
+            .filter(|c| p.known_params[*c] != 0.0 && !p.unknown_cols.contains(c))
+            .map(|c| (c, p.known_params[c]))
+            .collect();
+        let sw = p.weights.map_or([1.0; 6], |w| w.map(f64::sqrt));
+        BlockBuilder {
+            m,
+            p,
+            d: Data::new(m),
+            k: vec![0.0; 60 * m.nbodies()],
+            qbuf: Vec::new(),
+            block: DMatrix::zeros(6 * BLOCK_SAMPLES, n + 1),
+            known,
+            sw,
+        }
+    }
+
+    /// Regressor of sample s into the block's rows 6·slot..6·slot+6 (weighted, known part moved
+    /// to the right-hand side: y = h − K_known P_known).
+    fn fill(&mut self, s: usize, slot: usize) -> Result<()> {
+        let (m, p) = (self.m, self.p);
+        let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
+        let cols = 10 * m.nbodies();
+        let mut k = nalgebra::DMatrixViewMut::from_slice(&mut self.k, 6, cols); // column-major, as the block
+        momentum_regressor(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv], &mut k);
+        let n = p.unknown_cols.len();
+        // both K (6 × np) and the block are column-major: copy six contiguous numbers per column
+        let ks = &self.k[..];
+        let cap = self.block.nrows();
+        let bs = self.block.as_mut_slice();
+        let row0 = 6 * slot;
+        for (j, &c) in p.unknown_cols.iter().enumerate() {
+            let (src, dst) = (&ks[6 * c..6 * c + 6], &mut bs[j * cap + row0..j * cap + row0 + 6]);
+            for r in 0..6 {
+                dst[r] = self.sw[r] * src[r];
+            }
+        }
+        let mut y: [f64; 6] = std::array::from_fn(|r| p.h[6 * s + r]);
+        for &(c, pk) in &self.known {
+            for r in 0..6 {
+                y[r] -= ks[6 * c + r] * pk;
+            }
+        }
+        for r in 0..6 {
+            bs[n * cap + row0 + r] = self.sw[r] * y[r];
+        }
+        Ok(())
+    }
+
+    /// Stream samples `range` block by block into `feed(block, rows)`.
+    fn run(&mut self, range: std::ops::Range<usize>, mut feed: impl FnMut(&mut DMatrix<f64>, usize)) -> Result<()> {
+        let mut s = range.start;
+        while s < range.end {
+            let cnt = BLOCK_SAMPLES.min(range.end - s);
+            for slot in 0..cnt {
+                self.fill(s + slot, slot)?;
+            }
+            feed(&mut self.block, 6 * cnt);
+            s += cnt;
+        }
+        Ok(())
+    }
+}
+
+fn at_sample(e: FfError, s: usize) -> FfError {
+    match e {
+        FfError::Argument { name, msg } => FfError::Argument { name, msg: format!("sample {s}: {msg}") },
+        other => other,
+    }
+}
+
+/// One pass over all samples, split across threads; each thread owns an accumulator `A`.
+fn par_pass<A: Send>(
+    m: &Model,
+    p: &MomentumProblem,
+    t: usize,
+    make: impl Fn() -> A + Sync,
+    feed: impl Fn(&mut A, &mut DMatrix<f64>, usize) + Sync,
+) -> Result<Vec<A>> {
+    let threads =
+        if t < PARALLEL_MIN_SAMPLES { 1 } else { std::thread::available_parallelism().map_or(1, |x| x.get()).min(8) };
+    let chunk = t.div_ceil(threads);
+    let work = |range: std::ops::Range<usize>| -> Result<A> {
+        let mut acc = make();
+        BlockBuilder::new(m, p).run(range, |b, rows| feed(&mut acc, b, rows))?;
+        Ok(acc)
+    };
+    if threads == 1 {
+        return Ok(vec![work(0..t)?]);
+    }
+    std::thread::scope(|sc| {
+        let handles: Vec<_> =
+            (0..threads).map(|i| (i * chunk)..((i + 1) * chunk).min(t)).map(|r| sc.spawn(move || work(r))).collect();
+        handles.into_iter().map(|h| h.join().expect("estimation worker panicked")).collect()
+    })
+}
+
+/// Identify the parameters in `unknown_cols` from measured momenta, streaming over samples.
+///
+/// Pass 1 accumulates the Gram matrix and measures the equilibrated condition number κ_s. If
+/// κ_s ≤ [`GRAM_KAPPA_MAX`], pass 2 computes the true residual `y − A x̂` and corrects x̂ once
+/// (corrected semi-normal equations), giving QR-grade accuracy and the exact RSS. Otherwise pass 2
+/// is a streaming Householder QR. The tall regressor is never formed; per sample nothing is
+/// allocated. A rank-deficient problem is an error naming the unexcited combinations.
+pub fn identify_momentum(m: &Model, p: &MomentumProblem) -> Result<LsResult> {
+    identify_momentum_with(m, p, false)
+}
+
+/// As [`identify_momentum`]; `force_qr` skips the normal equations (for testing and comparison).
+pub fn identify_momentum_with(m: &Model, p: &MomentumProblem, force_qr: bool) -> Result<LsResult> {
+    let t = p.samples(m)?;
+    let n = p.unknown_cols.len();
+    if !force_qr {
+        let mut grams = par_pass(m, p, t, || GramLs::new(n), |g, b, rows| g.add_augmented(b, rows))?.into_iter();
+        let mut g = grams.next().expect("one thread");
+        grams.for_each(|o| g.merge(&o));
+        if let Some(f) = g.factor().filter(|f| f.kappa_scaled <= GRAM_KAPPA_MAX) {
+            check_rank(&f.r)?;
+            return refine(m, p, t, f.r, f.x);
+        }
+    }
+    let mut qrs = par_pass(m, p, t, || StreamingLs::new(n), |q, b, rows| q.add_augmented(b, rows))?.into_iter();
+    let mut qr = qrs.next().expect("one thread");
+    qrs.for_each(|o| qr.merge(&o));
+    qr.solve()
+}
+
+/// Residual accumulator of the refinement pass: Aᵀr and ‖r‖² for r = y − A x.
+struct Residual {
+    atr: DVector<f64>,
+    rss: f64,
+    r: DVector<f64>,
+}
+
+/// One step of iterative refinement: x ← x + (RᵀR)⁻¹ Aᵀ(y − A x), and the RSS at the new x.
+fn refine(m: &Model, p: &MomentumProblem, t: usize, r: DMatrix<f64>, x: DVector<f64>) -> Result<LsResult> {
+    let n = x.len();
+    let make = || Residual { atr: DVector::zeros(n), rss: 0.0, r: DVector::zeros(6 * BLOCK_SAMPLES) };
+    let feed = |acc: &mut Residual, b: &mut DMatrix<f64>, rows: usize| {
+        let cap = b.nrows();
+        let a = strided(b.as_slice(), rows, n, 1, cap);
+        let mut res = acc.r.rows_mut(0, rows);
+        res.copy_from(&b.view((0, n), (rows, 1)));
+        res.gemv(-1.0, &a, &x, 1.0);
+        acc.rss += res.norm_squared();
+        acc.atr.gemv_tr(1.0, &a, &res, 1.0);
+    };
+    let mut parts = par_pass(m, p, t, make, feed)?.into_iter();
+    let mut acc = parts.next().expect("one thread");
+    for o in parts {
+        acc.atr += o.atr;
+        acc.rss += o.rss;
+    }
+    let rt = r.transpose();
+    let z = rt.solve_lower_triangular(&acc.atr).ok_or_else(|| FfError::Numerical("singular factor".into()))?;
+    let delta = r.solve_upper_triangular(&z).ok_or_else(|| FfError::Numerical("singular factor".into()))?;
+    // rss(x + δ) = rss(x) − δᵀAᵀr exactly, since RᵀR δ = Aᵀr
+    let rss = (acc.rss - delta.dot(&acc.atr)).max(0.0);
+    Ok(finish(&r, x + delta, rss, 6 * t, super::Method::GramRefined))
+}
+
+/// One streaming pass that only builds the weighted blocks `[A_b | y_b]` and discards them: the
+/// regressor-building cost inside [`identify_momentum`] (per pass), for benchmarks. Returns the
+/// sum of the right-hand sides so the work cannot be optimised away.
+pub fn momentum_regressor_pass(m: &Model, p: &MomentumProblem) -> Result<f64> {
+    let t = p.samples(m)?;
+    let n = p.unknown_cols.len();
+    let parts = par_pass(m, p, t, || 0.0, |acc: &mut f64, b, rows| *acc += b.view((0, n), (rows, 1)).sum())?;
+    Ok(parts.into_iter().sum())
+}

@@ -1,0 +1,128 @@
+//! Least-squares identification from momentum (freefloat_core::estimation), streamed over samples
+//! in Rust with the GIL released; the tall regressor is never formed.
+
+use crate::batch::{model_arg, Batch};
+use crate::errors::{guard, input_err};
+use freefloat_core::estimation::{identify_momentum_with, momentum_regressor_pass, Method, MomentumProblem};
+use numpy::{IntoPyArray, PyArrayMethods};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+type Arr<'a, 'py> = &'a Bound<'py, PyAny>;
+
+/// Identify the parameters in `columns` (indices into the 10·nbodies standard parameters) from
+/// measured momenta H (T, 6), states Q (T, nq), V (T, nv). `known_params` (10·nbodies,): the known
+/// bodies' momentum K·P over the other columns is subtracted from H. `weights` (6,): inverse
+/// variances of [p; L]. method: "auto" (normal equations + refinement when well conditioned, else
+/// streaming QR) or "qr". Returns a dict: x, std, covariance, rss, dof, condition_number, rank,
+/// rows, method. Raises NumericalError naming the unexcited combinations if rank deficient.
+#[pyfunction]
+#[pyo3(signature = (model, q, v, h, columns, known_params, weights = None, method = "auto"))]
+#[allow(clippy::too_many_arguments)]
+pub fn identify_momentum<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    h: Arr<'_, 'py>,
+    columns: Vec<usize>,
+    known_params: Arr<'_, 'py>,
+    weights: Option<Arr<'_, 'py>>,
+    method: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
+    let m = &model.inner;
+    let force_qr = match method {
+        "auto" => false,
+        "qr" => true,
+        _ => return Err(input_err(format!("argument `method`: expected 'auto' or 'qr', got {method:?}"))),
+    };
+    let a = Args::new(m, q, v, h, known_params, weights)?;
+    let problem = a.problem(&columns);
+    let res = py.detach(|| guard(|| identify_momentum_with(m, &problem, force_qr)))?;
+    let n = res.x.len();
+    let d = PyDict::new(py);
+    d.set_item("x", res.x.as_slice().to_vec().into_pyarray(py))?;
+    d.set_item("std", res.std.as_slice().to_vec().into_pyarray(py))?;
+    // nalgebra is column-major; the covariance is symmetric, but transpose to be exact
+    let cov: Vec<f64> = res.covariance.transpose().as_slice().to_vec();
+    d.set_item("covariance", cov.into_pyarray(py).reshape([n, n])?)?;
+    d.set_item("rss", res.rss)?;
+    d.set_item("dof", res.dof)?;
+    d.set_item("condition_number", res.condition_number)?;
+    d.set_item("rank", res.rank)?;
+    d.set_item("rows", res.rows)?;
+    d.set_item(
+        "method",
+        if res.method == Method::GramRefined { "normal equations + refinement" } else { "streaming QR" },
+    )?;
+    Ok(d)
+}
+
+/// The arguments of a momentum identification, validated and copied out of numpy.
+struct Args {
+    q: Batch,
+    v: Batch,
+    h: Batch,
+    known: Batch,
+    weights: Option<[f64; 6]>,
+}
+
+impl Args {
+    fn new(
+        m: &freefloat_core::Model,
+        q: Arr,
+        v: Arr,
+        h: Arr,
+        known_params: Arr,
+        weights: Option<Arr>,
+    ) -> PyResult<Args> {
+        let (qb, vb, hb) = (Batch::new("Q", q, &[m.nq])?, Batch::new("V", v, &[m.nv])?, Batch::new("H", h, &[6])?);
+        if qb.rows != hb.rows || vb.rows != hb.rows || !(qb.stacked && vb.stacked && hb.stacked) {
+            return Err(input_err(format!(
+                "arguments `Q`, `V`, `H` must be stacked over the same samples: got {}, {}, {} rows",
+                qb.rows, vb.rows, hb.rows
+            )));
+        }
+        let known = Batch::new("known_params", known_params, &[10 * m.nbodies()])?;
+        let w = weights.map(|w| Batch::new("weights", w, &[6])).transpose()?;
+        let weights = w.map(|w| std::array::from_fn(|k| w.data[k]));
+        Ok(Args { q: qb, v: vb, h: hb, known, weights })
+    }
+
+    fn problem<'a>(&'a self, columns: &'a [usize]) -> MomentumProblem<'a> {
+        MomentumProblem {
+            q: &self.q.data,
+            v: &self.v.data,
+            h: &self.h.data,
+            unknown_cols: columns,
+            known_params: &self.known.data,
+            weights: self.weights,
+        }
+    }
+}
+
+/// For benchmarks: one streaming pass of `identify_momentum` that builds every block of the
+/// regressor and right-hand side and discards it (no solve). Returns the sum of the right-hand
+/// sides. Same arguments as `identify_momentum`.
+#[pyfunction]
+#[pyo3(signature = (model, q, v, h, columns, known_params, weights = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn momentum_regressor_stream<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+    v: Arr<'_, 'py>,
+    h: Arr<'_, 'py>,
+    columns: Vec<usize>,
+    known_params: Arr<'_, 'py>,
+    weights: Option<Arr<'_, 'py>>,
+) -> PyResult<f64> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
+    let m = &model.inner;
+    let a = Args::new(m, q, v, h, known_params, weights)?;
+    let problem = a.problem(&columns);
+    py.detach(|| guard(|| momentum_regressor_pass(m, &problem)))
+}

@@ -1,0 +1,148 @@
+"""Least-squares identification from momentum (python/freefloat/estimation.py, engine crate `estimation`):
+seed001_dual_arm driven by a prescribed multi-sine on the six arm joints and three wheels; exact recovery from
+noise-free momentum, consistent standard deviations under noise, agreement with numpy.linalg.lstsq on the
+explicitly built minimal regressor (eq. 26), rank deficiency reported, and the error figures (eqs. 38-39)."""
+
+import freefloat as ff
+import numpy as np
+import pytest
+from freefloat import estimation as est
+
+DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]
+
+
+def multisine(m, joints, seed, wheel_scale=20.0):
+    """prescription(t) -> (q, v, a): per joint a sum of three sines (random amplitude, frequency, phase)."""
+    rng = np.random.default_rng(seed)
+    qi = np.array([m.idx_q[m.joint_names.index(j)] for j in joints])
+    vi = np.array([m.idx_v[m.joint_names.index(j)] for j in joints])
+    amp = rng.uniform(0.2, 0.6, (len(joints), 3))  # rate amplitudes, rad/s
+    amp[[j.startswith("W") for j in joints]] *= wheel_scale
+    w = rng.uniform(0.5, 3.0, (len(joints), 3))
+    ph = rng.uniform(0.0, 2 * np.pi, (len(joints), 3))
+
+    def presc(t):
+        q, v, a = m.neutral(), np.zeros(m.nv), np.zeros(m.nv)
+        s = w * t + ph
+        q[qi] = (amp / w * np.sin(s)).sum(1)
+        v[vi] = (amp * np.cos(s)).sum(1)
+        a[vi] = (-amp * w * np.sin(s)).sum(1)
+        return q, v, a
+
+    return presc
+
+
+def run(m, joints=DRIVEN, t_final=6.0, seed=1):
+    presc = multisine(m, joints, seed)
+    q0, v0, _ = presc(0.0)
+    return ff.simulate(m, q0, v0, t_final, 1e-3, prescribed=joints, prescription=presc, record_every=10)
+
+
+@pytest.fixture(scope="module")
+def case():
+    m = ff.models.load("seed001_dual_arm")
+    mp = ff.minimal_parameters(m, method="closed-form")  # wheels are known (tagged)
+    return m, mp, run(m), mp.from_standard(m.parameters())
+
+
+def explicit(mp, tr, H, weights=None):
+    """The tall minimal regressor G_m and right-hand side of eq. 26, built explicitly, optionally weighted."""
+    G = mp.regressor(tr.q, tr.v)
+    y = H - mp.known_momentum(tr.q, tr.v)
+    if weights is not None:
+        sw = np.sqrt(weights)
+        G, y = G * sw[:, None], y * sw
+    return G.reshape(-1, mp.n_min), y.ravel()
+
+
+def test_noise_free_momentum_recovers_the_minimal_parameters(case):
+    m, mp, tr, truth = case
+    assert mp.known == [7, 8, 9]
+    for method in ("auto", "qr"):
+        r = est.least_squares(m, tr.q, tr.v, tr.momentum, mp, method=method)
+        rel = np.abs(r.estimate - truth) / np.abs(truth)
+        assert rel.max() < 1e-8, (method, rel.max())
+        assert r.rows == 6 * len(tr.t) and r.dof == r.rows - 52
+        assert r.rss < 1e-16 * np.sum(tr.momentum**2)
+    med, mx = est.relative_errors(r.estimate, truth)
+    assert mx < 1e-6 and med <= mx  # percent
+
+
+def test_equals_numpy_lstsq_on_the_explicit_regressor(case):
+    m, mp, tr, truth = case
+    rng = np.random.default_rng(3)
+    H = tr.momentum + rng.normal(scale=0.5, size=tr.momentum.shape)
+    for weights in (None, np.array([1.0, 2.0, 0.5, 4.0, 1.0, 0.25])):
+        r = est.least_squares(m, tr.q, tr.v, H, mp, weights=weights)
+        G, y = explicit(mp, tr, H, weights)
+        x, res, rank, sv = np.linalg.lstsq(G, y, rcond=None)
+        assert rank == 52
+        np.testing.assert_allclose(r.estimate, x, rtol=0, atol=1e-10 * np.abs(x).max())
+        np.testing.assert_allclose(r.rss, res[0], rtol=1e-9)
+        np.testing.assert_allclose(r.condition_number, sv[0] / sv[-1], rtol=1e-9)
+        cov = r.rss / (G.shape[0] - 52) * np.linalg.inv(G.T @ G)
+        np.testing.assert_allclose(r.covariance, cov, rtol=1e-8, atol=1e-12 * np.abs(cov).max())
+        np.testing.assert_allclose(r.std, np.sqrt(np.diag(cov)), rtol=1e-8)
+
+
+def test_noisy_momentum_gives_consistent_standard_deviations(case):
+    """With Gaussian noise of known sigma per component and weights 1/sigma^2, the normalised errors
+    (estimate - truth)/std are ~N(0, 1): their mean square is near 1 and none is extreme."""
+    m, mp, tr, truth = case
+    sigma = np.array([0.2, 0.2, 0.2, 0.5, 0.5, 0.5])
+    z2 = []
+    for seed in range(5):
+        rng = np.random.default_rng(100 + seed)
+        H = tr.momentum + rng.normal(size=tr.momentum.shape) * sigma
+        r = est.least_squares(m, tr.q, tr.v, H, mp, weights=1.0 / sigma**2)
+        z = (r.estimate - truth) / r.std
+        assert np.abs(z).max() < 5.0, np.abs(z).max()
+        assert 0.7 < r.sigma < 1.3  # weighted residuals have unit variance
+        z2.append(np.mean(z**2))
+    # 5 x 52 normalised errors: mean square ~ chi^2_260 / 260, within [0.7, 1.35] with overwhelming probability
+    assert 0.7 < np.mean(z2) < 1.35, z2
+
+
+def test_unexcited_parameters_are_reported(case):
+    """One state repeated (Fig. 4's single interval, taken to the limit) excites at most 6 combinations."""
+    m, mp, tr, _ = case
+    Q, V, H = (np.repeat(x[100:101], 20, axis=0) for x in (tr.q, tr.v, tr.momentum))
+    with pytest.raises(ff.NumericalError, match=r"rank-deficient.*rank [1-6] of 52") as e:
+        est.least_squares(m, Q, V, H, mp)
+    assert str(e.value).count("x[") >= 46  # every unexcited direction is listed with its parameter indices
+    assert "(phi_m(" in str(e.value)  # ... and the names of the minimal parameters
+
+
+def test_relative_errors_follow_eqs_38_39():
+    truth = np.array([2.0, -4.0, 10.0, 1.0])
+    estimate = np.array([2.2, -4.0, 9.0, 1.5])  # 10 %, 0 %, 10 %, 50 %
+    med, mx = est.relative_errors(estimate, truth)
+    assert med == pytest.approx(10.0) and mx == pytest.approx(50.0)
+    with pytest.raises(ff.InputError):
+        est.relative_errors([1.0, 2.0], [1.0, 0.0])
+
+
+def test_bad_arguments_are_named(case):
+    m, mp, tr, _ = case
+    with pytest.raises(ff.InputError, match="H"):
+        est.least_squares(m, tr.q, tr.v, tr.momentum[:-1], mp)
+    with pytest.raises(ff.InputError, match="weights"):
+        est.least_squares(m, tr.q, tr.v, tr.momentum, mp, weights=[1.0, 1.0, 1.0, 1.0, 1.0, -1.0])
+    with pytest.raises(ff.InputError, match="method"):
+        est.least_squares(m, tr.q, tr.v, tr.momentum, mp, method="svd")
+
+
+def test_benchmark_script_quick_runs_and_agrees(tmp_path):
+    """benches/identify_vs_numpy.py keeps working (smoke run; speed is reported, not asserted)."""
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "benches" / "identify_vs_numpy.py"
+    r = subprocess.run([sys.executable, str(script), "--quick", "--repeats", "1", "--out", str(tmp_path)],
+                       capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr[-2000:]
+    res = json.loads((tmp_path / "identify_vs_numpy.json").read_text())
+    assert res["agreement"]["estimate_max_rel"] < 1e-9 and res["agreement"]["regressor_max_rel"] < 1e-12
+    assert all(v > 0 for v in res["ratios"].values())
