@@ -14,7 +14,7 @@ def run(*args, ok=True):
     return r
 
 
-@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["params"], ["params", "minimal"]])
+@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"]])
 def test_every_command_has_help(cmd):
     r = run(*cmd, "--help")
     assert "Usage:" in r.stdout and len(r.stdout) > 200
@@ -64,3 +64,14 @@ def test_params_minimal_prints_and_writes_table4(tmp_path):
 def test_params_minimal_closed_form_refuses_prismatic():
     r = run("params", "minimal", "thesis_ch7_two_arm", "--method", "closed-form", ok=False)
     assert r.returncode == 2 and 'method="numeric"' in r.stderr and "Traceback" not in r.stderr
+
+
+def test_identify_minimal_from_a_simulation_and_from_a_file(tmp_path):
+    r = run("identify", "minimal", "seed001_dual_arm", "--simulate", "16", "--out", str(tmp_path))
+    assert "eqs. 38-39" in r.stdout
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert len(res["estimate"]) == 52 and res["median_rel_error_pct"] < 1.0
+    r2 = run("identify", "minimal", "seed001_dual_arm", "--data", str(tmp_path / "telemetry.parquet"))
+    assert "52 minimal parameters" in r2.stdout
+    bad = run("identify", "minimal", "seed001_dual_arm", ok=False)
+    assert bad.returncode == 2 and "exactly one of --data" in bad.stderr

@@ -32,11 +32,12 @@ from .minimal import MinimalParameters, minimal_parameters
 from .model import Model
 from .simulation import Trajectory, simulate
 from .telemetry import Telemetry
+from .identify import IdentificationResult, identify_minimal
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Trajectory", "models", "simulate", "telemetry", "trajectories", "Telemetry", "estimation",
+    "Model", "Trajectory", "models", "simulate", "telemetry", "trajectories", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
     "aba", "rnea", "crba", "hybrid_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",

@@ -1,0 +1,206 @@
+"""Minimal-parameter identification of a free-floating robot from its momentum (seed 001, Secs. III-IV, VI.C).
+
+    res = ff.identify_minimal(model, data)        # data: Trajectory, Telemetry, or a .parquet/.csv telemetry file
+    print(res.table(truth=model.parameters()))     # name, true value, estimate, std, relative error
+    res.save("out/")                               # results.json + figures
+
+The measured output is the total momentum: taken from the data when it has a momentum column, otherwise the
+conserved value `h0` (zero for a robot released at rest). The known bodies (reaction wheels by default) move to
+the right-hand side; their momentum is what gives the estimate its scale."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ._core import InputError
+from .estimation import LeastSquaresResult, least_squares, relative_errors
+from .minimal import MinimalParameters, minimal_parameters
+from .telemetry import Telemetry
+
+
+@dataclass
+class IdentificationResult:
+    """Identified minimal parameters with their statistics; `mp` maps them to standard parameters."""
+
+    mp: MinimalParameters
+    fit: LeastSquaresResult
+    samples: int
+
+    @property
+    def names(self) -> list[str]:
+        return list(self.mp.names)
+
+    @property
+    def estimate(self) -> np.ndarray:
+        return self.fit.estimate
+
+    @property
+    def std(self) -> np.ndarray:
+        return self.fit.std
+
+    def truth_values(self, truth) -> np.ndarray:
+        """Minimal parameters of `truth`: standard parameters (nbodies, 10) or a Model."""
+        P = truth.parameters() if hasattr(truth, "parameters") else np.asarray(truth, dtype=float)
+        return self.mp.from_standard(P)
+
+    def errors(self, truth) -> dict:
+        """Seed 001's error figures against `truth` (eqs. 38-39), in percent."""
+        med, mx = relative_errors(self.estimate, self.truth_values(truth))
+        return {"median_rel_error_pct": med, "max_rel_error_pct": mx}
+
+    def table(self, truth=None) -> str:
+        """The estimate as a printable table, with true values and relative errors when `truth` is given."""
+        tv = None if truth is None else self.truth_values(truth)
+        head = f"{'parameter':24s} " + (f"{'true':>14s} " if tv is not None else "") + f"{'estimate':>14s} {'std':>11s}"
+        lines = [head + (f" {'rel. error':>11s}" if tv is not None else "")]
+        for k, name in enumerate(self.names):
+            row = f"{name:24s} "
+            if tv is not None:
+                row += f"{tv[k]:14.6g} "
+            row += f"{self.estimate[k]:14.6g} {self.std[k]:11.3g}"
+            if tv is not None:
+                rel = abs((tv[k] - self.estimate[k]) / tv[k]) * 100 if tv[k] != 0 else float("nan")
+                row += f" {rel:10.3g}%"
+            lines.append(row)
+        lines.append(f"{len(self.names)} minimal parameters from {self.samples} samples ({self.fit.rows} rows); "
+                     f"condition number {self.fit.condition_number:.4g}; residual sigma {self.fit.sigma:.3g}; "
+                     f"solver: {self.fit.method}")
+        if tv is not None:
+            e = self.errors(truth)
+            lines.append(f"relative error (seed 001 eqs. 38-39): median {e['median_rel_error_pct']:.3g} %, "
+                         f"max {e['max_rel_error_pct']:.3g} %")
+        return "\n".join(lines)
+
+    def to_dict(self, truth=None) -> dict:
+        d = {
+            "names": self.names, "expressions": self.mp.expressions(), "estimate": self.estimate.tolist(),
+            "std": self.std.tolist(), "condition_number": self.fit.condition_number, "rows": self.fit.rows,
+            "samples": self.samples, "residual_sigma": self.fit.sigma, "solver": self.fit.method,
+            "known_bodies": [self.mp.model.body_names[i] for i in self.mp.known],
+        }
+        if truth is not None:
+            d["truth"] = self.truth_values(truth).tolist()
+            d.update(self.errors(truth))
+        return d
+
+    def save(self, directory, truth=None) -> Path:
+        """Write results.json and, with `truth`, a figure of relative errors and their 1-sigma bars."""
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "results.json").write_text(json.dumps(self.to_dict(truth), indent=2))
+        if truth is not None:
+            _plot_errors(self, self.truth_values(truth), out / "minimal_parameters.png")
+        return out
+
+
+def identify_minimal(model, data, known=None, method: str = "closed-form", h0=None, weights=None) -> IdentificationResult:
+    """Identify the minimal parameters of `model` from motion data.
+
+    data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
+    optionally momentum.<px..Lz>). known: bodies whose parameters are known (default: those tagged known/wheel).
+    method: "closed-form" (seed 001's grouping; revolute trees in modified-DH frames) or "numeric" (any tree).
+    h0: the conserved total momentum (6,) when the data has no momentum column (default zero).
+    weights: (6,) inverse variances of the momentum components."""
+    t, q, v, h = _read(model, data, h0)
+    if method == "closed-form":
+        try:
+            mp = minimal_parameters(model, "closed-form", known)
+        except Exception as e:  # a model outside the closed form's scope
+            raise InputError(f"{e} (use method='numeric')") from None
+    else:
+        mp = minimal_parameters(model, method, known)
+    fit = least_squares(model, q, v, h, mp, weights=weights)
+    return IdentificationResult(mp=mp, fit=fit, samples=len(t))
+
+
+def _read(model, data, h0):
+    if isinstance(data, (str, Path)):
+        data = Telemetry.from_file(data, model)
+    if not hasattr(data, "q") or not hasattr(data, "v"):
+        raise InputError(f"argument `data`: expected a Trajectory, a Telemetry or a file path, got {type(data).__name__}")
+    q, v = np.asarray(data.q, dtype=float), np.asarray(data.v, dtype=float)
+    if q.ndim != 2 or q.shape[1] != model.nq or v.shape != (len(q), model.nv):
+        raise InputError(f"argument `data`: q/v have shapes {q.shape}/{v.shape}, model '{model.name}' needs (T, {model.nq})/(T, {model.nv})")
+    h = getattr(data, "momentum", None)
+    if h is None or (h0 is not None):
+        h0 = np.zeros(6) if h0 is None else np.asarray(h0, dtype=float)
+        if h0.shape != (6,):
+            raise InputError(f"argument `h0`: expected 6 numbers [p; L], got shape {h0.shape}")
+        h = np.tile(h0, (len(q), 1))
+    return np.asarray(data.t, dtype=float), q, v, np.asarray(h, dtype=float)
+
+
+def _plot_errors(res: IdentificationResult, truth: np.ndarray, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    k = np.arange(len(truth))
+    scale = np.where(truth != 0, np.abs(truth), 1.0)
+    rel = (res.estimate - truth) / scale * 100
+    bar = res.std / scale * 100
+    fig, ax = plt.subplots(figsize=(12, 4.5), constrained_layout=True)
+    ax.errorbar(k + 1, rel, yerr=bar, fmt="o", ms=3, capsize=2, label="estimate − truth (± 1 std), % of |truth|")
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_yscale("symlog", linthresh=0.1)
+    ax.set_xlabel("minimal parameter index (seed 001 Table 4 order for the closed form)")
+    ax.set_ylabel("relative error [%]")
+    ax.set_title(f"{res.mp.model.name}: identified minimal parameters")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# Seed 001 Table 3 (digest B.5): start angles printed in degrees; the ranges read as radians.
+TABLE3_START_DEG = (40.661, -109.403, -78.782, 125.089, -110.0, 51.228)
+TABLE3_RANGE_RAD = (0.524, 2.51, 2.51, 2.513, 2.036, 2.5)
+
+
+def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every: int = 1, noise: bool = True,
+                    seed: int = 0, progress: bool = False, spread: bool = True):
+    """Simulated identification data for the seed 001 robot, as the paper produces it (Sec. VI.A-C).
+
+    The six arm joints and three wheels follow multi-interval cycloids (eqs. 28-31) from Table 3's seeds (wheels:
+    start 0, range 3π), one 1-s interval per direction combination, the first `n_intervals` of the 256 (an
+    un-designed trajectory: the excitation-design issue chooses and prunes them). The base floats from rest, so
+    the total momentum stays zero. With `noise`, the paper's rate noise is added and poses are rebuilt from the
+    noisy rates (Appendix C). Sampling every step (1 kHz by default) matters: rebuilding the poses from rates
+    sampled at 100 Hz alone biases the estimate (0.012 % median, 0.9 % max relative error without any noise),
+    at 1 kHz it does not. Returns (telemetry, trajectory)."""
+    from . import telemetry as tm
+    from . import trajectories as tr
+    from .simulation import simulate
+
+    arm = [j for j, tags in zip(model.joint_names, model.tags) if any(t.startswith("arm_") for t in tags)]
+    wheels = [j for j, tags in zip(model.joint_names, model.tags) if "wheel" in tags]
+    if len(arm) != 6 or len(wheels) != 3:
+        raise InputError(f"excitation_data needs the seed 001 robot (6 arm joints tagged arm_*, 3 wheels); '{model.name}' has {len(arm)} and {len(wheels)}")
+    start, range_ = tr.with_wheels(np.deg2rad(TABLE3_START_DEG), TABLE3_RANGE_RAD)
+    all_dirs = tr.direction_combinations(9)
+    if not 1 <= n_intervals <= len(all_dirs):
+        raise InputError(f"n_intervals must be between 1 and {len(all_dirs)}, got {n_intervals}")
+    pick = np.linspace(0, len(all_dirs) - 1, n_intervals).round().astype(int) if spread else np.arange(n_intervals)
+    dirs = all_dirs[pick]
+    cyc = tr.Cycloidal(start, range_, dirs)
+    joints = arm + wheels
+    traj = simulate(model, _start_configuration(model, cyc, joints), np.zeros(model.nv), cyc.duration, dt,
+                    prescribed=joints, prescription=cyc.prescription(model, joints), record_every=record_every,
+                    progress=progress)
+    telem = tm.from_trajectory(traj)
+    if noise:
+        telem = tm.add_noise(telem, model, np.random.default_rng(seed))
+    return telem, traj
+
+
+def _start_configuration(model, cyc, joints) -> np.ndarray:
+    q = model.neutral()
+    q0 = cyc.evaluate(np.array([0.0]))[0][0]
+    for name, x in zip(joints, q0):
+        q[model.idx_q[model.joint_names.index(name)]] = x
+    return q
