@@ -54,23 +54,9 @@ REFERENCE = {"regressor": 0.2, "end_to_end": 1.2}
 
 def multisine(m, seed=1):
     """prescription(t) -> (q, v, a): per driven joint a sum of three sines (smooth, persistently exciting)."""
-    rng = np.random.default_rng(seed)
-    qi = np.array([m.idx_q[m.joint_names.index(j)] for j in DRIVEN])
-    vi = np.array([m.idx_v[m.joint_names.index(j)] for j in DRIVEN])
-    amp = rng.uniform(0.2, 0.6, (len(DRIVEN), 3))
-    amp[6:] *= 20.0  # wheels spin faster than the arm joints
-    w = rng.uniform(0.5, 3.0, (len(DRIVEN), 3))
-    ph = rng.uniform(0.0, 2 * np.pi, (len(DRIVEN), 3))
-
-    def presc(t):
-        q, v, a = m.neutral(), np.zeros(m.nv), np.zeros(m.nv)
-        s = w * t + ph
-        q[qi] = (amp / w * np.sin(s)).sum(1)
-        v[vi] = (amp * np.cos(s)).sum(1)
-        a[vi] = (-amp * w * np.sin(s)).sum(1)
-        return q, v, a
-
-    return presc
+    traj = ff.trajectories.MultiSine.random(len(DRIVEN), seed)
+    traj.amp[6:] *= 20.0  # wheels spin faster than the arm joints
+    return traj.prescription(m, DRIVEN)
 
 
 def make_data(m, seconds):

@@ -13,23 +13,9 @@ DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]
 
 def multisine(m, joints, seed, wheel_scale=20.0):
     """prescription(t) -> (q, v, a): per joint a sum of three sines (random amplitude, frequency, phase)."""
-    rng = np.random.default_rng(seed)
-    qi = np.array([m.idx_q[m.joint_names.index(j)] for j in joints])
-    vi = np.array([m.idx_v[m.joint_names.index(j)] for j in joints])
-    amp = rng.uniform(0.2, 0.6, (len(joints), 3))  # rate amplitudes, rad/s
-    amp[[j.startswith("W") for j in joints]] *= wheel_scale
-    w = rng.uniform(0.5, 3.0, (len(joints), 3))
-    ph = rng.uniform(0.0, 2 * np.pi, (len(joints), 3))
-
-    def presc(t):
-        q, v, a = m.neutral(), np.zeros(m.nv), np.zeros(m.nv)
-        s = w * t + ph
-        q[qi] = (amp / w * np.sin(s)).sum(1)
-        v[vi] = (amp * np.cos(s)).sum(1)
-        a[vi] = (-amp * w * np.sin(s)).sum(1)
-        return q, v, a
-
-    return presc
+    traj = ff.trajectories.MultiSine.random(len(joints), seed)
+    traj.amp[[j.startswith("W") for j in joints]] *= wheel_scale
+    return traj.prescription(m, joints)
 
 
 def run(m, joints=DRIVEN, t_final=6.0, seed=1):

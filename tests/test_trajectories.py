@@ -153,3 +153,14 @@ def test_with_wheels_appends_seed_values():
     s, r = tr.with_wheels([0.1, 0.2], [0.3, 0.4])
     np.testing.assert_array_equal(s, [0.1, 0.2, 0, 0, 0])
     np.testing.assert_array_equal(r, [0.3, 0.4, 3 * np.pi, 3 * np.pi, 3 * np.pi])
+
+
+def test_multisine_derivatives_are_consistent():
+    traj = tr.MultiSine.random(4, 3)
+    t = np.linspace(0.0, 5.0, 2001)
+    q, qd, qdd = traj.evaluate(t)
+    h = t[1] - t[0]
+    np.testing.assert_allclose((q[2:] - q[:-2]) / (2 * h), qd[1:-1], atol=1e-5)
+    np.testing.assert_allclose((qd[2:] - qd[:-2]) / (2 * h), qdd[1:-1], atol=1e-4)
+    with pytest.raises(ff.InputError, match="positive"):
+        tr.MultiSine([[1.0]], [[0.0]], [[0.0]])

@@ -85,6 +85,33 @@ class _JointTrajectory:
         return f
 
 
+class MultiSine(_JointTrajectory):
+    """Per joint a sum of sines in the rate: qd_j(t) = Σ_k A_jk cos(w_jk t + φ_jk), so
+    q_j(t) = Σ_k A_jk / w_jk sin(w_jk t + φ_jk). Smooth and persistently exciting; a quick way to excite a robot
+    when no designed trajectory is at hand. `amplitude`, `frequency` (rad/s, > 0) and `phase` are (n, K)."""
+
+    def __init__(self, amplitude, frequency, phase):
+        self.amp, self.w, self.ph = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (amplitude, frequency, phase))
+        if not (self.amp.shape == self.w.shape == self.ph.shape):
+            raise InputError(f"MultiSine: amplitude, frequency and phase must share a shape, got {self.amp.shape}, {self.w.shape}, {self.ph.shape}")
+        if np.any(self.w <= 0):
+            raise InputError("MultiSine: frequencies must be positive")
+        self.n = self.amp.shape[0]
+
+    @classmethod
+    def random(cls, n: int, rng, terms: int = 3, amplitude=(0.2, 0.6), frequency=(0.5, 3.0)) -> "MultiSine":
+        """Random amplitudes (rad/s), frequencies (rad/s) and phases, uniform in the given ranges."""
+        rng = np.random.default_rng(rng)
+        return cls(rng.uniform(*amplitude, (n, terms)), rng.uniform(*frequency, (n, terms)),
+                   rng.uniform(0.0, 2 * np.pi, (n, terms)))
+
+    def evaluate(self, t):
+        t = np.atleast_1d(np.asarray(t, dtype=float))[:, None, None]
+        s = self.w * t + self.ph
+        return ((self.amp / self.w * np.sin(s)).sum(2), (self.amp * np.cos(s)).sum(2),
+                (-self.amp * self.w * np.sin(s)).sum(2))
+
+
 class Cycloidal(_JointTrajectory):
     """Multi-interval cycloidal joint trajectory of seed 001, eqs. 28–31.
 
