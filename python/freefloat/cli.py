@@ -301,7 +301,7 @@ def identify_group():
 @click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="closed-form", show_default=True,
               help="Minimal-parameter set: seed 001's closed form (revolute trees in modified-DH frames) or numeric (any robot).")
 @click.option("--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel').")
-@click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz] when the data has no momentum column (default zero).")
+@click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns (default: those, else zero).")
 @click.option("--truth/--no-truth", default=True, show_default=True,
               help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).")
 @click.option("--out", help="Directory for results.json and the error figure (and the simulated telemetry).")

@@ -103,7 +103,8 @@ def identify_minimal(model, data, known=None, method: str = "closed-form", h0=No
     data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
     optionally momentum.<px..Lz>). known: bodies whose parameters are known (default: those tagged known/wheel).
     method: "closed-form" (seed 001's grouping; revolute trees in modified-DH frames) or "numeric" (any tree).
-    h0: the conserved total momentum (6,) when the data has no momentum column (default zero).
+    h0: the conserved total momentum (6,); used when the data has no momentum column (then zero if not given),
+    and overriding the data's column when given.
     weights: (6,) inverse variances of the momentum components."""
     t, q, v, h = _read(model, data, h0)
     if method == "closed-form":
