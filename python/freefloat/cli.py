@@ -188,7 +188,7 @@ def demo_cmd(out, t_final):
        paper's rate noise, then the 52 minimal parameters from the momentum model; prints the paper's
        error figures and plots every parameter's error."""
     m = models.load("seed001_dual_arm")
-    arm = [j for j, tags in zip(m.joint_names, m.tags) if any(t.startswith("arm_") for t in tags)]
+    arm = m.joints_tagged("arm_")
     idx = [m.idx_q[m.joint_names.index(j)] for j in arm]
     vidx = [m.idx_v[m.joint_names.index(j)] for j in arm]
     amp = np.deg2rad([40, 30, 45, -40, 25, -35])

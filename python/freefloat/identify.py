@@ -136,10 +136,9 @@ def _read(model, data, h0):
 
 
 def _plot_errors(res: IdentificationResult, truth: np.ndarray, path: Path) -> None:
-    import matplotlib
+    from .plots import _plt
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _plt()
 
     k = np.arange(len(truth))
     scale = np.where(truth != 0, np.abs(truth), 1.0)
@@ -178,8 +177,7 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
     from . import trajectories as tr
     from .simulation import simulate
 
-    arm = [j for j, tags in zip(model.joint_names, model.tags) if any(t.startswith("arm_") for t in tags)]
-    wheels = [j for j, tags in zip(model.joint_names, model.tags) if "wheel" in tags]
+    arm, wheels = model.joints_tagged("arm_"), model.joints_tagged("wheel")
     if len(arm) != 6 or len(wheels) != 3:
         raise InputError(f"excitation_data needs the seed 001 robot (6 arm joints tagged arm_*, 3 wheels); '{model.name}' has {len(arm)} and {len(wheels)}")
     start, range_ = tr.with_wheels(np.deg2rad(TABLE3_START_DEG), TABLE3_RANGE_RAD)
@@ -190,18 +188,11 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
     dirs = all_dirs[pick]
     cyc = tr.Cycloidal(start, range_, dirs)
     joints = arm + wheels
-    traj = simulate(model, _start_configuration(model, cyc, joints), np.zeros(model.nv), cyc.duration, dt,
-                    prescribed=joints, prescription=cyc.prescription(model, joints), record_every=record_every,
-                    progress=progress)
+    presc = cyc.prescription(model, joints)
+    q0, v0, _ = presc(0.0)  # at rest at t = 0 (cycloids are rest-to-rest)
+    traj = simulate(model, q0, v0, cyc.duration, dt, prescribed=joints, prescription=presc,
+                    record_every=record_every, progress=progress)
     telem = tm.from_trajectory(traj)
     if noise:
         telem = tm.add_noise(telem, model, np.random.default_rng(seed))
     return telem, traj
-
-
-def _start_configuration(model, cyc, joints) -> np.ndarray:
-    q = model.neutral()
-    q0 = cyc.evaluate(np.array([0.0]))[0][0]
-    for name, x in zip(joints, q0):
-        q[model.idx_q[model.joint_names.index(name)]] = x
-    return q

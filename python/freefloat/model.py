@@ -140,6 +140,10 @@ class Model:
             out += [f"{owner}.{p}" for p in parts] if parts else ([owner] if n == 1 else [])
         return out
 
+    def joints_tagged(self, prefix: str) -> list[str]:
+        """Names of the joints whose child body carries a tag starting with `prefix` (e.g. "arm_", "wheel")."""
+        return [j for j, tags in zip(self.joint_names, self.tags) if any(t.startswith(prefix) for t in tags)]
+
     def body_index(self, name: str) -> int:
         try:
             return self.body_names.index(name)

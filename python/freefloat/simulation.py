@@ -199,18 +199,11 @@ def _bar_callback(bar):
 
 def _radius(model: Model, q) -> float:
     """Largest distance of a body's centre of mass from the system's, at q (a length scale)."""
+    from ._rotations import quat_to_matrix
     from .algorithms import center_of_mass, forward_kinematics
 
     fk = forward_kinematics(model, q)
-    com = center_of_mass(model, q)
     P = model.parameters()
-    best = 0.0
-    for i in range(model.nbodies):
-        if P[i, 0] > 0:
-            x, y, z, w = fk[i, 3:]
-            R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                          [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                          [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
-            c = fk[i, :3] + R @ (P[i, 1:4] / P[i, 0])
-            best = max(best, float(np.linalg.norm(c - com)))
-    return best
+    massive = P[:, 0] > 0
+    coms = fk[massive, :3] + np.einsum("bij,bj->bi", quat_to_matrix(fk[massive, 3:7]), P[massive, 1:4] / P[massive, :1])
+    return float(np.linalg.norm(coms - center_of_mass(model, q), axis=1).max())

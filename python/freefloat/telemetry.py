@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ._core import InputError
+from ._rotations import quat_to_matrix
 from .simulation import MOMENTUM_NAMES
 
 #: Noise levels of seed 001 Sec. VI.C (digest B.6): base linear velocity 50 µm/s, base angular
@@ -250,7 +251,7 @@ def integrate_poses(model, t, v, q0) -> np.ndarray:
     if nb == 6:
         quats = _integrate_attitude(q0[3:7], v[:, 3:6], dt[:, 0])
         q[:, 3:7] = quats
-        lin = np.einsum("kij,kj->ki", _quat_to_matrix(quats), v[:, 0:3])
+        lin = np.einsum("kij,kj->ki", quat_to_matrix(quats), v[:, 0:3])
         q[1:, 0:3] = q0[0:3] + np.cumsum((lin[:-1] + lin[1:]) * dt / 2, axis=0)
     elif nb == 3:
         q[1:, 2] = q0[2] + np.cumsum((v[:-1, 2] + v[1:, 2]) * dt[:, 0] / 2)
@@ -308,15 +309,6 @@ def _integrate_attitude(quat0, omega, dt) -> np.ndarray:
         out[k + 1] = x, y, z, w
     return out
 
-
-def _quat_to_matrix(Q) -> np.ndarray:
-    """Rotation matrices (T, 3, 3), base to inertial, from quaternions (T, 4) xyzw."""
-    x, y, z, w = Q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
 
 
 def from_trajectory(traj) -> Telemetry:
