@@ -4,7 +4,10 @@ import json
 import subprocess
 import sys
 
+import numpy as np
 import pytest
+
+import freefloat as ff
 
 
 def run(*args, ok=True):
@@ -75,3 +78,18 @@ def test_identify_minimal_from_a_simulation_and_from_a_file(tmp_path):
     assert "52 minimal parameters" in r2.stdout
     bad = run("identify", "minimal", "seed001_dual_arm", ok=False)
     assert bad.returncode == 2 and "exactly one of --data" in bad.stderr
+
+
+def test_identify_minimal_full_urdf_and_weights(tmp_path):
+    r = run("identify", "minimal", "seed001_dual_arm_consistent", "--simulate", "16", "--weights", "auto", "--full",
+            "--prior", "seed001_dual_arm_offset", "--out", str(tmp_path))
+    assert "physically consistent" in r.stdout
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["consistent"]["max_rel_deviation"] < 1e-5
+    # The URDF written back loads without allow_nonphysical and has the identified momentum model.
+    m = ff.Model.from_urdf(tmp_path / "identified.urdf")
+    truth = ff.models.load("seed001_dual_arm_consistent")
+    mp = ff.minimal_parameters(truth, "closed-form")
+    np.testing.assert_allclose(mp.from_standard(m.parameters()), res["estimate"], rtol=1e-4)
+    bad = run("identify", "minimal", "seed001_dual_arm", "--simulate", "16", "--weights", "1,2", ok=False)
+    assert bad.returncode == 2 and "--weights" in bad.stderr

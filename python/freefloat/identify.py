@@ -4,8 +4,9 @@
     print(res.table(truth=model.parameters()))     # name, true value, estimate, std, relative error
     res.save("out/")                               # results.json + figures
 
-The measured output is the total momentum: taken from the data when it has a momentum column, otherwise the
-conserved value `h0` (zero for a robot released at rest). The known bodies (reaction wheels by default) move to
+The measured output is the total momentum: taken from the data when it has momentum columns, otherwise the time
+integral of its external-wrench columns (thrusters firing, a contact), otherwise the conserved value `h0` (zero for
+a robot released at rest). The known bodies (reaction wheels by default) move to
 the right-hand side; their momentum is what gives the estimate its scale."""
 
 from __future__ import annotations
@@ -101,11 +102,13 @@ def identify_minimal(model, data, known=None, method: str = "closed-form", h0=No
     """Identify the minimal parameters of `model` from motion data.
 
     data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
-    optionally momentum.<px..Lz>). known: bodies whose parameters are known (default: those tagged known/wheel).
+    optionally momentum.<px..Lz> or wrench.<fx..mz>). known: bodies whose parameters are known (default: those
+    tagged known/wheel).
     method: "closed-form" (seed 001's grouping; revolute trees in modified-DH frames) or "numeric" (any tree).
-    h0: the conserved total momentum (6,); used when the data has no momentum column (then zero if not given),
-    and overriding the data's column when given.
-    weights: (6,) inverse variances of the momentum components."""
+    h0: the total momentum at the start (6,). Without momentum columns it is conserved (zero if not given), or,
+    with wrench columns, the start of their integral; given explicitly, it overrides a momentum column.
+    weights: (6,) inverse variances of the momentum components, or "auto": solve once unweighted, estimate each
+    component's residual variance, and solve again with their inverses (two-step feasible weighted LS)."""
     t, q, v, h = _read(model, data, h0)
     if method == "closed-form":
         try:
@@ -114,8 +117,24 @@ def identify_minimal(model, data, known=None, method: str = "closed-form", h0=No
             raise InputError(f"{e} (use method='numeric')") from None
     else:
         mp = minimal_parameters(model, method, known)
+    if isinstance(weights, str):
+        if weights != "auto":
+            raise InputError(f"argument `weights`: expected six inverse variances or 'auto', got {weights!r}")
+        first = least_squares(model, q, v, h, mp)
+        weights = 1.0 / np.maximum(component_variances(mp, q, v, h, first.estimate), 1e-300)
     fit = least_squares(model, q, v, h, mp, weights=weights)
     return IdentificationResult(mp=mp, fit=fit, samples=len(t))
+
+
+def component_variances(mp, q, v, h, phi, chunk: int = 4096) -> np.ndarray:
+    """(6,) mean square residual of each momentum component, h − K_min φ − known momentum, over the samples
+    (computed in chunks so the stacked regressor is never formed whole)."""
+    ss = np.zeros(6)
+    for k in range(0, len(q), chunk):
+        qs, vs = q[k:k + chunk], v[k:k + chunk]
+        r = h[k:k + chunk] - mp.regressor(qs, vs) @ phi - mp.known_momentum(qs, vs)
+        ss += np.sum(r * r, axis=0)
+    return ss / max(len(q), 1)
 
 
 def _read(model, data, h0):
@@ -127,11 +146,14 @@ def _read(model, data, h0):
     if q.ndim != 2 or q.shape[1] != model.nq or v.shape != (len(q), model.nv):
         raise InputError(f"argument `data`: q/v have shapes {q.shape}/{v.shape}, model '{model.name}' needs (T, {model.nq})/(T, {model.nv})")
     h = getattr(data, "momentum", None)
-    if h is None or (h0 is not None):
-        h0 = np.zeros(6) if h0 is None else np.asarray(h0, dtype=float)
+    if h0 is not None:
+        h0 = np.asarray(h0, dtype=float)
         if h0.shape != (6,):
             raise InputError(f"argument `h0`: expected 6 numbers [p; L], got shape {h0.shape}")
-        h = np.tile(h0, (len(q), 1))
+    if getattr(data, "wrench", None) is not None and (h is None or h0 is not None):
+        h = data.integrated_momentum(h0)  # external impulses integrated from h0 (zero: released at rest)
+    elif h is None or h0 is not None:
+        h = np.tile(np.zeros(6) if h0 is None else h0, (len(q), 1))
     return np.asarray(data.t, dtype=float), q, v, np.asarray(h, dtype=float)
 
 

@@ -4,7 +4,9 @@ seed 001 (Sec. VI.C and Appendix C): white Gaussian noise on the measured rates 
 integrating those noisy rates.
 
 Columns are named like `Trajectory.to_parquet`: `t`, `q.<label>` for `model.q_labels()` and `v.<label>`
-for `model.v_labels()`, optionally `momentum.<px…Lz>`. Conventions (ARCHITECTURE.md): q = [base position,
+for `model.v_labels()`, optionally `momentum.<px…Lz>` (the total momentum, when it is measured or known) or
+`wrench.<fx…mz>` (the external wrench on the robot — thrusters, contact — in the inertial frame with the moment
+about the inertial origin; the momentum is then its time integral, see `Telemetry.integrated_momentum`). Conventions (ARCHITECTURE.md): q = [base position,
 base quaternion xyzw, joints], v = [base linear, base angular velocity in the BASE frame, joint rates]."""
 
 from __future__ import annotations
@@ -18,6 +20,9 @@ import numpy as np
 from ._core import InputError
 from ._rotations import quat_to_matrix
 from .simulation import MOMENTUM_NAMES
+
+#: external wrench columns: force, then moment about the inertial origin, both in the inertial frame
+WRENCH_NAMES = ["fx", "fy", "fz", "mx", "my", "mz"]
 
 #: Noise levels of seed 001 Sec. VI.C (digest B.6): base linear velocity 50 µm/s, base angular
 #: velocity 80 µrad/s, joint rates 50 µrad/s (standard deviations of zero-mean white Gaussian noise).
@@ -40,6 +45,7 @@ class Telemetry:
     q_labels: list = field(default_factory=list)
     v_labels: list = field(default_factory=list)
     momentum: np.ndarray | None = None
+    wrench: np.ndarray | None = None
 
     def __post_init__(self):
         # Check shapes once here so every later step can trust them; name the offending field.
@@ -62,6 +68,22 @@ class Telemetry:
             self.momentum = np.asarray(self.momentum, dtype=float)
             if self.momentum.shape != (n, 6):
                 raise InputError(f"Telemetry: momentum must be ({n}, 6), got shape {self.momentum.shape}")
+        if self.wrench is not None:
+            self.wrench = np.asarray(self.wrench, dtype=float)
+            if self.wrench.shape != (n, 6):
+                raise InputError(f"Telemetry: wrench must be ({n}, 6), got shape {self.wrench.shape}")
+
+    def integrated_momentum(self, h0=None) -> np.ndarray:
+        """(T, 6) total momentum h(t) = h0 + ∫₀ᵗ w dt from the recorded external wrench w = [f; m about the
+        inertial origin] (trapezoidal rule; exact for a piecewise-linear wrench), starting at h0 (default
+        zero: released at rest).  This is seed 001's "integrated external impulses" right-hand side."""
+        if self.wrench is None:
+            raise InputError("Telemetry.integrated_momentum: this telemetry has no wrench.* columns")
+        h0 = np.zeros(6) if h0 is None else np.asarray(h0, dtype=float)
+        if h0.shape != (6,):
+            raise InputError(f"argument `h0`: expected 6 numbers [p; L], got shape {h0.shape}")
+        steps = 0.5 * (self.wrench[1:] + self.wrench[:-1]) * np.diff(self.t)[:, None]
+        return h0 + np.vstack([np.zeros(6), np.cumsum(steps, axis=0)])
 
     def __len__(self) -> int:
         return len(self.t)
@@ -75,12 +97,14 @@ class Telemetry:
 
     # -- files ---------------------------------------------------------------------------------------
     def columns(self) -> dict:
-        """Named columns in file order: t, q.*, v.*, then momentum.* if present."""
+        """Named columns in file order: t, q.*, v.*, then momentum.* and wrench.* if present."""
         cols = {"t": self.t}
         cols.update({f"q.{n}": self.q[:, j] for j, n in enumerate(self.q_labels)})
         cols.update({f"v.{n}": self.v[:, j] for j, n in enumerate(self.v_labels)})
         if self.momentum is not None:
             cols.update({f"momentum.{n}": self.momentum[:, j] for j, n in enumerate(MOMENTUM_NAMES)})
+        if self.wrench is not None:
+            cols.update({f"wrench.{n}": self.wrench[:, j] for j, n in enumerate(WRENCH_NAMES)})
         return cols
 
     def to_parquet(self, path) -> None:
@@ -159,8 +183,10 @@ def _from_columns(cols: dict, model, where: str) -> Telemetry:
     missing = [c for c in need if c not in cols]
     if missing:
         raise InputError(f"{where}: missing columns for model '{model.name}': {', '.join(missing)}")
-    has_h = all(f"momentum.{n}" in cols for n in MOMENTUM_NAMES)
-    used = need + ([f"momentum.{n}" for n in MOMENTUM_NAMES] if has_h else [])
+    has_h = _optional_block(cols, "momentum", MOMENTUM_NAMES, where)
+    has_w = _optional_block(cols, "wrench", WRENCH_NAMES, where)
+    used = need + ([f"momentum.{n}" for n in MOMENTUM_NAMES] if has_h else []) + \
+        ([f"wrench.{n}" for n in WRENCH_NAMES] if has_w else [])
     _check_finite(cols, used, where)
     t = cols["t"]
     _check_time(t, where)
@@ -168,7 +194,17 @@ def _from_columns(cols: dict, model, where: str) -> Telemetry:
         t=t.copy(), q=np.column_stack([cols[f"q.{n}"] for n in ql]), v=np.column_stack([cols[f"v.{n}"] for n in vl]),
         model_name=model.name, q_labels=ql, v_labels=vl,
         momentum=np.column_stack([cols[f"momentum.{n}"] for n in MOMENTUM_NAMES]) if has_h else None,
+        wrench=np.column_stack([cols[f"wrench.{n}"] for n in WRENCH_NAMES]) if has_w else None,
     )
+
+
+def _optional_block(cols: dict, prefix: str, names: list, where: str) -> bool:
+    """True when all of prefix.<names> are present, False when none are; a partial block is an error."""
+    have = [n for n in names if f"{prefix}.{n}" in cols]
+    if have and len(have) != len(names):
+        missing = [f"{prefix}.{n}" for n in names if n not in have]
+        raise InputError(f"{where}: incomplete {prefix} columns: missing {', '.join(missing)}")
+    return bool(have)
 
 
 def _check_finite(cols: dict, names: list, where: str) -> None:
