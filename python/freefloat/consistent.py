@@ -129,6 +129,22 @@ def consistent_parameters(mp, phi, covariance=None, prior=None, solver: str | No
     )
 
 
+def representative_parameters(mp, phi, prior=None) -> np.ndarray:
+    """(nbodies, 10) standard parameters that map exactly to `phi`, the smallest change of `prior` (default:
+    mp.model's parameters) that does: P_u = P0 + Bᵀ(BBᵀ)⁻¹(φ − B P0).  Linear and exact, but not necessarily
+    physically consistent — use it when only momentum and dynamics matter (prediction), e.g. for a robot whose
+    true parameters are themselves inconsistent (seed 001 Table 2)."""
+    phi = np.asarray(phi, dtype=float)
+    if phi.shape != (mp.n_min,) or not np.all(np.isfinite(phi)):
+        raise InputError(f"argument `phi`: expected {mp.n_min} finite numbers, got shape {phi.shape}")
+    P = _prior_parameters(mp.model, prior)
+    P[mp.known] = mp.model.parameters()[mp.known]
+    B = mp.matrix
+    P0 = P[mp.unknown].ravel()
+    P[mp.unknown] = (P0 + B.T @ np.linalg.solve(B @ B.T, phi - B @ P0)).reshape(len(mp.unknown), 10)
+    return P
+
+
 def _standard_from_pseudo(J):
     """cvxpy expression: J -> [m, h, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] with I = tr(Σ) 1 − Σ."""
     import cvxpy as cp
@@ -176,14 +192,20 @@ def _nearest_consistent(J) -> np.ndarray:
 
 
 def _solve(problem, solvers, what) -> str:
+    import warnings
+
     last = None
     for s in solvers:
         try:
-            problem.solve(solver=s)
+            with warnings.catch_warnings():  # an inaccurate solve is reported in the returned name instead
+                warnings.simplefilter("ignore", UserWarning)
+                problem.solve(solver=s)
         except Exception as e:  # solver missing or failed: try the next one
             last = e
             continue
-        if problem.status in ("optimal", "optimal_inaccurate"):
+        if problem.status == "optimal":
             return s
+        if problem.status == "optimal_inaccurate":
+            return f"{s} (inaccurate)"
         last = problem.status
     raise NumericalError(f"consistent_parameters: the {what} program was not solved ({last})")
