@@ -17,6 +17,14 @@ from .simulation import Trajectory, simulate
 MODEL_HELP = "a built-in robot name (see `freefloat models`) or a .yaml / .urdf file"
 
 
+def _scenario(name: str) -> Path:
+    """A file shipped in the repository's scenarios/ directory (next to the package source)."""
+    p = Path(__file__).resolve().parents[2] / "scenarios" / name
+    if not p.exists():
+        raise click.ClickException(f"scenario file {p} not found (the demo runs from a source checkout)")
+    return p
+
+
 def load_model(spec: str, base: str = "free") -> Model:
     """A built-in name, or a path to a YAML or URDF file."""
     p = Path(spec)
@@ -184,9 +192,10 @@ def demo_cmd(out, t_final):
     1. Simulation: the robot floats freely while its six arm joints follow a smooth prescribed manoeuvre
        (hybrid dynamics: the base responds, the joint torques needed are recorded); prints and plots how
        well momentum and energy are conserved.
-    2. Identification: 32 one-second excitation intervals (cycloids from the paper's seeds) with the
-       paper's rate noise, then the 52 minimal parameters from the momentum model; prints the paper's
-       error figures and plots every parameter's error."""
+    2. Identification: the exciting trajectory designed by `freefloat excite` (scenarios/) with the paper's
+       rate noise, then the 52 minimal parameters from the momentum model; prints the paper's error
+       figures and plots every parameter's error.
+    3. Validation by prediction (seed 001 Sec. VI.D): true and identified robots along a Fourier trajectory."""
     m = models.load("seed001_dual_arm")
     arm = m.joints_tagged("arm_")
     idx = [m.idx_q[m.joint_names.index(j)] for j in arm]
@@ -220,8 +229,12 @@ def demo_cmd(out, t_final):
 
     from . import identify as idf
 
-    click.echo("\nidentification: 32 excitation intervals with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)")
-    telem, _ = idf.excitation_data(m, n_intervals=32, progress=True)
+    from .excitation import load_trajectory
+
+    designed, joints = load_trajectory(_scenario("seed001_exciting_trajectory.json"))
+    click.echo(f"\nidentification: the designed exciting trajectory ({designed.n_intervals} intervals, `freefloat excite`) "
+               "with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)")
+    telem, _ = idf.trajectory_data(m, designed, joints, progress=True)
     plain = idf.identify_minimal(m, telem).errors(m)
     res = idf.identify_minimal(m, telem, rate_noise=(50e-6, 80e-6, 50e-6))
     e = res.errors(m)
@@ -312,6 +325,9 @@ def identify_group():
                                                   "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).")
 @click.option("--simulate", "n_sim", type=int, help="Instead of --data: simulate N one-second excitation intervals of the "
                                                      "seed 001 robot (cycloids from the paper's Table 3 seeds) with the paper's rate noise.")
+@click.option("--trajectory", "traj_file", type=click.Path(exists=True, dir_okay=False),
+              help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
+                   "`freefloat excite`) with the paper's rate noise, and identify from that.")
 @click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="closed-form", show_default=True,
               help="Minimal-parameter set: seed 001's closed form (revolute trees in modified-DH frames) or numeric (any robot).")
 @click.option("--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel').")
@@ -332,7 +348,7 @@ def identify_group():
 @click.option("--truth/--no-truth", default=True, show_default=True,
               help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).")
 @click.option("--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf).")
-def identify_minimal_cmd(model, data, n_sim, method, known, h0, weights, rate_noise, full, prior, validate, truth, out):
+def identify_minimal_cmd(model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, out):
     """Estimate the minimal inertial parameters of MODEL from motion data.
 
     The robot floats freely, so its total momentum is conserved (zero when released at rest) or changes by the
@@ -346,12 +362,12 @@ def identify_minimal_cmd(model, data, n_sim, method, known, h0, weights, rate_no
     from . import identify as idf
 
     m = load_model(model)
-    if (data is None) == (n_sim is None):
-        raise click.UsageError("give exactly one of --data FILE and --simulate N")
+    if sum(x is not None for x in (data, n_sim, traj_file)) != 1:
+        raise click.UsageError("give exactly one of --data FILE, --simulate N and --trajectory FILE")
     known_list = None if known is None else [k for k in known.split(",") if k]
     h = None if h0 is None else parse_vector(h0, 6, "--h0", np.zeros(6))
     w = None if weights is None else ("auto" if weights.strip() == "auto" else parse_vector(weights, 6, "--weights", None))
-    if rate_noise is None and n_sim is not None and w is None:
+    if rate_noise is None and (n_sim is not None or traj_file is not None) and w is None:
         rate_noise = "paper"  # the simulated data carries the paper's noise, so its levels are known
     if rate_noise is not None and rate_noise.strip() == "paper":
         from .telemetry import SIGMA_ANG, SIGMA_JOINT, SIGMA_LIN
@@ -361,6 +377,15 @@ def identify_minimal_cmd(model, data, n_sim, method, known, h0, weights, rate_no
     if n_sim is not None:
         click.echo(f"simulating {n_sim} excitation intervals of {m.name} with the paper's rate noise ...")
         data, _ = idf.excitation_data(m, n_intervals=n_sim, progress=True)
+        if out:
+            Path(out).mkdir(parents=True, exist_ok=True)
+            data.to_parquet(Path(out) / "telemetry.parquet")
+    if traj_file is not None:
+        from .excitation import load_trajectory
+
+        trajectory, joints = load_trajectory(traj_file)
+        click.echo(f"simulating {m.name} along {traj_file} ({trajectory.duration:g} s) with the paper's rate noise ...")
+        data, _ = idf.trajectory_data(m, trajectory, joints, progress=True)
         if out:
             Path(out).mkdir(parents=True, exist_ok=True)
             data.to_parquet(Path(out) / "telemetry.parquet")
@@ -400,6 +425,58 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
             pred.save(out)
             click.echo(f"  wrote {out}/prediction.json and {out}/prediction_errors.png")
     return extra
+
+
+@main.command("excite")
+@click.argument("model")
+@click.option("--guess", help="Robot (built-in name or file) whose inertial parameters are the rough guess the design "
+                              "uses for the base response (default: MODEL's own). For seed 001: seed001_dual_arm_offset.")
+@click.option("--weight", type=float, default=None, help="w of eq. 32 (default 1000 rad²/s², see docs/excitation.md).")
+@click.option("--min-gain", type=float, default=None,
+              help="Relative decrease of the condition number that counts as an improvement in the pruning "
+                   "(default 0.01; 0 is Algorithm 1 as printed, which keeps nearly every interval).")
+@click.option("--maxiter", type=int, default=100, show_default=True, help="SQP iterations per optimisation step.")
+@click.option("--q-limit", type=float, default=270.0, show_default=True, help="Arm joint position limit ±[deg].")
+@click.option("--rate-limit", type=float, default=5.0265, show_default=True, help="Arm joint rate limit [rad/s] (1.6π).")
+@click.option("--acc-limit", type=float, default=15.791, show_default=True, help="Arm joint acceleration limit [rad/s²] (1.6π²).")
+@click.option("--compare/--no-compare", default=False, show_default=True,
+              help="Then simulate MODEL along the designed trajectory, along the same number of un-designed intervals "
+                   "and along the un-pruned step-1 trajectory, with the paper's noise, and compare identification errors.")
+@click.option("--out", default="freefloat-excite", show_default=True,
+              help="Directory for trajectory.json, results.json and fig4.png.")
+def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc_limit, compare, out):
+    """Design an exciting trajectory for identifying MODEL's minimal parameters (seed 001, Sec. V).
+
+    Three steps, each with a progress bar: (1) SQP over two seeds per arm joint (start angle and range of the
+    cycloids, eqs. 28-31) on every direction combination of the driven joints, minimising eq. 32 (condition
+    number of the minimal regressor plus a reward for fast motion) within the joint limits (eqs. 33-37);
+    (2) pruning of the intervals by Algorithm 1; (3) SQP again on the kept intervals. The base motion comes
+    from the momentum model with the --guess parameters. Prints the seeds (Table 3 format) and writes the
+    trajectory for `freefloat identify minimal MODEL --trajectory OUT/trajectory.json`."""
+    from . import excitation as exc
+
+    m = load_model(model)
+    g = m if guess is None else load_model(guess)
+    n_arm = len(g.joints_tagged("arm_"))
+    limits = exc.Limits(np.full(n_arm, -np.deg2rad(q_limit)), np.full(n_arm, np.deg2rad(q_limit)),
+                        np.full(n_arm, rate_limit), np.full(n_arm, acc_limit))
+    kw = {} if weight is None else {"weight": weight}
+    design = exc.ExcitationDesign(g, limits=limits, **kw)
+    click.echo(f"designing an exciting trajectory for {m.name} (guess: {g.name}): {design.n_arm} arm joints, "
+               f"{len(design.wheels)} wheels, {design.n_intervals} direction combinations, {design.n_min} minimal parameters")
+    res = design.design(maxiter=maxiter, progress=True, **({} if min_gain is None else {"min_gain": min_gain}))
+    click.echo(res.summary())
+    click.echo(res.table3())
+    click.echo("time: " + ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items()))
+    res.save(out)
+    summary = res.to_dict()
+    if compare:
+        click.echo("\ncomparison with the paper's noise (identification of MODEL's minimal parameters):")
+        summary["comparison"] = exc.compare(m, res, progress=True)
+        click.echo(exc.comparison_table(summary["comparison"]))
+        Path(out, "results.json").write_text(json.dumps(summary, indent=2))
+    click.echo(f"wrote {out}/trajectory.json, {out}/results.json and {out}/fig4.png")
+
 
 if __name__ == "__main__":
     main()

@@ -285,9 +285,7 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
     noisy rates (Appendix C). Sampling every step (1 kHz by default) matters: rebuilding the poses from rates
     sampled at 100 Hz alone biases the estimate (0.012 % median, 0.9 % max relative error without any noise),
     at 1 kHz it does not. Returns (telemetry, trajectory)."""
-    from . import telemetry as tm
     from . import trajectories as tr
-    from .simulation import simulate
 
     arm, wheels = model.joints_tagged("arm_"), model.joints_tagged("wheel")
     if len(arm) != 6 or len(wheels) != 3:
@@ -297,12 +295,28 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
     if not 1 <= n_intervals <= len(all_dirs):
         raise InputError(f"n_intervals must be between 1 and {len(all_dirs)}, got {n_intervals}")
     pick = np.linspace(0, len(all_dirs) - 1, n_intervals).round().astype(int) if spread else np.arange(n_intervals)
-    dirs = all_dirs[pick]
-    cyc = tr.Cycloidal(start, range_, dirs)
-    joints = arm + wheels
-    presc = cyc.prescription(model, joints)
-    q0, v0, _ = presc(0.0)  # at rest at t = 0 (cycloids are rest-to-rest)
-    traj = simulate(model, q0, v0, cyc.duration, dt, prescribed=joints, prescription=presc,
+    cyc = tr.Cycloidal(start, range_, all_dirs[pick])
+    return trajectory_data(model, cyc, arm + wheels, dt=dt, record_every=record_every, noise=noise, seed=seed,
+                           progress=progress)
+
+
+def trajectory_data(model, trajectory, joints, dt: float = 1e-3, record_every: int = 1, noise: bool = True,
+                    seed: int = 0, progress: bool = False):
+    """Simulated identification data along any joint trajectory (e.g. a designed one, `freefloat excite`): the
+    named joints follow it, the base floats with zero total momentum (its initial twist solved from the
+    momentum model when the trajectory starts moving), the other joints rest.  With `noise`, seed 001's rate
+    noise and pose rebuild (Appendix C).  Returns (telemetry, trajectory)."""
+    from . import telemetry as tm
+    from .algorithms import centroidal_momentum_matrix
+    from .simulation import simulate
+
+    presc = trajectory.prescription(model, joints)
+    q0, v0, _ = presc(0.0)
+    if np.any(v0[6:] != 0.0):  # zero total momentum: A_b v_b = −A_j q̇_j
+        A = centroidal_momentum_matrix(model, q0)
+        v0[:6] = np.linalg.solve(A[:, :6], -A[:, 6:] @ v0[6:])
+    duration = trajectory.duration
+    traj = simulate(model, q0, v0, duration, dt, prescribed=joints, prescription=presc,
                     record_every=record_every, progress=progress)
     telem = tm.from_trajectory(traj)
     if noise:

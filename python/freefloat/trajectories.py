@@ -19,21 +19,28 @@ WHEEL_START = 0.0
 WHEEL_RANGE = 3.0 * np.pi
 
 
-def direction_combinations(n: int, fixed: int = 0) -> np.ndarray:
+def direction_combinations(n: int, fixed: int = 0, fastest: str = "last") -> np.ndarray:
     """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (seed 001 V.B:
     one joint keeps its direction, so there are 2^(n-1) combinations, 256 for 6 arm joints + 3 wheels).
 
     The paper fixes neither the joint nor the order (digest F, "not specified"). Ordering chosen here:
     row k is the binary expansion of k over the free joints in column order, most significant bit
     first, with bit 0 -> +1 and bit 1 -> -1. So row 0 is all +1 and the last free joint alternates
-    fastest (lexicographic order with + before -). Returns an int array (2**(n-1), n)."""
+    fastest (lexicographic order with + before -). With fastest="first" the bit order is reversed: the
+    first free joint alternates every interval, the next every second, and so on — joint j's accumulated
+    travel then stays within 2^(j-1) ranges, which is what position limits need (the excitation design puts
+    the arm joints first and fixes the last wheel). Returns an int array (2**(n-1), n)."""
     n = int(n)
     if n < 1:
         raise InputError(f"direction_combinations: n must be >= 1, got {n}")
     if not 0 <= fixed < n:
         raise InputError(f"direction_combinations: fixed joint index {fixed} is outside 0..{n - 1}")
+    if fastest not in ("last", "first"):
+        raise InputError(f"direction_combinations: fastest must be 'last' or 'first', got {fastest!r}")
     k = np.arange(2 ** (n - 1))[:, None]
     shifts = np.arange(n - 2, -1, -1)[None, :]  # MSB first over the n-1 free joints
+    if fastest == "first":
+        shifts = shifts[:, ::-1]
     bits = (k >> shifts) & 1
     free = 1 - 2 * bits
     return np.insert(free, fixed, 1, axis=1).astype(int)
@@ -224,3 +231,22 @@ class Fourier(_JointTrajectory):
         qd = (c * w) @ self.a.T - (s * w) @ self.b.T
         qdd = -(s * w**2) @ self.a.T - (c * w**2) @ self.b.T
         return q, qd, qdd
+
+
+class Stacked(_JointTrajectory):
+    """Several joint trajectories side by side (columns concatenated), e.g. Fourier arm joints with cycloidal
+    wheels. Duration: the longest part's."""
+
+    def __init__(self, *parts):
+        if not parts:
+            raise InputError("Stacked: needs at least one trajectory")
+        self.parts = parts
+        self.n = sum(p.n for p in parts)
+
+    @property
+    def duration(self) -> float:
+        return max(p.duration for p in self.parts)
+
+    def evaluate(self, t):
+        out = [p.evaluate(t) for p in self.parts]
+        return tuple(np.hstack([o[k] for o in out]) for k in range(3))

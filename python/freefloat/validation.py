@@ -146,10 +146,10 @@ def identified_model(model, result, prior=None):
     try:
         rep = model.with_parameters(representative_parameters(result.mp, result.estimate, prior))
     except ModelError:
-        return c.model(model), c, (f"physically consistent estimate (misses the identified minimal parameters by up to "
-                                   f"{c.max_rel_deviation:.2g} relative; the model does not admit non-physical bodies)")
+        return c.model(model), c, (f"physically consistent estimate (misses the identified minimal parameters by "
+                                   f"{c.misfit:.3g} standard deviations; the model does not admit non-physical bodies)")
     return rep, c, (f"exact representative of the identified minimal parameters (no physically consistent robot "
-                    f"reproduces them: nearest misses by {c.max_rel_deviation:.2g} relative)")
+                    f"reproduces them: the nearest is {c.misfit:.3g} standard deviations away)")
 
 
 def predict(true_model, identified_model, joints=None, trajectory=None, dt: float = 1e-3,

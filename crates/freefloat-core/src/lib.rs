@@ -13,6 +13,7 @@ pub mod data;
 pub mod dynamics;
 pub mod error;
 pub mod estimation;
+pub mod excitation;
 pub mod kinematics;
 pub mod model;
 pub mod regressors;

@@ -5,6 +5,7 @@ mod algorithms;
 mod batch;
 mod errors;
 mod estimation;
+mod excitation;
 mod model;
 mod simulate;
 
@@ -36,5 +37,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
+    m.add_function(wrap_pyfunction!(excitation::excitation_objective, m)?)?;
+    m.add_function(wrap_pyfunction!(excitation::excitation_rows_py, m)?)?;
     Ok(())
 }
