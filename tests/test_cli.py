@@ -17,7 +17,7 @@ def run(*args, ok=True):
     return r
 
 
-@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"]])
+@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"], ["excite"]])
 def test_every_command_has_help(cmd):
     r = run(*cmd, "--help")
     assert "Usage:" in r.stdout and len(r.stdout) > 200
@@ -93,3 +93,17 @@ def test_identify_minimal_full_urdf_and_weights(tmp_path):
     np.testing.assert_allclose(mp.from_standard(m.parameters()), res["estimate"], rtol=1e-4)
     bad = run("identify", "minimal", "seed001_dual_arm", "--simulate", "16", "--weights", "1,2", ok=False)
     assert bad.returncode == 2 and "--weights" in bad.stderr
+
+
+def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
+    r = run("excite", "seed001_dual_arm", "--guess", "seed001_dual_arm_offset", "--maxiter", "3", "--out", str(tmp_path))
+    assert "pruning kept" in r.stdout and "Table 3" in r.stdout
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert 0 < res["n_kept"] < 256 and len(res["kept_intervals"]) == res["n_kept"]
+    assert (tmp_path / "fig4.png").stat().st_size > 10_000
+    r2 = run("identify", "minimal", "seed001_dual_arm", "--trajectory", str(tmp_path / "trajectory.json"),
+             "--out", str(tmp_path / "id"))
+    ident = json.loads((tmp_path / "id" / "results.json").read_text())
+    assert ident["median_rel_error_pct"] < 1.0 and "bias compensation" in ident["solver"]
+    bad = run("excite", "seed001_dual_arm", "--out", str(tmp_path / "bad"), ok=False)  # Table 2 is non-physical
+    assert bad.returncode != 0 and "non-physical" in bad.stderr and "Traceback" not in bad.stderr

@@ -169,3 +169,28 @@ def test_bad_input(guess):
         exc.ExcitationDesign(ff.models.load("seed000_3d"))
     with pytest.raises(ff.InputError, match="not a 1-DoF joint"):
         exc.ExcitationDesign(guess, arm=["nope"])
+
+
+def test_the_shipped_designed_trajectory():
+    """scenarios/seed001_exciting_trajectory.json (written by `freefloat excite seed001_dual_arm --guess
+    seed001_dual_arm_offset`): within the limits on a fine grid, and on the TRUE robot it excites every minimal
+    parameter (noise-free data recovers them)."""
+    from pathlib import Path
+
+    traj, joints = exc.load_trajectory(Path(__file__).parents[1] / "scenarios" / "seed001_exciting_trajectory.json")
+    L = exc.Limits.seed001()
+    t = np.linspace(0, traj.duration, 100 * traj.n_intervals + 1)
+    q, qd, qdd = traj.evaluate(t)
+    assert np.all(q[:, :6] >= L.q_min - 1e-9) and np.all(q[:, :6] <= L.q_max + 1e-9)
+    assert np.all(np.abs(qd[:, :6]) <= L.qd_max + 1e-9) and np.all(np.abs(qdd[:, :6]) <= L.qdd_max + 1e-9)
+    m = ff.models.load("seed001_dual_arm")
+    telem, _ = ff.identify.trajectory_data(m, traj, joints, dt=2e-3, noise=False)
+    res = ff.identify_minimal(m, telem)
+    np.testing.assert_allclose(res.estimate, res.truth_values(m), rtol=1e-7)
+
+
+def test_a_design_that_cannot_excite_everything_is_reported(guess):
+    # only J1 designed, every other arm joint and the wheels are still: most parameters stay unexcited
+    d = exc.ExcitationDesign(guess, arm=["J1"], wheels=[], limits=exc.Limits.seed001(1))
+    with pytest.raises(ff.NumericalError, match="does not excite every minimal parameter"):
+        d.design(maxiter=2, progress=False)

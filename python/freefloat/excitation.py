@@ -50,6 +50,9 @@ U_MAX, DELTA = 5, 1.0 / 300.0
 MIN_GAIN = 0.01
 #: eq. 32 weight (our choice; the paper gives none)
 WEIGHT = 1000.0
+#: a condition number above this means some parameter combination is not excited (the Gram matrix the objective
+#: uses cannot resolve singular values below ~1e-8 of the largest)
+KAPPA_UNEXCITED = 1e8
 #: seed 001 results to print beside ours
 PAPER_KAPPA, PAPER_KEPT = 248.8, 67
 
@@ -362,9 +365,10 @@ class ExcitationDesign:
         t0 = time.perf_counter()
         s3 = self._run_step("step 3/3: SQP on the kept intervals", kept_dirs, s1.x, maxiter, progress)
         timings["step3"] = time.perf_counter() - t0
-        if not np.isfinite(s3.condition_number):
+        if not s3.condition_number < KAPPA_UNEXCITED:
             raise NumericalError(f"the designed trajectory does not excite every minimal parameter of '{self.guess.name}' "
-                                 f"(κ = inf after step 3); drive more joints or widen the limits")
+                                 f"(κ = {s3.condition_number:.3g} after step 3, {self.n_min} parameters): drive more joints, "
+                                 "widen the joint limits, or declare the unreachable bodies known")
         return DesignResult(design=self, step1=s1, prune=pr, step3=s3, directions=kept_dirs, timings=timings)
 
     # -- the paper's baseline: a 5-term Fourier series per arm joint ------------------------------------------

@@ -2,7 +2,7 @@
 //!     C = κ(G_m) + w · N_l N_m / Σ_i Σ_j h_ij²
 //! κ is the 2-norm condition number of the stacked minimal regressor, obtained from the eigenvalues of its
 //! small Gram matrix (n_min × n_min) rather than an SVD of the tall matrix; h ranges over the base twist
-//! components and the driven joint rates at the sampled points.
+//! components and the rates of the designed (arm) joints at the sampled points — `ObjectiveSpec::n_signal`.
 
 use super::response::{excitation_rows, JointPath};
 use crate::data::Data;

@@ -3,10 +3,10 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::{forward_velocities, momentum_from_data, world_composite_inertias};
-use crate::regressors::momentum_regressor;
+use crate::kinematics::forward_velocities;
 use crate::model::{JointType, Model};
-use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, V3};
+use crate::regressors::momentum_regressor_from_data;
+use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, Force, Inertia, Motion, Se3, V3};
 use nalgebra::{DMatrix, Vector6};
 
 /// Joint angles and rates of the driven joints on a uniform time grid: `q`, `qd` are (samples × n)
@@ -61,13 +61,28 @@ pub fn base_twist_zero_momentum(m: &Model, d: &mut Data, q: &mut [f64], v: &mut 
     q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
     v[..6].fill(0.0);
     forward_velocities(m, d, q, v);
-    let h = momentum_from_data(m, d);
-    world_composite_inertias(m, d);
-    let ic = d.ic[0].to_matrix();
+    // One pass: the joint motion's momentum and the whole robot's inertia, both about the base origin.
+    let (mut h, mut ic) = (Force::ZERO, Inertia::zero());
+    for i in 0..m.nbodies() {
+        h += d.o_mi[i].act_force(&m.inertias[i].mul_motion(&d.v[i]));
+        ic = ic.add(&m.inertias[i].transformed(&d.o_mi[i]));
+    }
     let rhs = -Vector6::new(h.lin.x, h.lin.y, h.lin.z, h.ang.x, h.ang.y, h.ang.z);
-    ic.cholesky()
+    ic.to_matrix()
+        .cholesky()
         .map(|c| c.solve(&rhs))
         .ok_or_else(|| FfError::Numerical("the composite inertia of the robot is not positive definite".into()))
+}
+
+/// After `base_twist_zero_momentum` (identity base, joint-only twists in `d`): add the base twist to every
+/// body twist (twists are linear in the rates) and move every placement rigidly to the base pose, so `d`
+/// describes the real state without a second kinematics pass.
+fn place_base(m: &Model, d: &mut Data, tw: &Vector6<f64>, base: &Se3) {
+    let vb = Motion::from_slice(tw.as_slice());
+    for i in 0..m.nbodies() {
+        d.v[i] += d.o_mi[i].inv_act_motion(&vb);
+        d.o_mi[i] = base.compose(&d.o_mi[i]);
+    }
 }
 
 /// Minimal-regressor rows along a joint path, and the signal the objective rewards.
@@ -144,11 +159,8 @@ pub fn excitation_rows(
         let vel = rot_from_quat(&quat) * V3::new(tw[0], tw[1], tw[2]);
         prev = Some((tw, vel));
         if i % stride == offset {
-            q.copy_from_slice(&scratch);
-            q[..3].copy_from_slice(pos.as_slice());
-            q[3..7].copy_from_slice(&quat);
-            v[..6].copy_from_slice(tw.as_slice());
-            momentum_regressor(m, d, &q, &v, &mut full);
+            place_base(m, d, &tw, &Se3::new(rot_from_quat(&quat), pos));
+            momentum_regressor_from_data(m, d, &mut full);
             for (c, &col) in columns.iter().enumerate() {
                 for k in 0..6 {
                     rows[(6 * r + k, c)] = full[(k, col)];

@@ -6,7 +6,7 @@ mod dynamics;
 mod momentum;
 
 pub use dynamics::dynamics_regressor;
-pub use momentum::momentum_regressor;
+pub use momentum::{momentum_regressor, momentum_regressor_from_data};
 
 use crate::model::Model;
 use crate::spatial::Force;

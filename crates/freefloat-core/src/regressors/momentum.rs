@@ -28,6 +28,13 @@ pub fn momentum_regressor<S: StorageMut<f64, Dyn, Dyn>>(
 ) {
     check_shape(m, out, 6, "momentum_regressor");
     forward_velocities(m, d, q, v);
+    momentum_regressor_from_data(m, d, out);
+}
+
+/// The momentum regressor from placements `d.o_mi` and body twists `d.v` already in `d` (e.g. placements
+/// moved rigidly with the base, as the excitation design does, without a second kinematics pass).
+pub fn momentum_regressor_from_data<S: StorageMut<f64, Dyn, Dyn>>(m: &Model, d: &Data, out: &mut RegressorOut<S>) {
+    check_shape(m, out, 6, "momentum_regressor");
     let z = V3::zeros();
     for i in 0..m.nbodies() {
         let (rot, p) = (&d.o_mi[i].rot, d.o_mi[i].trans);
