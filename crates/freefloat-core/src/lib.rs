@@ -15,6 +15,7 @@ pub mod error;
 pub mod estimation;
 pub mod kinematics;
 pub mod model;
+pub mod postcapture;
 pub mod regressors;
 pub mod sim;
 pub mod spatial;

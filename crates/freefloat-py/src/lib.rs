@@ -6,6 +6,7 @@ mod batch;
 mod errors;
 mod estimation;
 mod model;
+mod postcapture;
 mod simulate;
 
 use pyo3::prelude::*;
@@ -36,5 +37,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::postcapture_simulate, m)?)?;
+    m.add_class::<postcapture::PyRls>()?;
+    m.add_class::<postcapture::PyModifiedRls>()?;
     Ok(())
 }
