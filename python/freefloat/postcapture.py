@@ -133,7 +133,7 @@ def simulate(sc: Scenario, model=None) -> dict:
     c, e = sc.control, sc.excitation
     return _core.postcapture_simulate(
         m._core, np.asarray(sc.q0, float), np.asarray(sc.v0, float), sc.duration, sc.dt,
-        float(c["F_max"]), float(c["K_F"]), float(c["M_max"]), float(c["K_M"]), float(c["K_D"]), float(c["K_P"]),
+        float(c["F_max"]), float(c["K_F"]), float(c["M_max"]), float(c["K_M"]), list(np.atleast_1d(np.asarray(c["K_D"], float))), list(np.atleast_1d(np.asarray(c["K_P"], float))),
         list(map(float, c.get("jet", [0, 0, 0]))), e["damping"], e["amp"], e["freq"], e["phase"], 1)
 
 

@@ -40,8 +40,8 @@ pub fn postcapture_simulate<'py>(
     k_f: f64,
     m_max: f64,
     k_m: f64,
-    k_d: f64,
-    k_p: f64,
+    k_d: Vec<f64>,
+    k_p: Vec<f64>,
     jet: Vec<f64>,
     damping: f64,
     amp: Vec<f64>,
@@ -52,6 +52,14 @@ pub fn postcapture_simulate<'py>(
     if jet.len() != 3 {
         return Err(input_err(format!("argument `jet`: expected 3 entries, got {}", jet.len())));
     }
+    let gain = |name: &str, g: &[f64]| -> PyResult<V3> {
+        match g {
+            [x] => Ok(V3::repeat(*x)),
+            [x, y, z] => Ok(V3::new(*x, *y, *z)),
+            _ => Err(input_err(format!("argument `{name}`: expected 1 or 3 entries, got {}", g.len()))),
+        }
+    };
+    let (k_d, k_p) = (gain("k_d", &k_d)?, gain("k_p", &k_p)?);
     let m = model.inner.clone();
     let ctl = PostcaptureControl {
         f_max,

@@ -28,9 +28,10 @@ pub struct PostcaptureControl {
     /// the system CoM (digest §11: about the CoM, so that translation does not feed the couple)
     pub m_max: f64,
     pub k_m: f64,
-    /// eq. (39): base angular acceleration `−K_D ω − K_P φ` (φ: yaw in 2D, rotation vector in 3D)
-    pub k_d: f64,
-    pub k_p: f64,
+    /// eq. (39): base angular acceleration `−K_D ω − K_P φ` per axis of the base frame (φ: yaw in 2D,
+    /// rotation vector in 3D; the paper's gains are diagonal, its 3D values are not printed)
+    pub k_d: V3,
+    pub k_p: V3,
     /// thruster point in the base frame (r'_jet, eq. 15); the thrust's moment about the base origin
     /// is `r'_jet × f`
     pub jet: V3,
@@ -77,9 +78,10 @@ impl Controller {
                 return Err(FfError::arg(name, format!("must be finite and ≥ 0, got {x}")));
             }
         }
-        for (name, x) in
-            [("k_f", ctl.k_f), ("k_m", ctl.k_m), ("k_d", ctl.k_d), ("k_p", ctl.k_p), ("damping", ctl.damping)]
-        {
+        if ctl.k_d.iter().chain(ctl.k_p.iter()).any(|g| !g.is_finite()) {
+            return Err(FfError::arg("k_d/k_p", "attitude gains must be finite"));
+        }
+        for (name, x) in [("k_f", ctl.k_f), ("k_m", ctl.k_m), ("damping", ctl.damping)] {
             if !x.is_finite() {
                 return Err(FfError::arg(name, format!("must be finite, got {x}")));
             }
@@ -154,7 +156,7 @@ impl Controller {
         // Eq. (39): angular rows of a_b = α.
         let ang: Vec<usize> = if self.planar { vec![2] } else { vec![3, 4, 5] };
         let w_body = if self.planar { V3::new(0.0, 0.0, v[2]) } else { V3::new(v[3], v[4], v[5]) };
-        let alpha = -self.ctl.k_d * w_body - self.ctl.k_p * phi;
+        let alpha = -self.ctl.k_d.component_mul(&w_body) - self.ctl.k_p.component_mul(&phi);
         let k = ang.len();
         let cm = DMatrix::from_fn(k, nj, |r, c| x[(ang[r], c)]);
         let dv = DVector::from_fn(k, |r, _| z[ang[r]] - if self.planar { alpha.z } else { alpha[r] });
