@@ -30,6 +30,9 @@ from ._rotations import quat_to_matrix
 SCENARIO_DIR = Path(__file__).resolve().parents[2] / "scenarios"
 METHODS = ("momentum", "force")
 SOLVERS = ("modified_rls", "standard_rls")
+# Noise study levels (the paper has no noise): white, per sample. Velocities [m/s, rad/s] and accelerations
+# [m/s², rad/s²] at the 10 Hz samples; thrust [N, N·m] at the 1 kHz step rate before integration.
+DEFAULT_NOISE = {"velocity": 1e-4, "acceleration": 1e-4, "force": 0.01}
 SOLVER_TITLES = {"modified_rls": "paper (modified RLS)", "standard_rls": "standard params (RLS)"}
 
 
