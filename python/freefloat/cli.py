@@ -375,7 +375,7 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep):
         vels = sc.sweep["velocities"]
         with tqdm(total=len(vels), desc="velocity sweep", unit="run", leave=False) as bar:
             sw = pc.sweep(sc, progress=lambda k, n: bar.update(1))
-        click.echo(pc.sweep_table(sw))
+        click.echo(pc.sweep_table(sw, paper=sc.paper_sweep))
     if out:
         path = res.save(out)
         if sw is not None:

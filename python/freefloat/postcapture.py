@@ -56,6 +56,7 @@ class Scenario:
     noise: dict | None = None
     paper: dict = field(default_factory=dict)
     sweep: dict | None = None
+    paper_sweep: dict | None = None
     source: str = ""
 
     def with_base_velocity(self, vel) -> "Scenario":
@@ -121,7 +122,8 @@ def _parse(d: dict, source: str) -> Scenario:
         duration=float(d["duration"]), dt=float(d.get("dt", 1e-3)), sample_period=float(d.get("sample_period", 0.1)),
         q0=q0, v0=v0, control=dict(d["control"]), excitation=exc, tolerance=float(ident["transit_tolerance"]),
         P0=float(ident.get("P0", 1e6)), forgetting=float(ident.get("forgetting", 1.0)), guess=ident["guess"],
-        noise=d.get("noise"), paper=d.get("paper", {}) or {}, sweep=d.get("sweep"), source=source)
+        noise=d.get("noise"), paper=d.get("paper", {}) or {}, sweep=d.get("sweep"), paper_sweep=d.get("paper_sweep"),
+        source=source)
 
 
 def _base_attitude(m, q) -> np.ndarray:
@@ -344,7 +346,7 @@ class PostcaptureResult:
                 if n not in paper and paper and _is_product(n):
                     continue
                 p = paper.get(n)
-                ptxt = "" if p is None else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (-)"))
+                ptxt = "" if p is None or p[0] is None else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (-)"))
                 cells = []
                 for s in SOLVERS:
                     e = self.final(method, s)[j]
@@ -451,7 +453,7 @@ def sweep(sc: Scenario, velocities=None, progress=None) -> dict:
     return out
 
 
-def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx")) -> str:
+def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx"), paper: dict | None = None) -> str:
     names = sw["names"]
     cols = [names.index(p) for p in params]
     lines = ["relative error (%) at the end of the run vs initial base velocity [m/s]",
@@ -459,6 +461,10 @@ def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx")) -> str:
     for k, v in enumerate(sw["velocities"]):
         for key, errs in sw["errors"].items():
             lines.append(f"{str([round(x, 1) for x in v]):>14} {key:>26} " + " ".join(f"{100 * errs[k][c]:>10.4f}" for c in cols))
+    if paper:
+        lines.append("paper (text of Sec. V-A-3): momentum-based I'n " + ", ".join(
+            f"{p['error_percent']} % at {p['velocity']}" for p in paper.get("momentum_In", []))
+            + f"; force-based: {paper.get('force_In', '')}")
     return "\n".join(lines)
 
 
