@@ -468,6 +468,38 @@ def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx"), paper: dict | None =
     return "\n".join(lines)
 
 
+# -- noise study --------------------------------------------------------------------------------------
+def noise_study(sc: Scenario, scales=(0.0, 0.01, 0.1, 1.0), seeds=(0, 1, 2)) -> dict:
+    """Relative error at the end of the run for DEFAULT_NOISE × scale (the paper has no noise), the
+    median over seeds, per method/solver and parameter."""
+    import copy
+
+    out = {"levels": [], "names": None}
+    for scale in scales:
+        s = copy.deepcopy(sc)
+        s.noise = {k: v * scale for k, v in DEFAULT_NOISE.items()} if scale > 0 else None
+        errs = {}
+        for seed in (seeds if scale > 0 else seeds[:1]):
+            res = run(s, seed=seed)
+            out["names"] = res.names
+            for method in METHODS:
+                for solver in SOLVERS:
+                    errs.setdefault(f"{method}/{solver}", []).append(res.rel_error(method, solver))
+        out["levels"].append({"scale": scale, "noise": s.noise,
+                              "median_error": {k: np.median(v, 0).tolist() for k, v in errs.items()}})
+    return out
+
+
+def noise_table(ns: dict) -> str:
+    names = ns["names"]
+    lines = ["median relative error (%) at the end of the run; noise = DEFAULT_NOISE × scale"]
+    lines.append(f"{'scale':>6} {'method/solver':>24} " + " ".join(f"{n:>9}" for n in names))
+    for lv in ns["levels"]:
+        for key, e in lv["median_error"].items():
+            lines.append(f"{lv['scale']:>6g} {key:>24} " + " ".join(f"{100 * x:>9.4f}" for x in e))
+    return "\n".join(lines)
+
+
 # -- figures --------------------------------------------------------------------------------------------
 def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
     """Figs. 4-5 style: estimate / truth versus time, one figure per method (both solvers)."""
@@ -492,6 +524,8 @@ def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
             if res.truth[j] != 0:
                 ax.set_ylim(0.9, 1.1)
             ax.grid(alpha=0.3)
+        for ax in axes[-1]:
+            ax.set_xlabel("t [s]")
         for ax in axes.ravel()[len(show):]:
             ax.axis("off")
         axes[0, 0].legend(fontsize=7)
