@@ -3,7 +3,9 @@
 //!     nice cargo bench -p freefloat-core --bench rls
 //!
 //! - `rls_standard_3d`: ordinary RLS, 20 unknowns (standard parameters of base and target), 6 rows
-//!   per sample (linear + angular momentum or Newton-Euler).
+//!   per sample: the real rows of the 3D problem, i.e. the base and target columns of the engine's
+//!   momentum regressor of `seed000_3d` at random states (the linear rows have no inertia columns).
+//! - `rls_dense_20x6`: the same estimator on dense random rows (no structure to exploit).
 //! - `modified_rls_3d`: the paper's modified RLS (eqs. 34-38): μ ∈ R⁸ from 3 rows, θ ∈ R¹² from
 //!   3 rows, D(μ) ∈ R²⁰ (so M is 12 × 20).
 //!
@@ -11,6 +13,9 @@
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
+use freefloat_core::regressors::momentum_regressor;
+use freefloat_core::Data;
+use nalgebra::DMatrix;
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -20,15 +25,53 @@ fn pool(rows: usize, cols: usize, rng: &mut StdRng) -> Vec<Vec<f64>> {
     (0..POOL).map(|_| (0..rows * cols).map(|_| rng.gen_range(-1.0..1.0)).collect()).collect()
 }
 
+/// Rows of the 3D standard-parameter momentum regression: base (body 0) and target columns of the
+/// momentum regressor at random states (row-major 6 × 20).
+fn real_rows(rng: &mut StdRng) -> Vec<Vec<f64>> {
+    let m = freefloat_core::model::builtin::load("seed000_3d").expect("built-in model");
+    let target = m.nbodies() - 1;
+    let mut d = Data::new(&m);
+    let mut k = DMatrix::zeros(6, 10 * m.nbodies());
+    (0..POOL)
+        .map(|_| {
+            let mut q = vec![0.0; m.nq];
+            q[6] = 1.0;
+            for x in q.iter_mut().skip(7) {
+                *x = rng.gen_range(-3.0..3.0);
+            }
+            let v: Vec<f64> = (0..m.nv).map(|_| rng.gen_range(-1.0..1.0)).collect();
+            momentum_regressor(&m, &mut d, &q, &v, &mut k);
+            let mut row = Vec::with_capacity(120);
+            for r in 0..6 {
+                for c in (0..10).chain(10 * target..10 * target + 10) {
+                    row.push(k[(r, c)]);
+                }
+            }
+            row
+        })
+        .collect()
+}
+
 fn bench(c: &mut Criterion) {
     let mut rng = StdRng::seed_from_u64(3);
     let mut g = c.benchmark_group("estimator_update");
     g.throughput(Throughput::Elements(1));
 
-    let (phi, y) = (pool(6, 20, &mut rng), pool(6, 1, &mut rng));
+    let (real, y) = (real_rows(&mut rng), pool(6, 1, &mut rng));
     let mut est = Rls::new(&[0.0; 20], &[1e6; 20], 0.999).expect("valid prior");
     let mut k = 0usize;
     g.bench_function("rls_standard_3d", |b| {
+        b.iter(|| {
+            let i = k % POOL;
+            k += 1;
+            est.update(k as f64, black_box(&real[i]), black_box(&y[i])).expect("update");
+        })
+    });
+
+    let phi = pool(6, 20, &mut rng);
+    let mut est = Rls::new(&[0.0; 20], &[1e6; 20], 0.999).expect("valid prior");
+    let mut k = 0usize;
+    g.bench_function("rls_dense_20x6", |b| {
         b.iter(|| {
             let i = k % POOL;
             k += 1;
