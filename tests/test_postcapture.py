@@ -274,3 +274,19 @@ def test_simulation_bad_input():
     sc.v0[0] = np.nan
     with pytest.raises(ff.InputError, match="v0"):
         pc.simulate(sc)
+
+
+def test_projection_and_forgetting_options():
+    """The projection leaves consistent (here: the true) parameters alone and repairs a non-physical set;
+    a forgetting factor close to 1 still converges on noise-free data."""
+    truth = np.array(ff.models.load("seed000_2d_medium").parameters())[4]
+    np.testing.assert_allclose(eq.project_consistent(truth), truth, rtol=1e-9)
+    bad = truth.copy()
+    bad[4] = -1.0  # Ixx < 0: violates positivity
+    fixed = eq.project_consistent(bad)
+    m, b, Ic = eq.from_standard(fixed[None])
+    assert m[0] > 0 and np.linalg.eigvalsh(Ic[0]).min() >= -1e-9
+    sc = pc.load_scenario("seed000_2d_medium")
+    sc.forgetting, sc.project = 0.9999, True
+    res = pc.run(sc)
+    assert res.rel_error("momentum", "standard_rls").max() < 1e-3

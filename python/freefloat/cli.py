@@ -340,7 +340,10 @@ def identify_minimal_cmd(model, data, n_sim, method, known, h0, truth, out):
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
 @click.option("--sweep/--no-sweep", default=True, show_default=True,
               help="For a scenario with a `sweep` section: also run the initial-velocity sweep (Figs. 6-9).")
-def identify_postcapture_cmd(scenario, out, noise, seed, sweep):
+@click.option("--forgetting", type=float, help="Forgetting factor of the standard-parameter RLS (default: the scenario's, 1 = none).")
+@click.option("--project/--no-project", default=None,
+              help="Report the standard-parameter estimate projected onto physically consistent parameters.")
+def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project):
     """Seed 000: identify base and captured target online, in one step (momentum- and force-based).
 
     SCENARIO is a built-in name (`freefloat scenarios`) or a YAML file. Simulates the post-capture motion
@@ -359,6 +362,12 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep):
         sc.noise = dict(pc.DEFAULT_NOISE)
     elif noise is False:
         sc.noise = None
+    if forgetting is not None:
+        if not 0 < forgetting <= 1:
+            raise click.BadParameter("must be in (0, 1]", param_hint="--forgetting")
+        sc.forgetting = forgetting
+    if project is not None:
+        sc.project = project
     t0 = _time.perf_counter()
     with tqdm(total=2, desc=f"{sc.name}", unit="stage", leave=False) as bar:
         res = pc.run(sc, seed=seed, progress=lambda what: (bar.set_postfix_str(what), bar.update(1)))

@@ -53,6 +53,7 @@ class Scenario:
     P0: float
     forgetting: float
     guess: dict
+    project: bool = False
     noise: dict | None = None
     paper: dict = field(default_factory=dict)
     sweep: dict | None = None
@@ -122,6 +123,7 @@ def _parse(d: dict, source: str) -> Scenario:
         duration=float(d["duration"]), dt=float(d.get("dt", 1e-3)), sample_period=float(d.get("sample_period", 0.1)),
         q0=q0, v0=v0, control=dict(d["control"]), excitation=exc, tolerance=float(ident["transit_tolerance"]),
         P0=float(ident.get("P0", 1e6)), forgetting=float(ident.get("forgetting", 1.0)), guess=ident["guess"],
+        project=bool(ident.get("project", False)),
         noise=d.get("noise"), paper=d.get("paper", {}) or {}, sweep=d.get("sweep"), paper_sweep=d.get("paper_sweep"),
         source=source)
 
@@ -250,8 +252,15 @@ def identify_standard(model, rows: eq.StandardRows, sc: Scenario, planar: bool, 
     for body in range(2):
         full = np.zeros((len(x), 10))
         full[:, L.std_cols] = x[:, body * k:(body + 1) * k]
-        if planar:  # out-of-plane entries are not identifiable; keep I_zz only
-            full[:, [4, 6]] = full[:, [9]]
+        if planar:
+            # Out-of-plane inertia is not identifiable in planar motion. Complete it as an isotropic CoM
+            # inertia (as the model files do) so the projection sees a body: I_ref = I_czz 1 + (|h|²1 − hhᵀ)/m,
+            # which keeps the identified I_ref,zz.
+            m_, h = full[:, 0], full[:, 1:4]
+            iczz = full[:, 9] - (h[:, 0] ** 2 + h[:, 1] ** 2) / m_
+            Io = iczz[:, None, None] * np.eye(3) + (np.einsum("ti,ti->t", h, h)[:, None, None] * np.eye(3)
+                                                    - np.einsum("ti,tj->tij", h, h)) / m_[:, None, None]
+            full[:, 4:] = np.stack([Io[:, 0, 0], Io[:, 0, 1], Io[:, 1, 1], Io[:, 0, 2], Io[:, 1, 2], Io[:, 2, 2]], -1)
         if project:
             full = eq.project_consistent(full)
         m, b, I = eq.from_standard(full)
@@ -315,6 +324,7 @@ class PostcaptureResult:
 
     def to_dict(self) -> dict:
         out = {"scenario": self.scenario.name, "model": self.scenario.model, "tolerance": self.scenario.tolerance,
+               "P0": self.scenario.P0, "forgetting": self.scenario.forgetting, "projected": self.scenario.project,
                "duration": self.scenario.duration, "timings_s": self.timings, "equation_residuals_at_truth": self.residuals,
                "noise": self.scenario.noise, "methods": {}}
         for (method, solver), (t, h) in self.histories.items():
@@ -387,7 +397,7 @@ def identify(model, meas: eq.Measurements, sc: Scenario, methods=METHODS, timing
         res[method] = equation_residuals(model, paper_rows, std_rows, planar, base, target)
         t0 = time.perf_counter()
         hist[(method, "modified_rls")] = (paper_rows.t, identify_modified(model, paper_rows, sc, planar))
-        hist[(method, "standard_rls")] = (std_rows.t, identify_standard(model, std_rows, sc, planar))
+        hist[(method, "standard_rls")] = (std_rows.t, identify_standard(model, std_rows, sc, planar, project=sc.project))
         timings[f"{method}_estimators"] = time.perf_counter() - t0
     return PostcaptureResult(sc, parameter_names(planar), truth, hist, timings, res)
 
