@@ -167,7 +167,7 @@ def test_noise_free_3d(spatial):
     for method in pc.METHODS:
         for solver in pc.SOLVERS:
             err = dict(zip(names, spatial.rel_error(method, solver)))
-            for p in ("m1", "b1x", "b1y", "b1z", "mn", "bnx", "bny", "Inxx", "Inyy", "Inzz", "I1yy", "I1zz"):
+            for p in ("m1", "b1x", "b1y", "b1z", "mn", "bnx", "bny", "Inxx", "Inyy", "Inzz", "I1xx", "I1yy", "I1zz"):
                 assert err[p] < 1e-2, (method, solver, p, err[p])   # the paper's 1 % band
             assert abs(spatial.final(method, solver)[names.index("bnz")]) < 1e-8  # zero true value
 
