@@ -92,7 +92,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let i = k % POOL;
             k += 1;
-            if k % 4096 == 0 {
+            if k.is_multiple_of(4096) {
                 m = fresh();
             }
             let s = CoupledSample { t: k as f64, a: &a[i], b: &bb[i], phi: &ph[i], y: &yy[i], psi: &psi[i] };
