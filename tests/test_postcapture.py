@@ -238,6 +238,18 @@ def test_rls_bad_samples_raise_clear_errors():
         big.update(1.0, np.array([[1.0]]), np.array([1.0]))
 
 
+def test_online_wrappers_accept_lists_and_name_bad_arguments():
+    est = ff.online.RecursiveLS([0, 0], [1, 1], forgetting=1.0)
+    est.update(0, [[1, 2]], [3])
+    # one sample with p0 = I: θ = φᵀ y / (1 + |φ|²) = [1, 2]·3/6
+    np.testing.assert_allclose(est.estimate, [0.5, 1.0], rtol=1e-15)
+    with pytest.raises(ff.InputError, match="phi"):
+        est.update(1, [["a", 2]], [3])
+    m = ff.online.ModifiedRLS("planar", [600, 0, 0, 100, 10, 10], [1e6] * 6, [100, 10], [1e6] * 2)
+    mu, th = m.update(0.1, np.ones((2, 6)), [1, 1], [[1, 1]], [1], np.zeros((1, 8)))
+    assert np.isfinite(mu).all() and np.isfinite(th).all() and m.samples == 1
+
+
 def test_modified_rls_bad_samples_raise_clear_errors():
     est = _core.ModifiedRLS("planar", np.array([600.0, 0, 0, 100, 10, 10]), np.full(6, 1e6),
                             np.array([100.0, 10.0]), np.full(2, 1e6))

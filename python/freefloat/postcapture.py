@@ -23,6 +23,7 @@ import yaml
 from . import _core
 from . import algorithms as alg
 from . import models
+from . import online
 from . import postcapture_equations as eq
 from ._core import InputError
 from ._rotations import quat_to_matrix
@@ -223,7 +224,7 @@ def identify_modified(model, rows: eq.PaperRows, sc: Scenario, planar: bool) -> 
     (m1, b1, I1), (mn, bn, In) = _guess(sc, planar)
     mu0 = np.concatenate([np.concatenate([[m], m * b])[L.mu_cols] for m, b in ((m1, b1), (mn, bn))])
     th0 = np.concatenate([eq.inertia_sharp(I)[L.th_cols] for I in (I1, In)])
-    est = _core.ModifiedRLS(L.coupling, mu0, np.full(len(mu0), sc.P0), th0, np.full(len(th0), sc.P0))
+    est = online.ModifiedRLS(L.coupling, mu0, np.full(len(mu0), sc.P0), th0, np.full(len(th0), sc.P0))
     mu, th = est.run(rows.t, rows.A, rows.b, rows.Phi, rows.y, rows.Psi)
     k = len(L.mu_cols)
     hist = []
@@ -245,7 +246,7 @@ def identify_standard(model, rows: eq.StandardRows, sc: Scenario, planar: bool, 
     """Ordinary RLS on the standard parameters (digest §7); returns (N, P) physical parameters."""
     L = eq.Layout(planar)
     x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in _guess(sc, planar)])
-    est = _core.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting if forgetting is None else forgetting)
+    est = online.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting if forgetting is None else forgetting)
     x = est.run(rows.t, rows.Phi, rows.y)
     k = len(L.std_cols)
     hist = []

@@ -136,6 +136,9 @@ impl ModifiedRls {
         let p_th = full_covariance("p_theta0", p_th0, n_th)?;
         let mut d_prev = vec![0.0; n_d];
         coupling.d_of_mu(mu0, &mut d_prev).map_err(|e| FfError::arg("mu0", e.to_string()))?;
+        if d_prev.iter().any(|x| !x.is_finite()) {
+            return Err(FfError::arg("mu0", "D(μ0) overflows: first moments far too large for the masses"));
+        }
         Ok(ModifiedRls {
             coupling,
             n_mu,
@@ -267,6 +270,12 @@ impl ModifiedRls {
             }
         }
         std::mem::swap(&mut self.d_prev, &mut self.d_new);
+        // Overflow (e.g. a mass estimate close to zero making D(μ) huge) must not leak out as inf/NaN.
+        if let Some(i) = self.mu.iter().chain(&self.theta).chain(&self.d_prev).position(|x| !x.is_finite()) {
+            return Err(FfError::Numerical(format!(
+                "estimate overflowed (entry {i} of [μ, θ, D(μ)] is not finite); the data do not determine the masses"
+            )));
+        }
         Ok(())
     }
 }
@@ -381,6 +390,8 @@ mod tests {
         let e = est.update(&CoupledSample { t: 0.3, a: &a, b: &b, phi: &phi, y: &y, psi: &psi[..7] }).unwrap_err();
         assert!(e.to_string().contains("psi"), "{e}");
         assert!(est.mu().iter().chain(est.theta()).all(|x| x.is_finite()));
+        // a guess whose D(μ) overflows is refused up front (the update also checks its own results)
+        assert!(ModifiedRls::new(c, &[1.0, 1e200, 0.0, 1.0, 0.0, 0.0], &[1.0; 6], &[1.0, 1.0], &[1.0; 2]).is_err());
         // a zero initial mass makes D(μ) undefined
         assert!(ModifiedRls::new(c, &[0.0; 6], &[1.0; 6], &[1.0], &[1.0]).is_err());
     }

@@ -87,6 +87,11 @@ impl Rls {
                 return Err(FfError::Numerical(msg));
             }
         }
+        if let Some(i) = self.theta.iter().position(|x| !x.is_finite()) {
+            let msg = format!("sample {k}: estimate overflowed (entry {i} is not finite)");
+            self.failed = Some(msg.clone());
+            return Err(FfError::Numerical(msg));
+        }
         self.samples += 1;
         self.last_t = Some(t);
         Ok(())
