@@ -561,7 +561,7 @@ def plot_sweep(sw: dict, out: Path, params=("In", "I1", "mn", "bnx")) -> Path:
         j = names.index(p)
         for key, errs in sw["errors"].items():
             e = np.asarray(errs)[:, j] * 100
-            ax.semilogy(speed[order], np.maximum(e[order], 1e-12), "o-", label=key, ms=3)
+            ax.semilogy(speed[order], np.maximum(e[order], 1e-12), "o", label=key, ms=4, alpha=0.8)
         ax.set_xlabel("|v_base(0)| [m/s]")
         ax.set_ylabel("relative error [%]")
         ax.set_title(p)
