@@ -302,3 +302,21 @@ def test_projection_and_forgetting_options():
     sc.forgetting, sc.project = 0.9999, True
     res = pc.run(sc)
     assert res.rel_error("momentum", "standard_rls").max() < 1e-3
+
+
+def test_measurement_options():
+    """Central differences of the sampled velocities approximate the exact accelerations (to the O(h²) error of a
+    0.1 s step) and drop the two end samples; an unknown mode is an InputError."""
+    sc = pc.load_scenario("seed000_2d_medium")
+    sc.duration = 10.0
+    m = ff.models.load(sc.model)
+    sim = pc.simulate(sc, m)
+    exact = pc.measure(m, sim, sc)
+    sc.measurement = {"accelerations": "central_difference", "impulses": "trapezoid"}
+    fd = pc.measure(m, sim, sc)
+    assert len(fd.t) == len(exact.t) - 2 and fd.t[0] == exact.t[1]
+    np.testing.assert_allclose(fd.ddq, exact.ddq[1:-1], atol=2e-3 * np.abs(exact.ddq).max())
+    np.testing.assert_allclose(fd.impulse_F, exact.impulse_F[1:-1], rtol=1e-2, atol=1e-3)
+    sc.measurement = {"accelerations": "spline"}
+    with pytest.raises(ff.InputError, match="accelerations"):
+        pc.measure(m, sim, sc)

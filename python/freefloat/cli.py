@@ -343,7 +343,11 @@ def identify_minimal_cmd(model, data, n_sim, method, known, h0, truth, out):
 @click.option("--forgetting", type=float, help="Forgetting factor of the standard-parameter RLS (default: the scenario's, 1 = none).")
 @click.option("--project/--no-project", default=None,
               help="Report the standard-parameter estimate projected onto physically consistent parameters.")
-def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project):
+@click.option("--accelerations", type=click.Choice(["exact", "central_difference"]),
+              help="Accelerations for the force form: exact at the samples (default) or central differences of the sampled velocities.")
+@click.option("--impulses", type=click.Choice(["simpson", "trapezoid"]),
+              help="Thrust impulses for the momentum form: Simpson on the 1 kHz thrust (default) or trapezoid on the samples.")
+def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses):
     """Seed 000: identify base and captured target online, in one step (momentum- and force-based).
 
     SCENARIO is a built-in name (`freefloat scenarios`) or a YAML file. Simulates the post-capture motion
@@ -368,6 +372,10 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
         sc.forgetting = forgetting
     if project is not None:
         sc.project = project
+    if accelerations:
+        sc.measurement["accelerations"] = accelerations
+    if impulses:
+        sc.measurement["impulses"] = impulses
     t0 = _time.perf_counter()
     with tqdm(total=2, desc=f"{sc.name}", unit="stage", leave=False) as bar:
         res = pc.run(sc, seed=seed, progress=lambda what: (bar.set_postfix_str(what), bar.update(1)))
@@ -378,7 +386,8 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
                f"(rhs up to {r['momentum']['paper_angular_scale']:.2e}), force form {r['force']['paper_angular']:.2e} "
                f"(rhs up to {r['force']['paper_angular_scale']:.2e})")
     click.echo(f"simulation + measurements + 4 estimators: {wall:.2f} s (simulation {res.timings['simulation']:.2f} s)"
-               + (f"; noise {sc.noise}" if sc.noise else "; noise-free"))
+               + (f"; noise {sc.noise}" if sc.noise else "; noise-free")
+               + (f"; measurement {sc.measurement}" if sc.measurement else ""))
     sw = None
     if sweep and sc.sweep:
         vels = sc.sweep["velocities"]

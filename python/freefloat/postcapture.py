@@ -55,6 +55,7 @@ class Scenario:
     forgetting: float
     guess: dict
     project: bool = False
+    measurement: dict = field(default_factory=dict)
     noise: dict | None = None
     paper: dict = field(default_factory=dict)
     sweep: dict | None = None
@@ -124,7 +125,7 @@ def _parse(d: dict, source: str) -> Scenario:
         duration=float(d["duration"]), dt=float(d.get("dt", 1e-3)), sample_period=float(d.get("sample_period", 0.1)),
         q0=q0, v0=v0, control=dict(d["control"]), excitation=exc, tolerance=float(ident["transit_tolerance"]),
         P0=float(ident.get("P0", 1e6)), forgetting=float(ident.get("forgetting", 1.0)), guess=ident["guess"],
-        project=bool(ident.get("project", False)),
+        project=bool(ident.get("project", False)), measurement=dict(d.get("measurement") or {}),
         noise=d.get("noise"), paper=d.get("paper", {}) or {}, sweep=d.get("sweep"), paper_sweep=d.get("paper_sweep"),
         source=source)
 
@@ -177,11 +178,30 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         cum = np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(pair, 0)])
         return cum[idx // 2]
 
+    def trapezoid(f):
+        # only the sampled thrust (the digest's alternative): trapezoid between the 10 Hz samples
+        fs = f[idx]
+        return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * (fs[1:] + fs[:-1]) * sc.sample_period, 0)])
+
+    mode = sc.measurement
     vs, as_ = v[idx], ddq[idx]
     if noise and rng is not None:
         vs = vs + rng.normal(0.0, float(noise.get("velocity", 0.0)), vs.shape)
         as_ = as_ + rng.normal(0.0, float(noise.get("acceleration", 0.0)), as_.shape)
-    return eq.Measurements(t[idx], q[idx], vs, as_, wrench[idx], simpson(F), simpson(M))
+    keep = slice(None)
+    if mode.get("accelerations", "exact") == "central_difference":
+        # v̇ from the sampled (possibly noisy) velocities by central differences. For the base, v holds body-frame
+        # components and ddq is their time derivative, so this approximates ddq itself. The first and last
+        # samples have no central difference and are dropped (an online estimator runs one sample behind).
+        as_ = np.gradient(vs, sc.sample_period, axis=0)
+        keep = slice(1, -1)
+    elif mode.get("accelerations", "exact") != "exact":
+        raise InputError(f"measurement.accelerations: expected 'exact' or 'central_difference', got {mode['accelerations']!r}")
+    integ = {"simpson": simpson, "trapezoid": trapezoid}.get(mode.get("impulses", "simpson"))
+    if integ is None:
+        raise InputError(f"measurement.impulses: expected 'simpson' or 'trapezoid', got {mode['impulses']!r}")
+    return eq.Measurements(t[idx][keep], q[idx][keep], vs[keep], as_[keep], wrench[idx][keep], integ(F)[keep],
+                           integ(M)[keep])
 
 
 # -- identification -------------------------------------------------------------------------------------
@@ -327,7 +347,7 @@ class PostcaptureResult:
         out = {"scenario": self.scenario.name, "model": self.scenario.model, "tolerance": self.scenario.tolerance,
                "P0": self.scenario.P0, "forgetting": self.scenario.forgetting, "projected": self.scenario.project,
                "duration": self.scenario.duration, "timings_s": self.timings, "equation_residuals_at_truth": self.residuals,
-               "noise": self.scenario.noise, "methods": {}}
+               "noise": self.scenario.noise, "measurement": self.scenario.measurement, "methods": {}}
         for (method, solver), (t, h) in self.histories.items():
             tt = self.transits(method, solver)
             err = self.rel_error(method, solver)
