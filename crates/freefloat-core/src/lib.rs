@@ -16,6 +16,7 @@ pub mod estimation;
 pub mod excitation;
 pub mod kinematics;
 pub mod model;
+pub mod postcapture;
 pub mod regressors;
 pub mod sim;
 pub mod spatial;

@@ -7,6 +7,7 @@ mod errors;
 mod estimation;
 mod excitation;
 mod model;
+mod postcapture;
 mod simulate;
 
 use pyo3::prelude::*;
@@ -39,5 +40,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
     m.add_function(wrap_pyfunction!(excitation::excitation_objective, m)?)?;
     m.add_function(wrap_pyfunction!(excitation::excitation_rows_py, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::postcapture_simulate, m)?)?;
+    m.add_class::<postcapture::PyRls>()?;
+    m.add_class::<postcapture::PyModifiedRls>()?;
     Ok(())
 }

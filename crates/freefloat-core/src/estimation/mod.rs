@@ -1,3 +1,6 @@
+//! Recursive estimators for online identification (seed 000): [`Rls`] (ordinary RLS with
+//! forgetting) and [`ModifiedRls`] (the paper's one-step mass/CoM + inertia recursion, eqs. 34-38).
+//!
 //! Batch least squares for inertial-parameter identification (seed 001 §A.9, eqs. 26–27), without
 //! ever forming the tall regressor `G_m` (6N × n).
 //!
@@ -18,14 +21,19 @@
 
 mod analysis;
 mod gram;
+mod modified_rls;
 mod momentum;
+mod rls;
+mod rls_kernel;
 mod streaming;
 
 pub use analysis::{unexcited_directions, Direction, RANK_RTOL};
 pub use gram::GramLs;
+pub use modified_rls::{CoupledSample, Coupling, ModifiedRls};
 pub use momentum::{
     identify_momentum, identify_momentum_with, momentum_regressor_pass, Method, MomentumProblem, GRAM_KAPPA_MAX,
 };
+pub use rls::Rls;
 pub use streaming::StreamingLs;
 
 use nalgebra::{DMatrix, DVector};

@@ -1,0 +1,17 @@
+//! Seed 000's post-capture scenario (Zhang, Yue, Yuan 2020; digest `seed000_one_step_identification.md`
+//! §8, §9, §11): a free-floating base with thrusters, an arm, and a target rigidly grasped at the end
+//! effector, driven by
+//! - bounded momentum damping by the base thrusters (eq. 40), and
+//! - base attitude stabilisation realised by the arm (eq. 39): at every instant the joint
+//!   accelerations are solved from the base's angular rows of the equations of motion so that the
+//!   base attitude follows `α = −K_D ω − K_P φ`, plus a null-space excitation.
+//!
+//! The simulation is the engine's RK4 on the configuration group; the controller runs inside every
+//! Runge-Kutta stage (continuous control, digest §11). Identification is done on the recorded
+//! trajectory (Python `freefloat.postcapture`).
+
+mod control;
+mod simulate;
+
+pub use control::{saturate, PostcaptureControl};
+pub use simulate::simulate_postcapture;
