@@ -194,3 +194,16 @@ def test_a_design_that_cannot_excite_everything_is_reported(guess):
     d = exc.ExcitationDesign(guess, arm=["J1"], wheels=[], limits=exc.Limits.seed001(1))
     with pytest.raises(ff.NumericalError, match="does not excite every minimal parameter"):
         d.design(maxiter=2, progress=False)
+
+
+def test_stacked_fourier_trajectory_file_round_trip(design, tmp_path):
+    dirs = design.all_directions[:6]
+    c = np.zeros((6, 11))
+    c[:, 0], c[:, 1], c[:, 7] = 0.1, 0.3, -0.2
+    traj = design.fourier(c.ravel(), dirs)
+    exc.save_trajectory(tmp_path / "f.json", traj, design.joints)
+    back, joints = exc.load_trajectory(tmp_path / "f.json")
+    t = np.linspace(0, traj.duration, 57)
+    for a, b in zip(traj.evaluate(t), back.evaluate(t)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-15)
+    assert traj.duration == pytest.approx(6.0)

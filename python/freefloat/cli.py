@@ -17,6 +17,12 @@ from .simulation import Trajectory, simulate
 MODEL_HELP = "a built-in robot name (see `freefloat models`) or a .yaml / .urdf file"
 
 
+def tqdm_bar(total: int, desc: str):
+    from tqdm.auto import tqdm
+
+    return tqdm(total=total, desc=desc, leave=False)
+
+
 def _scenario(name: str) -> Path:
     """A file shipped in the repository's scenarios/ directory (next to the package source)."""
     p = Path(__file__).resolve().parents[2] / "scenarios" / name
@@ -442,9 +448,12 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
 @click.option("--compare/--no-compare", default=False, show_default=True,
               help="Then simulate MODEL along the designed trajectory, along the same number of un-designed intervals "
                    "and along the un-pruned step-1 trajectory, with the paper's noise, and compare identification errors.")
+@click.option("--fourier/--no-fourier", default=False, show_default=True,
+              help="Also optimise the paper's baseline, a 5-term Fourier series per arm joint (11 variables each), on the "
+                   "same objective over the same duration; written as fourier_trajectory.json and compared with --compare.")
 @click.option("--out", default="freefloat-excite", show_default=True,
               help="Directory for trajectory.json, results.json and fig4.png.")
-def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc_limit, compare, out):
+def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc_limit, compare, fourier, out):
     """Design an exciting trajectory for identifying MODEL's minimal parameters (seed 001, Sec. V).
 
     Three steps, each with a progress bar: (1) SQP over two seeds per arm joint (start angle and range of the
@@ -470,9 +479,25 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
     click.echo("time: " + ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items()))
     res.save(out)
     summary = res.to_dict()
+    extra = {}
+    if fourier:
+        bar = tqdm_bar(maxiter, "Fourier baseline: SQP over 11 coefficients per joint")
+        try:
+            fstep, ftraj = design.fourier_baseline(res.directions, maxiter=maxiter,
+                                                   progress=lambda it, c: (bar.update(1), bar.set_postfix(C=f"{c:.4g}")))
+        finally:
+            bar.close()
+        click.echo(f"Fourier baseline ({len(res.directions) * design.interval:g} s, {fstep.x.size} variables): "
+                   f"κ = {fstep.condition_number:.4g}, C = {fstep.objective:.4g} "
+                   f"(cycloids, {2 * design.n_arm} variables: κ = {res.step3.condition_number:.4g}, C = {res.step3.objective:.4g})")
+        exc.save_trajectory(Path(out) / "fourier_trajectory.json", ftraj, design.joints, g.name)
+        summary["fourier"] = {"condition_number": fstep.condition_number, "objective": fstep.objective,
+                              "variables": int(fstep.x.size), "iterations": fstep.iterations}
+        extra["Fourier baseline (same duration)"] = ftraj
+        Path(out, "results.json").write_text(json.dumps(summary, indent=2))
     if compare:
         click.echo("\ncomparison with the paper's noise (identification of MODEL's minimal parameters):")
-        summary["comparison"] = exc.compare(m, res, progress=True)
+        summary["comparison"] = exc.compare(m, res, progress=True, extra=extra)
         click.echo(exc.comparison_table(summary["comparison"]))
         Path(out, "results.json").write_text(json.dumps(summary, indent=2))
     click.echo(f"wrote {out}/trajectory.json, {out}/results.json and {out}/fig4.png")

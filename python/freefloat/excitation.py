@@ -499,8 +499,11 @@ def significant(sv, delta: float) -> int:
     return int(np.sum(sv > delta * sv[0])) if sv.size and sv[0] > 0 else 0
 
 
-def _kappa(sv) -> float:
+def _kappa(sv, n: int | None = None) -> float:
+    """σ_max/σ_min over n singular values: a wide matrix (fewer rows than n) has n − rows zero ones."""
     sv = np.asarray(sv)
+    if n is not None and sv.size < n:
+        return float("inf")
     return float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
 
 
@@ -518,7 +521,7 @@ def prune_intervals(blocks, u_max: int = U_MAX, delta: float = DELTA, min_gain: 
     concat_s = np.zeros(K, dtype=int)
     for i in range(K):
         sv = np.linalg.svd(blocks[i], compute_uv=False)
-        single_k[i], single_s[i] = _kappa(sv), significant(sv, delta)
+        single_k[i], single_s[i] = _kappa(sv, n), significant(sv, delta)
     kept, R, rows = [], np.zeros((0, n)), 0
     i = 0
     while i < K and rows <= n:  # "while n_r <= n_c": take intervals until G_m^o is taller than wide
@@ -526,14 +529,14 @@ def prune_intervals(blocks, u_max: int = U_MAX, delta: float = DELTA, min_gain: 
         R = _stack(R, blocks[i])
         rows += blocks.shape[1]
         sv = np.linalg.svd(R, compute_uv=False)
-        concat_k[i], concat_s[i] = _kappa(sv), significant(sv, delta)
+        concat_k[i], concat_s[i] = _kappa(sv, n), significant(sv, delta)
         i += 1
     sv = np.linalg.svd(R, compute_uv=False)
-    s_prev, cn_prev, u = significant(sv, delta), _kappa(sv), 0
+    s_prev, cn_prev, u = significant(sv, delta), _kappa(sv, n), 0
     while i < K:
         Rt = _stack(R, blocks[i])
         sv = np.linalg.svd(Rt, compute_uv=False)
-        s_now, cn_now = significant(sv, delta), _kappa(sv)
+        s_now, cn_now = significant(sv, delta), _kappa(sv, n)
         improved = s_now > s_prev or cn_now < cn_prev * (1.0 - min_gain)
         if improved or (s_now == s_prev and u < u_max):
             kept.append(i)
@@ -561,7 +564,7 @@ def plot_fig4(pr: PruneResult, path) -> None:
     plt = _plt()
     k = np.arange(1, len(pr.single_kappa) + 1)
     fig, ax = plt.subplots(2, 1, figsize=(10, 7), sharex=True, constrained_layout=True)
-    ax[0].semilogy(k, np.minimum(pr.single_kappa, 1e20), ".", ms=3, label="single interval")
+    ax[0].semilogy(k, np.minimum(pr.single_kappa, 1e20), ".", ms=3, label="single interval (rank-deficient: shown at the cap)")
     ax[0].semilogy(k, np.minimum(pr.concat_kappa, 1e20), "-", label="accepted concatenation")
     ax[0].set_ylabel("condition number (capped at 1e20)")
     ax[1].plot(k, pr.single_significant, ".", ms=3, label="single interval")
@@ -581,17 +584,41 @@ def plot_fig4(pr: PruneResult, path) -> None:
 
 # -- trajectory files ---------------------------------------------------------------------------------------
 def save_trajectory(path, traj, joints, model_name: str = "") -> None:
-    """A designed trajectory as JSON: cycloidal (start, range, directions, interval) or Fourier coefficients."""
-    if isinstance(traj, Cycloidal):
-        d = {"kind": "cycloidal", "start": traj.start.tolist(), "range": traj.range_.tolist(),
-             "directions": traj.directions.astype(int).tolist(), "interval": traj.interval}
-    elif isinstance(traj, Fourier):
-        d = {"kind": "fourier", "q0": traj.q0.tolist(), "a": traj.a.tolist(), "b": traj.b.tolist(),
-             "omega_f": traj.omega_f, "n_h": traj.n_h, "duration": traj.duration}
-    else:
-        raise InputError(f"save_trajectory: cannot write a {type(traj).__name__}")
+    """A joint trajectory as JSON: cycloidal (start, range, directions, interval), Fourier coefficients, or a
+    stack of those (e.g. Fourier arm joints with cycloidal wheels)."""
+    d = _traj_to_dict(traj)
     d.update(joints=list(joints), model=model_name, format="freefloat-trajectory-1")
     Path(path).write_text(json.dumps(d, indent=2))
+
+
+def _traj_to_dict(traj) -> dict:
+    from .trajectories import Stacked
+
+    if isinstance(traj, Cycloidal):
+        return {"kind": "cycloidal", "start": traj.start.tolist(), "range": traj.range_.tolist(),
+                "directions": traj.directions.astype(int).tolist(), "interval": traj.interval}
+    if isinstance(traj, Fourier):
+        return {"kind": "fourier", "q0": traj.q0.tolist(), "a": traj.a.tolist(), "b": traj.b.tolist(),
+                "omega_f": traj.omega_f, "n_h": traj.n_h, "duration": traj.duration}
+    if isinstance(traj, Stacked):
+        return {"kind": "stacked", "parts": [_traj_to_dict(p) for p in traj.parts]}
+    raise InputError(f"save_trajectory: cannot write a {type(traj).__name__}")
+
+
+def _traj_from_dict(d: dict, where: str):
+    from .trajectories import Stacked
+
+    kind = d.get("kind")
+    try:
+        if kind == "cycloidal":
+            return Cycloidal(d["start"], d["range"], d["directions"], interval=d["interval"])
+        if kind == "fourier":
+            return Fourier(d["a"], d["b"], d["q0"], omega_f=d["omega_f"], n_h=d["n_h"])
+        if kind == "stacked":
+            return Stacked(*[_traj_from_dict(p, where) for p in d["parts"]])
+    except KeyError as e:
+        raise InputError(f"{where}: missing field {e} in a {kind} trajectory") from None
+    raise InputError(f"{where}: unknown trajectory kind {kind!r} (expected 'cycloidal', 'fourier' or 'stacked')")
 
 
 def load_trajectory(path):
@@ -601,29 +628,22 @@ def load_trajectory(path):
         d = json.loads(p.read_text())
     except (OSError, json.JSONDecodeError) as e:
         raise InputError(f"{p}: not a readable trajectory file ({e})") from None
-    kind = d.get("kind")
-    try:
-        if kind == "cycloidal":
-            traj = Cycloidal(d["start"], d["range"], d["directions"], interval=d["interval"])
-        elif kind == "fourier":
-            traj = Fourier(d["a"], d["b"], d["q0"], omega_f=d["omega_f"], n_h=d["n_h"])
-        else:
-            raise InputError(f"{p}: unknown trajectory kind {kind!r} (expected 'cycloidal' or 'fourier')")
-        joints = list(d["joints"])
-    except KeyError as e:
-        raise InputError(f"{p}: missing field {e} in a {kind} trajectory") from None
-    if len(joints) != traj.n:
-        raise InputError(f"{p}: {len(joints)} joint names for a trajectory of {traj.n} joints")
+    traj = _traj_from_dict(d, str(p))
+    joints = d.get("joints")
+    if not isinstance(joints, list) or len(joints) != traj.n:
+        raise InputError(f"{p}: 'joints' must list {traj.n} joint names, one per trajectory column")
     return traj, joints
 
 
 # -- does design pay? ------------------------------------------------------------------------------------------
-def compare(true_model, result: DesignResult, seeds=(0,), rate_noise=(50e-6, 80e-6, 50e-6), progress: bool = False) -> dict:
+def compare(true_model, result: DesignResult, seeds=(0,), rate_noise=(50e-6, 80e-6, 50e-6), progress: bool = False,
+            extra: dict | None = None) -> dict:
     """Identify `true_model`'s minimal parameters with the paper's rate noise along (a) the designed trajectory,
     (b) the same number of un-designed intervals — the first K direction combinations with arbitrary seeds
     (mid-range start, half the maximal range, scaled into the limits) — and (c) the un-pruned step-1 trajectory
     over all combinations (the paper's Table 5 argument).  Errors per case: median and max relative error in
-    percent (eqs. 38-39) of plain least squares and of the bias-compensated estimate, averaged over `seeds`."""
+    percent (eqs. 38-39) of plain least squares and of the bias-compensated estimate, averaged over `seeds`.
+    `extra`: more named trajectories (driving `design.joints`) to compare, e.g. the Fourier baseline."""
     from .identify import identify_minimal, trajectory_data
 
     d = result.design
@@ -634,6 +654,7 @@ def compare(true_model, result: DesignResult, seeds=(0,), rate_noise=(50e-6, 80e
         f"un-designed, first {K} combinations": d.cycloid(d.feasible_start(first), first),
         f"un-pruned step 1 ({d.n_intervals} intervals)": d.cycloid(result.step1.x, d.all_directions),
     }
+    cases.update(extra or {})  # e.g. {"Fourier baseline": trajectory}
     out = {}
     for name, traj in cases.items():
         rows = []
