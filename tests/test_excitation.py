@@ -71,12 +71,14 @@ def test_objective_matches_an_svd_of_the_stacked_rows(design):
 
 
 def test_batch_evaluation_equals_single_evaluations(design):
-    dirs = design.all_directions[:8]
+    # a full-rank case (with unexcited directions κ is round-off, and the summation order of the threads' Gram
+    # blocks, which differs between a batch and a single call, changes it)
+    dirs = design.all_directions[np.random.default_rng(1).choice(256, 32, replace=False)]
     x = _x(design)
     X = np.vstack([x, x * 1.01, x * 0.99])
     batch = design.evaluate(X, dirs)["objective"]
     single = [design.evaluate(xx, dirs)["objective"][0] for xx in X]
-    np.testing.assert_allclose(batch, single, rtol=1e-12)
+    np.testing.assert_allclose(batch, single, rtol=1e-10)
 
 
 def test_fastest_first_order_bounds_travel():

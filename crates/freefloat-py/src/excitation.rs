@@ -4,7 +4,6 @@
 use crate::batch::{array_arg, model_arg};
 use crate::errors::{guard, input_err};
 use freefloat_core::excitation::{evaluate_batch, excitation_rows, JointPath, ObjectiveSpec};
-use freefloat_core::Data;
 use numpy::{IntoPyArray, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -65,7 +64,7 @@ pub fn excitation_objective<'py>(
     let paths: Vec<JointPath> = (0..b)
         .map(|k| JointPath { step, iq: &iq, iv: &iv, q: &qa[k * w..(k + 1) * w], qd: &qda[k * w..(k + 1) * w] })
         .collect();
-    let spec = ObjectiveSpec { q0: &q0, stride, offset, columns: &columns, weight, n_signal };
+    let spec = ObjectiveSpec { q0: &q0, stride, offset, columns: &columns, weight, n_signal, threads: 1 };
     let results = py.detach(|| guard(|| Ok(evaluate_batch(m, &spec, &paths, threads))))?;
     let (mut obj, mut kap, mut ms, mut sv) = (vec![], vec![], vec![], vec![]);
     for r in results {
@@ -112,12 +111,7 @@ pub fn excitation_rows_py<'py>(
         return Err(input_err("arguments `q`, `qd`: expected one path, (S, n) each"));
     }
     let path = JointPath { step, iq: &iq, iv: &iv, q: &qa, qd: &qda };
-    let ex = py.detach(|| {
-        guard(|| {
-            let mut d = Data::new(m);
-            excitation_rows(m, &mut d, &q0, &path, stride, offset, &columns, n_signal)
-        })
-    })?;
+    let ex = py.detach(|| guard(|| excitation_rows(m, &q0, &path, stride, offset, &columns, n_signal, 2)))?;
     let (r, c) = (ex.rows.nrows(), ex.rows.ncols());
     let rows: Vec<f64> = ex.rows.transpose().as_slice().to_vec(); // column-major -> row-major
     let d = PyDict::new(py);

@@ -4,8 +4,7 @@
 //! small Gram matrix (n_min × n_min) rather than an SVD of the tall matrix; h ranges over the base twist
 //! components and the rates of the designed (arm) joints at the sampled points — `ObjectiveSpec::n_signal`.
 
-use super::response::{excitation_rows, JointPath};
-use crate::data::Data;
+use super::response::{sample_blocks, JointPath};
 use crate::error::Result;
 use crate::model::Model;
 use nalgebra::DMatrix;
@@ -19,6 +18,8 @@ pub struct ObjectiveSpec<'a> {
     pub weight: f64,
     /// the first `n_signal` driven joints count in the signal term (see `excitation_rows`)
     pub n_signal: usize,
+    /// worker threads of one evaluation (1 inside a batch whose evaluations already run in parallel)
+    pub threads: usize,
 }
 
 /// One evaluation of eq. (32).
@@ -34,10 +35,10 @@ pub struct Evaluation {
     pub singular_values: Vec<f64>,
 }
 
-/// Evaluate eq. (32) for one joint path.
-pub fn evaluate(m: &Model, d: &mut Data, spec: &ObjectiveSpec, path: &JointPath) -> Result<Evaluation> {
-    let ex = excitation_rows(m, d, spec.q0, path, spec.stride, spec.offset, spec.columns, spec.n_signal)?;
-    let gram = gram(&ex.rows);
+/// Evaluate eq. (32) for one joint path, on `spec.threads` worker threads.
+pub fn evaluate(m: &Model, spec: &ObjectiveSpec, path: &JointPath) -> Result<Evaluation> {
+    let ex = sample_blocks(m, spec.q0, path, spec.stride, spec.offset, spec.columns, spec.n_signal, spec.threads)?;
+    let gram = gram(&ex.blocks, spec.columns.len());
     let mut lam: Vec<f64> = gram.symmetric_eigenvalues().iter().map(|&l| l.max(0.0)).collect();
     lam.sort_by(|a, b| b.total_cmp(a));
     let sv: Vec<f64> = lam.iter().map(|l| l.sqrt()).collect();
@@ -46,29 +47,36 @@ pub fn evaluate(m: &Model, d: &mut Data, spec: &ObjectiveSpec, path: &JointPath)
     // is kept anyway, floored at 1e-16 σ_max so it stays finite.
     let kappa = if smax > 0.0 { smax / smin.max(1e-16 * smax) } else { f64::INFINITY };
     let ms = ex.sumsq / ex.count as f64;
-    Ok(Evaluation { objective: kappa + spec.weight / ms, condition_number: kappa, mean_square: ms, singular_values: sv })
+    Ok(Evaluation {
+        objective: kappa + spec.weight / ms,
+        condition_number: kappa,
+        mean_square: ms,
+        singular_values: sv,
+    })
 }
 
-/// Evaluate many joint paths, split over `threads` worker threads (finite-difference gradients).
+/// Evaluate many joint paths, split over `threads` worker threads (finite-difference gradients); with fewer
+/// paths than threads, each evaluation gets the spare threads.
 pub fn evaluate_batch(m: &Model, spec: &ObjectiveSpec, paths: &[JointPath], threads: usize) -> Vec<Result<Evaluation>> {
-    let threads = threads.clamp(1, paths.len().max(1));
-    let chunk = paths.len().div_ceil(threads);
+    let inner = (threads / paths.len().max(1)).max(1);
+    let spec = &ObjectiveSpec { threads: inner, ..*spec };
+    let outer = threads.clamp(1, paths.len().max(1));
+    let chunk = paths.len().div_ceil(outer).max(1);
     std::thread::scope(|s| {
         let handles: Vec<_> = paths
-            .chunks(chunk.max(1))
-            .map(|part| {
-                s.spawn(move || {
-                    let mut d = Data::new(m);
-                    part.iter().map(|p| evaluate(m, &mut d, spec, p)).collect::<Vec<_>>()
-                })
-            })
+            .chunks(chunk)
+            .map(|part| s.spawn(move || part.iter().map(|p| evaluate(m, spec, p)).collect::<Vec<_>>()))
             .collect();
         handles.into_iter().flat_map(|h| h.join().expect("excitation worker panicked")).collect()
     })
 }
 
-/// GᵀG by one matrix product: nalgebra hands `Gᵀ · G` of dynamic matrices to a blocked kernel
-/// (matrixmultiply), several times faster than `gemm_tr`'s column dot products at this size.
-fn gram(rows: &DMatrix<f64>) -> DMatrix<f64> {
-    rows.transpose() * rows
+/// GᵀG summed over the row blocks, each block's product in parallel: nalgebra hands `Bᵀ · B` of dynamic
+/// matrices to a blocked kernel (matrixmultiply), faster than `gemm_tr`'s column dot products at this size,
+/// and it is the largest cost of an evaluation (7680 × 52 for the seed 001 design).
+fn gram(blocks: &[DMatrix<f64>], n: usize) -> DMatrix<f64> {
+    std::thread::scope(|s| {
+        let parts: Vec<_> = blocks.iter().map(|b| s.spawn(move || b.transpose() * b)).collect();
+        parts.into_iter().map(|h| h.join().expect("gram worker panicked")).fold(DMatrix::zeros(n, n), |a, b| a + b)
+    })
 }

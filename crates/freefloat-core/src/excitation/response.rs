@@ -37,7 +37,7 @@ impl JointPath<'_> {
         if n == 0 || self.iv.len() != n {
             return Err(FfError::arg("joints", "need one or more driven joints, with q and v indices alike"));
         }
-        if self.q.len() % n != 0 || self.qd.len() != self.q.len() || self.q.len() < 2 * n {
+        if !self.q.len().is_multiple_of(n) || self.qd.len() != self.q.len() || self.q.len() < 2 * n {
             return Err(FfError::arg("q/qd", format!("expected two (samples × {n}) arrays of 2+ samples")));
         }
         if !(self.step > 0.0) || !self.step.is_finite() {
@@ -105,16 +105,52 @@ pub struct ExcitationRows {
 /// Integration is the trapezoidal rule on the group between grid points: the attitude advances by
 /// `exp(h (ω_i + ω_{i+1}) / 2)` and the position by `h (R_i v_i + R_{i+1} v_{i+1}) / 2` (second order;
 /// the grid is fine, and the design needs the base motion as a proxy, not as a simulation).
+#[allow(clippy::too_many_arguments)]
 pub fn excitation_rows(
     m: &Model,
-    d: &mut Data,
     q0: &[f64],
     path: &JointPath,
     stride: usize,
     offset: usize,
     columns: &[usize],
     n_signal: usize,
+    threads: usize,
 ) -> Result<ExcitationRows> {
+    let s = sample_blocks(m, q0, path, stride, offset, columns, n_signal, threads)?;
+    let total: usize = s.blocks.iter().map(|b| b.nrows()).sum();
+    let mut rows = DMatrix::zeros(total, columns.len());
+    let mut r0 = 0;
+    for b in &s.blocks {
+        rows.rows_mut(r0, b.nrows()).copy_from(b);
+        r0 += b.nrows();
+    }
+    Ok(ExcitationRows { rows, sumsq: s.sumsq, count: s.count, q_end: s.q_end })
+}
+
+/// The rows of `excitation_rows` as consecutive blocks, one per worker thread (the objective forms each
+/// block's Gram matrix where it was built).
+pub(crate) struct SampleBlocks {
+    pub blocks: Vec<DMatrix<f64>>,
+    pub sumsq: f64,
+    pub count: usize,
+    pub q_end: Vec<f64>,
+}
+
+/// Three phases, so that the expensive ones run in parallel: (1) the zero-momentum twist at every grid
+/// point depends on the joints only (not on the base pose), so the points are split over threads; (2) the
+/// base pose is integrated sequentially (a quaternion product per point); (3) the regressor rows at the
+/// sampled points, again split over threads.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sample_blocks(
+    m: &Model,
+    q0: &[f64],
+    path: &JointPath,
+    stride: usize,
+    offset: usize,
+    columns: &[usize],
+    n_signal: usize,
+    threads: usize,
+) -> Result<SampleBlocks> {
     if m.joint_types[0] != JointType::Free {
         return Err(FfError::arg("model", "exciting-trajectory design needs a free-floating base"));
     }
@@ -133,45 +169,104 @@ pub fn excitation_rows(
     if n_signal > n {
         return Err(FfError::arg("n_signal", format!("{n_signal} signal joints of {n} driven joints")));
     }
-    let picked = (0..samples).filter(|i| i % stride == offset).count();
-    let mut rows = DMatrix::zeros(6 * picked, columns.len());
-    let mut full = DMatrix::zeros(6, ncol);
-    let mut q = q0.to_vec();
-    let mut scratch = q0.to_vec();
-    let mut v = vec![0.0; m.nv];
-    let (mut pos, mut quat) = (V3::new(q[0], q[1], q[2]), [q[3], q[4], q[5], q[6]]);
-    quat_normalize(&mut quat);
-    let mut prev: Option<(Vector6<f64>, V3)> = None; // twist and inertial-frame base velocity at the last point
-    let (mut sumsq, mut r) = (0.0, 0);
-    for i in 0..samples {
+    let threads = threads.clamp(1, 16);
+    let set_joints = |i: usize, q: &mut [f64], v: &mut [f64]| {
         for k in 0..n {
-            scratch[path.iq[k]] = path.q[i * n + k];
+            q[path.iq[k]] = path.q[i * n + k];
             v[path.iv[k]] = path.qd[i * n + k];
         }
-        let tw = base_twist_zero_momentum(m, d, &mut scratch, &mut v)?;
-        if let Some((tw0, vel0)) = prev {
-            let w = (tw0.fixed_rows::<3>(3) + tw.fixed_rows::<3>(3)) * (0.5 * path.step);
-            quat = quat_mul(&quat, &quat_exp(&V3::new(w.x, w.y, w.z)));
-            quat_normalize(&mut quat);
-            let vel = rot_from_quat(&quat) * V3::new(tw[0], tw[1], tw[2]);
-            pos += (vel0 + vel) * (0.5 * path.step);
+    };
+
+    // (1) twists at every grid point
+    let chunk = samples.div_ceil(threads);
+    let twists: Vec<Vector6<f64>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..samples)
+            .step_by(chunk)
+            .map(|i0| {
+                s.spawn(move || -> Result<Vec<Vector6<f64>>> {
+                    let mut d = Data::new(m);
+                    let (mut q, mut v) = (q0.to_vec(), vec![0.0; m.nv]);
+                    (i0..(i0 + chunk).min(samples))
+                        .map(|i| {
+                            set_joints(i, &mut q, &mut v);
+                            base_twist_zero_momentum(m, &mut d, &mut q, &mut v)
+                        })
+                        .collect()
+                })
+            })
+            .collect();
+        let mut all = Vec::with_capacity(samples);
+        for h in handles {
+            all.extend(h.join().map_err(|_| FfError::Numerical("excitation worker panicked".into()))??);
         }
-        let vel = rot_from_quat(&quat) * V3::new(tw[0], tw[1], tw[2]);
-        prev = Some((tw, vel));
-        if i % stride == offset {
-            place_base(m, d, &tw, &Se3::new(rot_from_quat(&quat), pos));
-            momentum_regressor_from_data(m, d, &mut full);
-            for (c, &col) in columns.iter().enumerate() {
-                for k in 0..6 {
-                    rows[(6 * r + k, c)] = full[(k, col)];
-                }
-            }
-            sumsq += tw.norm_squared() + (0..n_signal).map(|k| path.qd[i * n + k].powi(2)).sum::<f64>();
-            r += 1;
-        }
+        Ok::<_, FfError>(all)
+    })?;
+
+    // (2) base poses by the trapezoidal rule on the group
+    let mut quat = [q0[3], q0[4], q0[5], q0[6]];
+    quat_normalize(&mut quat);
+    let mut pos = V3::new(q0[0], q0[1], q0[2]);
+    let mut poses = Vec::with_capacity(samples);
+    let mut vel0 = rot_from_quat(&quat) * V3::new(twists[0][0], twists[0][1], twists[0][2]);
+    poses.push(Se3::new(rot_from_quat(&quat), pos));
+    for i in 1..samples {
+        let w = (twists[i - 1].fixed_rows::<3>(3) + twists[i].fixed_rows::<3>(3)) * (0.5 * path.step);
+        quat = quat_mul(&quat, &quat_exp(&V3::new(w.x, w.y, w.z)));
+        quat_normalize(&mut quat);
+        let rot = rot_from_quat(&quat);
+        let vel = rot * V3::new(twists[i][0], twists[i][1], twists[i][2]);
+        pos += (vel0 + vel) * (0.5 * path.step);
+        vel0 = vel;
+        poses.push(Se3::new(rot, pos));
     }
-    q.copy_from_slice(&scratch);
-    q[..3].copy_from_slice(pos.as_slice());
-    q[3..7].copy_from_slice(&quat);
-    Ok(ExcitationRows { rows, sumsq, count: (6 + n_signal) * picked, q_end: q })
+
+    // (3) regressor rows at the sampled points
+    let picked: Vec<usize> = (0..samples).filter(|i| i % stride == offset).collect();
+    let pchunk = picked.len().div_ceil(threads).max(1);
+    let (twists, poses) = (&twists, &poses);
+    let parts: Vec<(DMatrix<f64>, f64)> = std::thread::scope(|s| {
+        let handles: Vec<_> = picked
+            .chunks(pchunk)
+            .map(|idx| {
+                s.spawn(move || {
+                    let mut d = Data::new(m);
+                    let (mut q, mut v) = (q0.to_vec(), vec![0.0; m.nv]);
+                    q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
+                    let mut full = DMatrix::zeros(6, ncol);
+                    let mut rows = DMatrix::zeros(6 * idx.len(), columns.len());
+                    let mut sumsq = 0.0;
+                    for (r, &i) in idx.iter().enumerate() {
+                        set_joints(i, &mut q, &mut v);
+                        forward_velocities(m, &mut d, &q, &v); // identity base, joint-only twists
+                        place_base(m, &mut d, &twists[i], &poses[i]);
+                        momentum_regressor_from_data(m, &d, &mut full);
+                        for (c, &col) in columns.iter().enumerate() {
+                            for k in 0..6 {
+                                rows[(6 * r + k, c)] = full[(k, col)];
+                            }
+                        }
+                        sumsq +=
+                            twists[i].norm_squared() + (0..n_signal).map(|k| path.qd[i * n + k].powi(2)).sum::<f64>();
+                    }
+                    (rows, sumsq)
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().expect("excitation worker panicked")).collect()
+    });
+
+    let mut q_end = q0.to_vec();
+    for k in 0..n {
+        q_end[path.iq[k]] = path.q[(samples - 1) * n + k];
+    }
+    let last = &poses[samples - 1];
+    q_end[..3].copy_from_slice(last.trans.as_slice());
+    q_end[3..7].copy_from_slice(&quat);
+    let sumsq = parts.iter().map(|p| p.1).sum();
+    Ok(SampleBlocks {
+        blocks: parts.into_iter().map(|p| p.0).collect(),
+        sumsq,
+        count: (6 + n_signal) * picked.len(),
+        q_end,
+    })
 }
