@@ -157,3 +157,24 @@ pub fn dh_exp(d: f64, theta: f64, a: f64, alpha: f64) -> DualQuat {
 pub fn dh_chain(rows: &[[f64; 4]]) -> DualQuat {
     rows.iter().fold(DualQuat::ONE, |acc, r| acc.mul(&dh(r[0], r[1], r[2], r[3])))
 }
+
+/// Body Jacobian of a serial chain in the form of (3.57)–(3.60) (corrected, digest §10.13):
+/// `ω^e_{e/I} = Σ_k Ad_{(q_{k+1/k} ⋯ q_{e/n})*} ξ_k α̇_k`. `rel = [q_{1/I}, q_{2/1}, …, q_{e/n}]` are the
+/// relative poses (n + 1 of them) and `screws[k]` is joint k's unit twist ξ_k in the frame it moves
+/// (Table 3.1). Returns the n columns (8-vectors, `[real; dual]`).
+pub fn serial_body_jacobian(rel: &[DualQuat], screws: &[DualQuat]) -> Result<Vec<DualQuat>> {
+    if rel.len() != screws.len() + 1 {
+        return Err(FfError::arg(
+            "rel",
+            format!("needs {} poses for {} joints, got {}", screws.len() + 1, screws.len(), rel.len()),
+        ));
+    }
+    let n = screws.len();
+    let mut cols = vec![DualQuat::ZERO; n];
+    let mut tail = DualQuat::ONE; // q_{k+1/k} ⋯ q_{e/n}
+    for k in (0..n).rev() {
+        tail = rel[k + 1].mul(&tail);
+        cols[k] = tail.shift_in(&screws[k]);
+    }
+    Ok(cols)
+}
