@@ -8,7 +8,7 @@
 
 Conventions are in docs/architecture.md; every number is computed by the Rust engine."""
 
-from . import estimation, models, telemetry, trajectories
+from . import dq, estimation, models, telemetry, trajectories
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
@@ -37,7 +37,7 @@ from .identify import IdentificationResult, identify_minimal
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Trajectory", "models", "simulate", "telemetry", "trajectories", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
+    "Model", "Trajectory", "models", "dq", "simulate", "telemetry", "trajectories", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
     "aba", "rnea", "crba", "hybrid_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",

@@ -3,6 +3,7 @@
 
 mod algorithms;
 mod batch;
+mod dq;
 mod errors;
 mod estimation;
 mod model;
@@ -36,5 +37,15 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
+    m.add_class::<dq::PyDualQuaternion>()?;
+    m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_exp, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_screw, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_dh, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_dh_chain, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_line_of_sight, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_approach_slope, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_attitude, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_distance_bound, m)?)?;
     Ok(())
 }

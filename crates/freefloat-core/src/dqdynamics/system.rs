@@ -1,0 +1,417 @@
+//! Assembly and solution of the dual-quaternion Newton–Euler system (seed 003, §6.3, (6.17)–(6.27)).
+//!
+//! Unknowns: every body's CoM-frame twist rate `ẏ_i` and every joint's reduced reaction `W̃_j`. With
+//! `G_ij` the map from joint j's reduced wrench to the wrench on body i at its CoM (6.20), the body rows are
+//! `M_i (ẏ_i)^s = B1_i + Σ_j G_ij W̃_j` ((2.56) with (6.22)) and the joint rows (6.16) are
+//! `Σ_i G_ijᵀ (ẏ_i)^s = B2_j`; we take the constraint selector `Λ_j = V_jᵀ P_swap` (the symmetric variant,
+//! digest §2.5), which makes `S21 = G_physᵀ P_swap` because `Ad_inᵀ P_swap = P_swap Ad_out` (power is frame
+//! invariant). Eliminating `ẏ` (Schur complement on S11, (6.24)–(6.27)) leaves
+//!   `K W̃ = B2 − Σ_i G_iᵀ M_i⁻¹ B1_i`,  `K = Σ_i G_iᵀ M_i⁻¹ G_i = −S21 S11⁻¹ S12`,
+//! K symmetric positive definite (the Delassus matrix), solved by Cholesky. K has a block for every pair of
+//! joints sharing a body; eliminating joints from the leaves up creates no fill-in (the joint graph of a
+//! tree is chordal), see `solve_tree`.
+
+use super::joints::{alignment, motion_slots, slots, swapped};
+use crate::dualquat::kinematics::joint_pose;
+use crate::dualquat::pose::translation;
+use crate::dualquat::{DualInertia, DualQuat};
+use crate::error::{FfError, Result};
+use crate::model::{JointType, Model};
+use crate::spatial::{Force, V3, V6};
+use nalgebra::{DMatrix, DVector, Matrix6};
+
+type M6 = Matrix6<f64>;
+
+/// Result of `dq_dynamics`.
+#[derive(Clone, Debug, Default)]
+pub struct DqDynamics {
+    /// Generalized accelerations (nv), the engine's convention.
+    pub ddq: Vec<f64>,
+    /// Per body: the total wrench its joint transmits onto it (reaction + actuation), child body frame,
+    /// about the body origin — the engine's RNEA `f_i`.
+    pub joint_wrenches: Vec<Force>,
+    /// Per body: the constraint (reaction) part alone, `V_j W̃_j` (for a locked joint: all but the actuated
+    /// slots; for a free base: zero), same frame.
+    pub reactions: Vec<Force>,
+    /// Per body: for locked joints, the generalized force the joint must supply (zero elsewhere), nv.
+    pub locked_forces: Vec<f64>,
+}
+
+/// The 6×6 restriction of an 8×8 sandwich matrix to the vector slots (1..4, 5..8) — exact for unit q,
+/// which maps vector dual quaternions to vector dual quaternions.
+fn reduce(m: &crate::dualquat::M8) -> M6 {
+    const IDX: [usize; 6] = [1, 2, 3, 5, 6, 7];
+    M6::from_fn(|r, c| m[(IDX[r], IDX[c])])
+}
+/// `x ↦ q* x q` ((2.41)/(2.43)) on 6-vectors.
+fn ad_in(q: &DualQuat) -> M6 {
+    reduce(&q.adjoint_in_matrix())
+}
+/// `x ↦ q x q*` ((2.42)/(2.44)) on 6-vectors.
+fn ad_out(q: &DualQuat) -> M6 {
+    reduce(&q.adjoint_out_matrix())
+}
+/// The swap on 6-vectors: `[a; b] ↦ [b; a]`.
+fn swap6(x: &V6) -> V6 {
+    V6::new(x[3], x[4], x[5], x[0], x[1], x[2])
+}
+/// Dual-quaternion cross product (Table 2.4) of two vector dual quaternions as 6-vectors:
+/// `(a_r × b_r) + ε(a_d × b_r + a_r × b_d)`.
+fn cross6(a: &V6, b: &V6) -> V6 {
+    let (ar, ad) = (a.fixed_rows::<3>(0).into_owned(), a.fixed_rows::<3>(3).into_owned());
+    let (br, bd) = (b.fixed_rows::<3>(0).into_owned(), b.fixed_rows::<3>(3).into_owned());
+    let r = ar.cross(&br);
+    let d = ad.cross(&br) + ar.cross(&bd);
+    V6::new(r.x, r.y, r.z, d.x, d.y, d.z)
+}
+/// `M⁻¹ [f; τ] = [f/m; Ī⁻¹τ]`, i.e. `(ẏ)^s` from a wrench (Lemma 3 without the swap).
+fn minv(mi: &DualInertia, iinv: &nalgebra::Matrix3<f64>, w: &V6) -> V6 {
+    let f = w.fixed_rows::<3>(0) / mi.mass();
+    let t = iinv * w.fixed_rows::<3>(3);
+    V6::new(f.x, f.y, f.z, t.x, t.y, t.z)
+}
+
+struct Joint {
+    body: usize,
+    parent: usize,
+    /// offset of W̃_j in the unknown vector, and its slots
+    off: usize,
+    reaction: &'static [usize],
+    locked: bool,
+    /// q_{J/B} of the child body
+    align: DualQuat,
+    /// `G` of the distal (child) and proximal (parent) body, 6 × r (first r columns used)
+    g_dist: M6,
+    g_prox: M6,
+    ad_out_oj: M6,
+    ad_in_jo: M6,
+    /// joint twist ω^j (6.13) and `x = q*_{j/o_k} ω_k q_{j/o_k}`
+    twist: V6,
+    parent_twist_in_j: V6,
+    /// actuation wrench in J (zero if locked)
+    act: V6,
+    /// prescribed J-frame twist rate of a locked joint (zero)
+    presc: V6,
+}
+
+/// Forward dynamics and joint wrenches by the dual-quaternion formulation for a tree with a free or fixed
+/// base and revolute, prismatic, spherical and fixed joints. `locked[i]` (per body, optional) holds joint i
+/// at zero joint acceleration (§6.4); its entry of `tau` is ignored and the force it needs is returned.
+/// `fext`: nbodies × 6 body-frame wrenches [force; torque about the body origin], as in the engine.
+pub fn dq_dynamics(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+) -> Result<DqDynamics> {
+    let n = m.nbodies();
+    let mut qbuf = Vec::new();
+    let q = m.checked_q(q, &mut qbuf)?;
+    crate::error::check_vec("v", v, m.nv)?;
+    crate::error::check_vec("tau", tau, m.nv)?;
+    if let Some(f) = fext {
+        crate::error::check_vec("fext", f, 6 * n)?;
+    }
+    if let Some(l) = locked {
+        if l.len() != n {
+            return Err(FfError::arg("locked", format!("expected {n} flags (one per joint), got {}", l.len())));
+        }
+    }
+    let is_locked = |i: usize| locked.map(|l| l[i]).unwrap_or(false);
+    let root_fixed = match m.joint_types[0] {
+        JointType::Free => false,
+        JointType::FixedBase => true,
+        other => {
+            return Err(FfError::Model(format!(
+                "dq_dynamics supports a free or fixed base, not a {} base",
+                other.name()
+            )))
+        }
+    };
+    if is_locked(0) {
+        return Err(FfError::arg("locked", "the base joint cannot be locked (lock the joints of the arm)"));
+    }
+    // Which bodies carry unknowns: all but a fixed root.
+    let dynamic = |i: usize| !(i == 0 && root_fixed);
+
+    // Mass properties in each body's CoM frame o_i (axes of the body frame B_i).
+    let mut inert = Vec::with_capacity(n);
+    let mut iinv = Vec::with_capacity(n);
+    let mut com = Vec::with_capacity(n);
+    for i in 0..n {
+        let inr = &m.inertias[i];
+        com.push(if inr.mass > 0.0 { inr.com() } else { V3::zeros() });
+        if !dynamic(i) {
+            inert.push(None);
+            iinv.push(nalgebra::Matrix3::zeros());
+            continue;
+        }
+        let di = DualInertia::from_inertia(inr).map_err(|e| {
+            FfError::Model(format!(
+                "body '{}' cannot enter the dual-quaternion formulation, which needs H(M)⁻¹ for every moving body: {e}",
+                m.body_names[i]
+            ))
+        })?;
+        iinv.push(di.i_com().try_inverse().unwrap_or_else(nalgebra::Matrix3::zeros));
+        inert.push(Some(di));
+    }
+
+    // Kinematics in dual-quaternion form: poses (3.43), CoM twists via (2.43).
+    let mut local = Vec::with_capacity(n); // q_{B_i/B_p}
+    let mut pose = Vec::with_capacity(n); // q_{B_i/I}
+    let mut tw_b: Vec<V6> = Vec::with_capacity(n);
+    for i in 0..n {
+        let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
+        let l = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+        // joint twist S q̇ in B_i as [ω; v]
+        let mut sj = V6::zeros();
+        let s = &m.subspaces[i];
+        for c in 0..m.nvs[i] {
+            let x = v[m.idx_v[i] + c];
+            for r in 0..3 {
+                sj[r] += s[(r + 3, c)] * x;
+                sj[r + 3] += s[(r, c)] * x;
+            }
+        }
+        let (p, t) = match m.parents[i] {
+            Some(p) => (pose[p], ad_in(&l) * tw_b[p] + sj),
+            None => (DualQuat::ONE, sj),
+        };
+        pose.push(p.mul(&l));
+        tw_b.push(t);
+        local.push(l);
+    }
+    let to_com: Vec<DualQuat> = com.iter().map(translation).collect(); // q_{o_i/B_i}
+    let tw_o: Vec<V6> = (0..n).map(|i| ad_in(&to_com[i]) * tw_b[i]).collect();
+
+    // Body right-hand sides B1 (6.22): −ω × (M ω^s) + gravity + external + actuation.
+    let mut b1 = vec![V6::zeros(); n];
+    for i in 0..n {
+        let w = &tw_o[i];
+        if let Some(mi) = &inert[i] {
+            let h = mi.apply(&crate::dualquat::DualQuat::vector(
+                &w.fixed_rows::<3>(3).into_owned(),
+                &w.fixed_rows::<3>(0).into_owned(),
+            ));
+            b1[i] -= cross6(w, &V6::new(h.r.v.x, h.r.v.y, h.r.v.z, h.d.v.x, h.d.v.y, h.d.v.z));
+        }
+        // gravity m g at the CoM, o_i coordinates
+        let g = pose[i].r.conj().rotate(&m.gravity) * m.inertias[i].mass;
+        b1[i] += V6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0);
+        if let Some(f) = fext {
+            let fe = &f[6 * i..6 * i + 6];
+            b1[i] += ad_in(&to_com[i]) * V6::from_column_slice(fe);
+        }
+    }
+    if !root_fixed {
+        // free-base actuation: a wrench on the base at its origin, base axes
+        b1[0] += ad_in(&to_com[0]) * V6::from_column_slice(&tau[0..6]);
+    }
+
+    // Joints.
+    let mut joints: Vec<Joint> = Vec::with_capacity(n.saturating_sub(1));
+    let mut r_total = 0;
+    for i in 1..n {
+        let Some(k) = m.parents[i] else {
+            return Err(FfError::Model(format!(
+                "body '{}' has no parent; dq_dynamics needs one root",
+                m.body_names[i]
+            )));
+        };
+        let kind = m.joint_types[i];
+        let lk = is_locked(i);
+        let sl = slots(kind, lk);
+        let align = alignment(kind, &m.axes[i]);
+        let q_jo = to_com[k].conj().mul(&local[i]).mul(&align); // q_{j/o_k}
+        let q_oj = align.conj().mul(&to_com[i]); // q_{o_i/j}
+        let (ad_out_oj, ad_in_oj) = (ad_out(&q_oj), ad_in(&q_oj));
+        let (ad_in_jo, ad_out_jo) = (ad_in(&q_jo), ad_out(&q_jo));
+        let mut g_dist = M6::zeros();
+        let mut g_prox = M6::zeros();
+        for (c, &s) in sl.reaction.iter().enumerate() {
+            g_dist.set_column(c, &ad_in_oj.column(s));
+            g_prox.set_column(c, &(-ad_out_jo.column(s)));
+        }
+        // joint twist (6.13) and the parent twist seen in J
+        let parent_twist_in_j = ad_in_jo * tw_o[k];
+        let twist = ad_out_oj * tw_o[i] - parent_twist_in_j;
+        // actuation (Table 6.3): the swaps of the motion slots carry tau
+        let mut act = V6::zeros();
+        if !lk {
+            for (c, &s) in motion_slots(kind).iter().enumerate() {
+                act[swapped(s)] = tau[m.idx_v[i] + c];
+            }
+            b1[i] += ad_in_oj * act;
+            b1[k] -= ad_out_jo * act;
+        }
+        joints.push(Joint {
+            body: i,
+            parent: k,
+            off: r_total,
+            reaction: sl.reaction,
+            locked: lk,
+            align,
+            g_dist,
+            g_prox,
+            ad_out_oj,
+            ad_in_jo,
+            twist,
+            parent_twist_in_j,
+            act,
+            presc: V6::zeros(),
+        });
+        r_total += sl.reaction.len();
+    }
+
+    // B2 (6.23): Λ_j ((q* ω_k q) × ω^j) + Λ_j ω̇_pres, with Λ_j = V_jᵀ P_swap.
+    let mut rhs = DVector::zeros(r_total);
+    for j in &joints {
+        let c = cross6(&j.parent_twist_in_j, &j.twist) + j.presc;
+        for (r, &s) in j.reaction.iter().enumerate() {
+            rhs[j.off + r] = c[swapped(s)];
+        }
+    }
+    // rhs −= Σ_i G_ijᵀ M_i⁻¹ B1_i
+    let mb1: Vec<V6> = (0..n)
+        .map(|i| match &inert[i] {
+            Some(mi) => minv(mi, &iinv[i], &b1[i]),
+            None => V6::zeros(),
+        })
+        .collect();
+    for j in &joints {
+        let r = j.reaction.len();
+        for c in 0..r {
+            let mut x = j.g_dist.column(c).dot(&mb1[j.body]);
+            if dynamic(j.parent) {
+                x += j.g_prox.column(c).dot(&mb1[j.parent]);
+            }
+            rhs[j.off + c] -= x;
+        }
+    }
+
+    // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i: blocks for joint pairs sharing a body.
+    let mut kmat = DMatrix::zeros(r_total, r_total);
+    // incidences per body: (joint index, is distal)
+    let mut inc: Vec<Vec<(usize, bool)>> = vec![Vec::new(); n];
+    for (jj, j) in joints.iter().enumerate() {
+        inc[j.body].push((jj, true));
+        if dynamic(j.parent) {
+            inc[j.parent].push((jj, false));
+        }
+    }
+    // M⁻¹ G for each incidence
+    let minv_g = |i: usize, g: &M6, r: usize| -> M6 {
+        let mut out = M6::zeros();
+        if let Some(mi) = &inert[i] {
+            for c in 0..r {
+                out.set_column(c, &minv(mi, &iinv[i], &g.column(c).into_owned()));
+            }
+        }
+        out
+    };
+    for i in 0..n {
+        for &(ja, da) in &inc[i] {
+            let a = &joints[ja];
+            let ga = if da { &a.g_dist } else { &a.g_prox };
+            let ra = a.reaction.len();
+            let mg = minv_g(i, ga, ra);
+            for &(jb, db) in &inc[i] {
+                let b = &joints[jb];
+                let gb = if db { &b.g_dist } else { &b.g_prox };
+                let rb = b.reaction.len();
+                for r in 0..rb {
+                    for c in 0..ra {
+                        kmat[(b.off + r, a.off + c)] += gb.column(r).dot(&mg.column(c));
+                    }
+                }
+            }
+        }
+    }
+    let sol = solve_spd(kmat, rhs)?;
+
+    // Body accelerations: (ẏ_i)^s = M_i⁻¹ (B1_i + Σ G W̃).
+    let mut net = b1.clone();
+    for j in &joints {
+        let w = DVector::from_iterator(j.reaction.len(), (0..j.reaction.len()).map(|c| sol[j.off + c]));
+        for c in 0..j.reaction.len() {
+            net[j.body] += j.g_dist.column(c) * w[c];
+            net[j.parent] += j.g_prox.column(c) * w[c];
+        }
+    }
+    let ydot: Vec<V6> = (0..n)
+        .map(|i| match &inert[i] {
+            Some(mi) => swap6(&minv(mi, &iinv[i], &net[i])),
+            None => V6::zeros(),
+        })
+        .collect();
+
+    // Generalized accelerations.
+    let mut out = DqDynamics {
+        ddq: vec![0.0; m.nv],
+        joint_wrenches: vec![Force::ZERO; n],
+        reactions: vec![Force::ZERO; n],
+        locked_forces: vec![0.0; m.nv],
+    };
+    if !root_fixed {
+        // base: ẏ_0 = [ω̇; v̇_o], v_o = v_b + ω × c ⇒ v̇_b = v̇_o − ω̇ × c (c constant in the body)
+        let wd = ydot[0].fixed_rows::<3>(0).into_owned();
+        let vd = ydot[0].fixed_rows::<3>(3).into_owned() - wd.cross(&com[0]);
+        out.ddq[0..3].copy_from_slice(vd.as_slice());
+        out.ddq[3..6].copy_from_slice(wd.as_slice());
+        out.joint_wrenches[0] = Force::from_slice(&tau[0..6]);
+    } else {
+        // the ground's wrench on a fixed root: everything else on it, negated (its ẏ is zero)
+        let w = -net[0];
+        out.joint_wrenches[0] = Force::from_v6(&flip(&(ad_out(&to_com[0]) * w)));
+        out.reactions[0] = out.joint_wrenches[0];
+    }
+    for j in &joints {
+        let i = j.body;
+        let k = j.parent;
+        // (6.15): ω̇^j = q_{o_i/j} ẏ_i q*_{o_i/j} − q*_{j/o_k} ẏ_k q_{j/o_k} − (q* ω_k q) × ω^j
+        let wdot = j.ad_out_oj * ydot[i] - j.ad_in_jo * ydot[k] - cross6(&j.parent_twist_in_j, &j.twist);
+        for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
+            out.ddq[m.idx_v[i] + c] = if j.locked { 0.0 } else { wdot[s] };
+        }
+        // wrenches in J, then in the child body frame (rotation only, same origin)
+        let mut react = V6::zeros();
+        for (c, &s) in j.reaction.iter().enumerate() {
+            react[s] = sol[j.off + c];
+        }
+        let total = react + j.act;
+        let ad = ad_out(&j.align);
+        out.joint_wrenches[i] = Force::from_v6(&flip(&(ad * total)));
+        let mut pure = react;
+        if j.locked {
+            for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
+                out.locked_forces[m.idx_v[i] + c] = react[swapped(s)];
+                pure[swapped(s)] = 0.0;
+            }
+        }
+        out.reactions[i] = Force::from_v6(&flip(&(ad * pure)));
+    }
+    Ok(out)
+}
+
+/// `[f; τ]` in our slot order is already the engine's `[force; moment]`; kept as a named step so the
+/// convention change is visible in one place.
+#[inline]
+fn flip(w: &V6) -> V6 {
+    *w
+}
+
+/// Solve the symmetric positive-definite Delassus system by Cholesky; a failure means dependent constraint
+/// rows (e.g. degenerate joint axes) or a non-physical body.
+fn solve_spd(k: DMatrix<f64>, rhs: DVector<f64>) -> Result<DVector<f64>> {
+    if k.nrows() == 0 {
+        return Ok(rhs);
+    }
+    match k.cholesky() {
+        Some(ch) => Ok(ch.solve(&rhs)),
+        None => Err(FfError::Numerical(
+            "the dual-quaternion constraint system (Delassus matrix) is singular or indefinite".into(),
+        )),
+    }
+}
