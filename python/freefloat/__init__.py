@@ -17,6 +17,7 @@ from .algorithms import (
     center_of_mass,
     centroidal_momentum_matrix,
     crba,
+    dq_dynamics,
     dynamics_regressor,
     forward_kinematics,
     frame_jacobian,
@@ -38,7 +39,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Trajectory", "models", "dq", "simulate", "telemetry", "trajectories", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
-    "aba", "rnea", "crba", "hybrid_dynamics",
+    "aba", "rnea", "crba", "hybrid_dynamics", "dq_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
     "momentum_regressor", "dynamics_regressor",

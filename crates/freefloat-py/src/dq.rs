@@ -85,6 +85,7 @@ impl PyDualQuaternion {
     fn tolist(&self) -> Vec<f64> {
         self.inner.to_array().to_vec()
     }
+    #[pyo3(signature = (dtype = None, copy = None))]
     fn __array__<'py>(
         &self,
         py: Python<'py>,

@@ -5,4 +5,4 @@
 pub mod joints;
 mod system;
 
-pub use system::{dq_dynamics, DqDynamics};
+pub use system::{dq_dynamics, dq_dynamics_with, DqDynamics, Solver};

@@ -106,6 +106,28 @@ pub fn dq_dynamics(
     fext: Option<&[f64]>,
     locked: Option<&[bool]>,
 ) -> Result<DqDynamics> {
+    dq_dynamics_with(m, q, v, tau, fext, locked, Solver::Tree)
+}
+
+/// How the Delassus system `K W̃ = rhs` is solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solver {
+    /// Assemble the R×R matrix and factor it densely (O(R³)): the thesis' (6.27) as written.
+    Dense,
+    /// Block elimination from the leaves up with no fill-in (O(number of bodies) for bounded fan-out).
+    Tree,
+}
+
+/// `dq_dynamics` with a choice of solver (the two agree to round-off; `Dense` is the reference).
+pub fn dq_dynamics_with(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+    solver: Solver,
+) -> Result<DqDynamics> {
     let n = m.nbodies();
     let mut qbuf = Vec::new();
     let q = m.checked_q(q, &mut qbuf)?;
@@ -291,45 +313,63 @@ pub fn dq_dynamics(
         }
     }
 
-    // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i: blocks for joint pairs sharing a body.
-    let mut kmat = DMatrix::zeros(r_total, r_total);
-    // incidences per body: (joint index, is distal)
-    let mut inc: Vec<Vec<(usize, bool)>> = vec![Vec::new(); n];
+    // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i, kept as one dense block per body over the joints incident to it
+    // (its distal joint first, then its children).
+    let mut inc: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (jj, j) in joints.iter().enumerate() {
-        inc[j.body].push((jj, true));
+        inc[j.body].push(jj);
         if dynamic(j.parent) {
-            inc[j.parent].push((jj, false));
+            inc[j.parent].push(jj);
         }
     }
-    // M⁻¹ G for each incidence
-    let minv_g = |i: usize, g: &M6, r: usize| -> M6 {
-        let mut out = M6::zeros();
-        if let Some(mi) = &inert[i] {
-            for c in 0..r {
-                out.set_column(c, &minv(mi, &iinv[i], &g.column(c).into_owned()));
-            }
-        }
-        out
-    };
+    let mut local: Vec<DMatrix<f64>> = Vec::with_capacity(n);
+    let mut loc_off: Vec<Vec<usize>> = Vec::with_capacity(n);
     for i in 0..n {
-        for &(ja, da) in &inc[i] {
-            let a = &joints[ja];
-            let ga = if da { &a.g_dist } else { &a.g_prox };
-            let ra = a.reaction.len();
-            let mg = minv_g(i, ga, ra);
-            for &(jb, db) in &inc[i] {
-                let b = &joints[jb];
-                let gb = if db { &b.g_dist } else { &b.g_prox };
-                let rb = b.reaction.len();
-                for r in 0..rb {
-                    for c in 0..ra {
-                        kmat[(b.off + r, a.off + c)] += gb.column(r).dot(&mg.column(c));
+        let g_of = |jj: usize| if joints[jj].body == i { &joints[jj].g_dist } else { &joints[jj].g_prox };
+        let offs: Vec<usize> = inc[i]
+            .iter()
+            .scan(0, |acc, &jj| {
+                let o = *acc;
+                *acc += joints[jj].reaction.len();
+                Some(o)
+            })
+            .collect();
+        let size: usize = inc[i].iter().map(|&jj| joints[jj].reaction.len()).sum();
+        let mut c = DMatrix::zeros(size, size);
+        if let Some(mi) = &inert[i] {
+            for (pa, &ja) in inc[i].iter().enumerate() {
+                let (ga, ra) = (g_of(ja), joints[ja].reaction.len());
+                for col in 0..ra {
+                    let mg = minv(mi, &iinv[i], &ga.column(col).into_owned());
+                    for (pb, &jb) in inc[i].iter().enumerate() {
+                        let gb = g_of(jb);
+                        for row in 0..joints[jb].reaction.len() {
+                            c[(offs[pb] + row, offs[pa] + col)] = gb.column(row).dot(&mg);
+                        }
                     }
                 }
             }
         }
+        local.push(c);
+        loc_off.push(offs);
     }
-    let sol = solve_spd(kmat, rhs)?;
+    let sol = match solver {
+        Solver::Dense => {
+            let mut kmat = DMatrix::zeros(r_total, r_total);
+            for i in 0..n {
+                for (pa, &ja) in inc[i].iter().enumerate() {
+                    for (pb, &jb) in inc[i].iter().enumerate() {
+                        let (ra, rb) = (joints[ja].reaction.len(), joints[jb].reaction.len());
+                        let blk = local[i].view((loc_off[i][pb], loc_off[i][pa]), (rb, ra));
+                        let mut dst = kmat.view_mut((joints[jb].off, joints[ja].off), (rb, ra));
+                        dst += blk;
+                    }
+                }
+            }
+            solve_spd(kmat, rhs)?
+        }
+        Solver::Tree => solve_tree(&joints, &inc, &loc_off, local, rhs)?,
+    };
 
     // Body accelerations: (ẏ_i)^s = M_i⁻¹ (B1_i + Σ G W̃).
     let mut net = b1.clone();
@@ -400,6 +440,77 @@ pub fn dq_dynamics(
 #[inline]
 fn flip(w: &V6) -> V6 {
     *w
+}
+
+/// Tree-sparse block Cholesky of K. Joint j couples only to joints sharing its child body i (i's children)
+/// or its parent body k (k's distal joint and k's other children). Eliminating joints in decreasing index
+/// (children before parents) leaves, when j's turn comes, only body i's block of j (its children's Schur
+/// updates already folded in) and neighbours that all share body k: their updates land in body k's block,
+/// so there is no fill-in outside the per-body blocks.
+fn solve_tree(
+    joints: &[Joint],
+    inc: &[Vec<usize>],
+    loc_off: &[Vec<usize>],
+    mut local: Vec<DMatrix<f64>>,
+    mut rhs: DVector<f64>,
+) -> Result<DVector<f64>> {
+    let nj = joints.len();
+    let mut eliminated = vec![false; nj];
+    // per joint: its pivot factor and its couplings C[a, j] to the joints solved before it
+    let mut pivots: Vec<Option<nalgebra::Cholesky<f64, nalgebra::Dyn>>> = (0..nj).map(|_| None).collect();
+    let mut couplings: Vec<Vec<(usize, DMatrix<f64>)>> = vec![Vec::new(); nj];
+    let singular = || FfError::Numerical("the dual-quaternion constraint system (Delassus matrix) is singular".into());
+    for jj in (0..nj).rev() {
+        let (i, k, rj, off) = (joints[jj].body, joints[jj].parent, joints[jj].reaction.len(), joints[jj].off);
+        let mut p = local[i].view((0, 0), (rj, rj)).clone_owned();
+        let mut rest: Vec<(usize, usize)> = Vec::new(); // (joint, local offset in body k)
+        let mut oj = 0;
+        if let Some(pos) = inc[k].iter().position(|&x| x == jj) {
+            oj = loc_off[k][pos];
+            p += local[k].view((oj, oj), (rj, rj));
+            for (pa, &ja) in inc[k].iter().enumerate() {
+                if ja != jj && !eliminated[ja] {
+                    rest.push((ja, loc_off[k][pa]));
+                }
+            }
+        }
+        let ch = p.cholesky().ok_or_else(singular)?;
+        let rhs_j = rhs.rows(off, rj).clone_owned();
+        let y_rhs = ch.solve(&rhs_j);
+        let cols: Vec<DMatrix<f64>> = rest
+            .iter()
+            .map(|&(ja, oa)| local[k].view((oa, oj), (joints[ja].reaction.len(), rj)).clone_owned())
+            .collect();
+        for (x, &(ja, oa)) in rest.iter().enumerate() {
+            let ra = joints[ja].reaction.len();
+            let y = ch.solve(&cols[x].transpose()); // P⁻¹ C[j, a]
+            let upd = &cols[x] * &y_rhs;
+            let mut r = rhs.rows_mut(joints[ja].off, ra);
+            r -= upd;
+            for (z, &(jb, ob)) in rest.iter().enumerate() {
+                let rb = joints[jb].reaction.len();
+                let u = &cols[z] * &y; // C[b, j] P⁻¹ C[j, a]
+                let mut dst = local[k].view_mut((ob, oa), (rb, ra));
+                dst -= u;
+            }
+        }
+        couplings[jj] = rest.iter().zip(cols).map(|(&(ja, _), c)| (ja, c)).collect();
+        pivots[jj] = Some(ch);
+        eliminated[jj] = true;
+    }
+    // back substitution, parents first: x_j = P⁻¹ (rhs_j − Σ_a C[a, j]ᵀ x_a)
+    let mut x = DVector::zeros(rhs.len());
+    for jj in 0..nj {
+        let (rj, off) = (joints[jj].reaction.len(), joints[jj].off);
+        let mut b = rhs.rows(off, rj).clone_owned();
+        for (ja, c) in &couplings[jj] {
+            let xa = x.rows(joints[*ja].off, joints[*ja].reaction.len()).clone_owned();
+            b -= c.transpose() * xa;
+        }
+        let ch = pivots[jj].as_ref().ok_or_else(singular)?;
+        x.rows_mut(off, rj).copy_from(&ch.solve(&b));
+    }
+    Ok(x)
 }
 
 /// Solve the symmetric positive-definite Delassus system by Cholesky; a failure means dependent constraint
