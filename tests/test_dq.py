@@ -210,8 +210,9 @@ def _xstar(R, p):
 
 
 def _crf(v):
+    """Motion cross-product matrix of a [lin; ang] twist: crf(v) m = v x m."""
     w, u = v[3:], v[:3]
-    return np.block([[rt.skew(w), np.zeros((3, 3))], [rt.skew(u), rt.skew(w)]])
+    return np.block([[rt.skew(w), rt.skew(u)], [np.zeros((3, 3)), rt.skew(w)]])
 
 
 def _trees():
@@ -266,7 +267,7 @@ def test_dq_dynamics_locked_and_batches():
         desc.base = desc.bodies[0].joint_type = "free"
     m = ff.Model.from_yaml_string(desc.to_yaml())
     rng = np.random.default_rng(0)
-    moving = [desc.bodies[i].effective_joint_name() for i in range(1, m.nbodies)
+    moving = [desc.bodies[i].effective_joint_name for i in range(1, m.nbodies)
               if desc.bodies[i].joint_type != "fixed"]
     Q = np.stack([desc.random_q(rng) for _ in range(3)])
     Vv = np.stack([desc.random_v(rng) for _ in range(3)])

@@ -81,6 +81,11 @@ impl PyDualQuaternion {
     fn py_new(coeffs: &Bound<'_, PyAny>) -> PyResult<Self> {
         Ok(wrap(operand(coeffs, "coeffs")?))
     }
+    /// numpy must not treat `array * q` elementwise: deferring makes it call `q.__rmul__(array)`.
+    #[classattr]
+    fn __array_ufunc__(py: Python<'_>) -> Py<PyAny> {
+        py.None()
+    }
     /// The 8 coefficients as a list (`numpy.asarray(q)` also works).
     fn tolist(&self) -> Vec<f64> {
         self.inner.to_array().to_vec()
