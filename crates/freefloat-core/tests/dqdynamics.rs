@@ -184,3 +184,20 @@ fn tree_and_dense_schur_solves_agree() {
         assert!(rel_err(&flat(&t.joint_wrenches), &flat(&d.joint_wrenches)) < 1e-12, "case {case}");
     }
 }
+
+#[test]
+fn closed_form_adjoints_equal_the_product_matrices() {
+    use freefloat_core::dqdynamics::{ad_in, ad_out, reduce};
+    use freefloat_core::dualquat::pose::from_rotation_translation;
+    use freefloat_core::dualquat::Quat;
+    use rand::Rng;
+    let mut r = rng(8);
+    for _ in 0..100 {
+        let q =
+            Quat::new(r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0));
+        let t = V3::new(r.gen_range(-2.0..2.0), r.gen_range(-2.0..2.0), r.gen_range(-2.0..2.0));
+        let p = from_rotation_translation(&q.scale(1.0 / q.norm()), &t);
+        assert!((ad_in(&p) - reduce(&p.adjoint_in_matrix())).amax() < 1e-13);
+        assert!((ad_out(&p) - reduce(&p.adjoint_out_matrix())).amax() < 1e-13);
+    }
+}

@@ -5,4 +5,4 @@
 pub mod joints;
 mod system;
 
-pub use system::{dq_dynamics, dq_dynamics_with, DqDynamics, Solver};
+pub use system::{ad_in, ad_out, dq_dynamics, dq_dynamics_with, reduce, DqDynamics, Solver};

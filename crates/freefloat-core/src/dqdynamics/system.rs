@@ -38,18 +38,33 @@ pub struct DqDynamics {
 }
 
 /// The 6×6 restriction of an 8×8 sandwich matrix to the vector slots (1..4, 5..8) — exact for unit q,
-/// which maps vector dual quaternions to vector dual quaternions.
-fn reduce(m: &crate::dualquat::M8) -> M6 {
+/// which maps vector dual quaternions to vector dual quaternions. The thesis' form; kept as the reference
+/// the closed forms below are tested against.
+pub fn reduce(m: &crate::dualquat::M8) -> M6 {
     const IDX: [usize; 6] = [1, 2, 3, 5, 6, 7];
     M6::from_fn(|r, c| m[(IDX[r], IDX[c])])
 }
-/// `x ↦ q* x q` ((2.41)/(2.43)) on 6-vectors.
-fn ad_in(q: &DualQuat) -> M6 {
-    reduce(&q.adjoint_in_matrix())
+/// `x ↦ q* x q` ((2.41)/(2.43)) on 6-vectors, in closed form: `[Rᵀ, 0; −Rᵀ[t]ˣ, Rᵀ]` with `R = C(q_r)`,
+/// `t = 2 q_d q_r*` — the shifting law `s_r^Y + ε(s_d^Y + r^Y_{X/Y} × s_r^Y)` written as a matrix. It replaces
+/// `[[q*]]_L [[q]]_R` (two 8×8 products) in the hot loop.
+pub fn ad_in(q: &DualQuat) -> M6 {
+    let rt = q.r.rotation_matrix().transpose();
+    let t = q.translation();
+    let mut m = M6::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-rt * crate::spatial::skew(&t)));
+    m
 }
-/// `x ↦ q x q*` ((2.42)/(2.44)) on 6-vectors.
-fn ad_out(q: &DualQuat) -> M6 {
-    reduce(&q.adjoint_out_matrix())
+/// `x ↦ q x q*` ((2.42)/(2.44)) on 6-vectors: `[R, 0; [t]ˣ R, R]`.
+pub fn ad_out(q: &DualQuat) -> M6 {
+    let r = q.r.rotation_matrix();
+    let t = q.translation();
+    let mut m = M6::zeros();
+    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
+    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
+    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&(crate::spatial::skew(&t) * r));
+    m
 }
 /// The swap on 6-vectors: `[a; b] ↦ [b; a]`.
 fn swap6(x: &V6) -> V6 {
