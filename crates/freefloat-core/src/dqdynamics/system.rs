@@ -328,8 +328,9 @@ pub fn dq_dynamics_with(
         }
     }
 
-    // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i, kept as one dense block per body over the joints incident to it
-    // (its distal joint first, then its children).
+    // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i as 6×6 blocks (each reduced reaction padded to 6 by the zero
+    // columns of its G), one set per body over the joints incident to it: its distal joint first, then its
+    // children. Block (b, a) of body i is `blocks[start[i] + b·L_i + a]`.
     let mut inc: Vec<Vec<usize>> = vec![Vec::new(); n];
     for (jj, j) in joints.iter().enumerate() {
         inc[j.body].push(jj);
@@ -337,45 +338,47 @@ pub fn dq_dynamics_with(
             inc[j.parent].push(jj);
         }
     }
-    let mut local: Vec<DMatrix<f64>> = Vec::with_capacity(n);
-    let mut loc_off: Vec<Vec<usize>> = Vec::with_capacity(n);
+    let mut start = Vec::with_capacity(n);
+    let mut blocks: Vec<M6> = Vec::new();
+    let mut mg: Vec<M6> = Vec::new();
     for i in 0..n {
+        start.push(blocks.len());
+        let Some(mi) = &inert[i] else { continue };
         let g_of = |jj: usize| if joints[jj].body == i { &joints[jj].g_dist } else { &joints[jj].g_prox };
-        let offs: Vec<usize> = inc[i]
-            .iter()
-            .scan(0, |acc, &jj| {
-                let o = *acc;
-                *acc += joints[jj].reaction.len();
-                Some(o)
-            })
-            .collect();
-        let size: usize = inc[i].iter().map(|&jj| joints[jj].reaction.len()).sum();
-        let mut c = DMatrix::zeros(size, size);
-        if let Some(mi) = &inert[i] {
-            for (pa, &ja) in inc[i].iter().enumerate() {
-                let (ga, ra) = (g_of(ja), joints[ja].reaction.len());
-                for col in 0..ra {
-                    let mg = minv(mi, &iinv[i], &ga.column(col).into_owned());
-                    for (pb, &jb) in inc[i].iter().enumerate() {
-                        let gb = g_of(jb);
-                        for row in 0..joints[jb].reaction.len() {
-                            c[(offs[pb] + row, offs[pa] + col)] = gb.column(row).dot(&mg);
-                        }
-                    }
-                }
+        mg.clear();
+        for &ja in &inc[i] {
+            // M⁻¹ G = [G_top / m; Ī⁻¹ G_bottom]
+            let g = g_of(ja);
+            let mut x = *g / mi.mass();
+            x.fixed_rows_mut::<3>(3).copy_from(&(iinv[i] * g.fixed_rows::<3>(3)));
+            mg.push(x);
+        }
+        for &jb in &inc[i] {
+            let gt = g_of(jb).transpose();
+            for x in &mg {
+                blocks.push(gt * x);
             }
         }
-        local.push(c);
-        loc_off.push(offs);
     }
+    let mut rhs6: Vec<V6> = joints
+        .iter()
+        .map(|j| {
+            let mut x = V6::zeros();
+            for c in 0..j.reaction.len() {
+                x[c] = rhs[j.off + c];
+            }
+            x
+        })
+        .collect();
     let sol = match solver {
         Solver::Dense => {
             let mut kmat = DMatrix::zeros(r_total, r_total);
             for i in 0..n {
-                for (pa, &ja) in inc[i].iter().enumerate() {
-                    for (pb, &jb) in inc[i].iter().enumerate() {
+                let l = inc[i].len();
+                for (pb, &jb) in inc[i].iter().enumerate() {
+                    for (pa, &ja) in inc[i].iter().enumerate() {
                         let (ra, rb) = (joints[ja].reaction.len(), joints[jb].reaction.len());
-                        let blk = local[i].view((loc_off[i][pb], loc_off[i][pa]), (rb, ra));
+                        let blk = blocks[start[i] + pb * l + pa].view((0, 0), (rb, ra)).clone_owned();
                         let mut dst = kmat.view_mut((joints[jb].off, joints[ja].off), (rb, ra));
                         dst += blk;
                     }
@@ -383,7 +386,16 @@ pub fn dq_dynamics_with(
             }
             solve_spd(kmat, rhs)?
         }
-        Solver::Tree => solve_tree(&joints, &inc, &loc_off, local, rhs)?,
+        Solver::Tree => {
+            let x = solve_tree(&joints, &inc, &start, &mut blocks, &mut rhs6)?;
+            let mut out = DVector::zeros(r_total);
+            for (j, xj) in joints.iter().zip(&x) {
+                for c in 0..j.reaction.len() {
+                    out[j.off + c] = xj[c];
+                }
+            }
+            out
+        }
     };
 
     // Body accelerations: (ẏ_i)^s = M_i⁻¹ (B1_i + Σ G W̃).
@@ -460,70 +472,71 @@ fn flip(w: &V6) -> V6 {
 /// Tree-sparse block Cholesky of K. Joint j couples only to joints sharing its child body i (i's children)
 /// or its parent body k (k's distal joint and k's other children). Eliminating joints in decreasing index
 /// (children before parents) leaves, when j's turn comes, only body i's block of j (its children's Schur
-/// updates already folded in) and neighbours that all share body k: their updates land in body k's block,
-/// so there is no fill-in outside the per-body blocks.
+/// updates already folded in) and neighbours that all share body k: their updates land in body k's blocks,
+/// so there is no fill-in outside the per-body blocks. Every block is a stack 6×6 (padding dimensions get
+/// a unit pivot and stay zero).
 fn solve_tree(
     joints: &[Joint],
     inc: &[Vec<usize>],
-    loc_off: &[Vec<usize>],
-    mut local: Vec<DMatrix<f64>>,
-    mut rhs: DVector<f64>,
-) -> Result<DVector<f64>> {
+    start: &[usize],
+    blocks: &mut [M6],
+    rhs: &mut [V6],
+) -> Result<Vec<V6>> {
     let nj = joints.len();
+    let singular = || {
+        FfError::Numerical("the dual-quaternion constraint system (Delassus matrix) is singular or indefinite".into())
+    };
     let mut eliminated = vec![false; nj];
-    // per joint: its pivot factor and its couplings C[a, j] to the joints solved before it
-    let mut pivots: Vec<Option<nalgebra::Cholesky<f64, nalgebra::Dyn>>> = (0..nj).map(|_| None).collect();
-    let mut couplings: Vec<Vec<(usize, DMatrix<f64>)>> = vec![Vec::new(); nj];
-    let singular = || FfError::Numerical("the dual-quaternion constraint system (Delassus matrix) is singular".into());
+    let mut pivots: Vec<Option<nalgebra::Cholesky<f64, nalgebra::U6>>> = vec![None; nj];
+    // couplings C[a, j] of joint j to the joints solved before it: flat, joint j owns cstart[j]..cstart[j+1]
+    let mut coupling: Vec<(usize, M6)> = Vec::with_capacity(2 * nj);
+    let mut cstart = vec![0; nj + 1];
+    let mut cend = vec![0; nj];
+    let mut rest: Vec<(usize, usize)> = Vec::new(); // (joint, position in its parent body's list)
     for jj in (0..nj).rev() {
-        let (i, k, rj, off) = (joints[jj].body, joints[jj].parent, joints[jj].reaction.len(), joints[jj].off);
-        let mut p = local[i].view((0, 0), (rj, rj)).clone_owned();
-        let mut rest: Vec<(usize, usize)> = Vec::new(); // (joint, local offset in body k)
-        let mut oj = 0;
-        if let Some(pos) = inc[k].iter().position(|&x| x == jj) {
-            oj = loc_off[k][pos];
-            p += local[k].view((oj, oj), (rj, rj));
+        let (i, k, rj) = (joints[jj].body, joints[jj].parent, joints[jj].reaction.len());
+        let mut p = blocks[start[i]];
+        rest.clear();
+        let (lk, pos) = (inc[k].len(), inc[k].iter().position(|&x| x == jj));
+        if let Some(pos) = pos {
+            p += blocks[start[k] + pos * lk + pos];
             for (pa, &ja) in inc[k].iter().enumerate() {
                 if ja != jj && !eliminated[ja] {
-                    rest.push((ja, loc_off[k][pa]));
+                    rest.push((ja, pa));
                 }
             }
         }
-        let ch = p.cholesky().ok_or_else(singular)?;
-        let rhs_j = rhs.rows(off, rj).clone_owned();
-        let y_rhs = ch.solve(&rhs_j);
-        let cols: Vec<DMatrix<f64>> = rest
-            .iter()
-            .map(|&(ja, oa)| local[k].view((oa, oj), (joints[ja].reaction.len(), rj)).clone_owned())
-            .collect();
-        for (x, &(ja, oa)) in rest.iter().enumerate() {
-            let ra = joints[ja].reaction.len();
-            let y = ch.solve(&cols[x].transpose()); // P⁻¹ C[j, a]
-            let upd = &cols[x] * &y_rhs;
-            let mut r = rhs.rows_mut(joints[ja].off, ra);
-            r -= upd;
-            for (z, &(jb, ob)) in rest.iter().enumerate() {
-                let rb = joints[jb].reaction.len();
-                let u = &cols[z] * &y; // C[b, j] P⁻¹ C[j, a]
-                let mut dst = local[k].view_mut((ob, oa), (rb, ra));
-                dst -= u;
+        for d in rj..6 {
+            p[(d, d)] = 1.0;
+        }
+        let ch = nalgebra::Cholesky::new(p).ok_or_else(singular)?;
+        let y_rhs = ch.solve(&rhs[jj]);
+        cstart[jj] = coupling.len();
+        if let Some(pos) = pos {
+            for &(ja, pa) in &rest {
+                let c_a = blocks[start[k] + pa * lk + pos]; // C[a, j]
+                let y_a = ch.solve(&c_a.transpose()); // P⁻¹ C[j, a]
+                rhs[ja] -= c_a * y_rhs;
+                for &(_, pb) in &rest {
+                    let c_b = blocks[start[k] + pb * lk + pos];
+                    blocks[start[k] + pb * lk + pa] -= c_b * y_a;
+                }
+                coupling.push((ja, c_a));
             }
         }
-        couplings[jj] = rest.iter().zip(cols).map(|(&(ja, _), c)| (ja, c)).collect();
+        cend[jj] = coupling.len();
         pivots[jj] = Some(ch);
         eliminated[jj] = true;
     }
+    cstart[nj] = coupling.len();
     // back substitution, parents first: x_j = P⁻¹ (rhs_j − Σ_a C[a, j]ᵀ x_a)
-    let mut x = DVector::zeros(rhs.len());
+    let mut x = vec![V6::zeros(); nj];
     for jj in 0..nj {
-        let (rj, off) = (joints[jj].reaction.len(), joints[jj].off);
-        let mut b = rhs.rows(off, rj).clone_owned();
-        for (ja, c) in &couplings[jj] {
-            let xa = x.rows(joints[*ja].off, joints[*ja].reaction.len()).clone_owned();
-            b -= c.transpose() * xa;
+        let mut b = rhs[jj];
+        for (ja, c) in &coupling[cstart[jj]..cend[jj]] {
+            b -= c.transpose() * x[*ja];
         }
-        let ch = pivots[jj].as_ref().ok_or_else(singular)?;
-        x.rows_mut(off, rj).copy_from(&ch.solve(&b));
+        x[jj] = pivots[jj].as_ref().ok_or_else(singular)?.solve(&b);
     }
     Ok(x)
 }
