@@ -488,3 +488,72 @@ fn product_matrix_helpers() {
     assert_eq!(Quat::pure(&v).skew_matrix().fixed_view::<3, 3>(1, 1).into_owned(), skew(&v));
     let _ = Se3::identity();
 }
+
+// ---- (2.58) pose error dynamics, Lemma 4, and the orbital dual forces (2.61)–(2.68) -------------------
+
+#[test]
+fn pose_error_dynamics_consistent_with_newton_euler() {
+    use freefloat_core::dualquat::orbital::pose_error_acceleration;
+    let mut r = rng();
+    for _ in 0..N {
+        let mi = random_inertia(&mut r);
+        let q = pose(&mut r); // q_{B/D}
+        let (w_bd, w_dd, wdot_dd, f) = (vdq(&mut r), vdq(&mut r), vdq(&mut r), vdq(&mut r));
+        let got = pose_error_acceleration(&mi, &q, &w_bd, &w_dd, &wdot_dd, &f);
+        // (2.57) for ω_{B/I} = ω_{B/D} + q* ω^D_{D/I} q, then d/dt(q* a q) = q* ȧ q + (q* a q) × ω_{B/D}
+        let w_di = q.shift_in(&w_dd);
+        let wdot_bi = mi.acceleration(&(w_bd + w_di), &f);
+        let expect = wdot_bi - q.shift_in(&wdot_dd) - w_di.cross(&w_bd);
+        assert_dq!(got, expect, 1e-10);
+        // Lemma 4, rotational (dual) part: Ī ω̇ = τ − (ω_BD + ω_DI) × Ī(ω_BD + ω_DI) − Ī ω̇_DI − Ī(ω_DI × ω_BD)
+        let ic = mi.i_com();
+        let (wb, wd) = (w_bd.r.v, w_di.r.v);
+        let lemma = f.d.v - (wb + wd).cross(&(ic * (wb + wd))) - ic * q.shift_in(&wdot_dd).r.v - ic * wd.cross(&wb);
+        assert!(close3(&(ic * got.r.v), &lemma, 1e-10));
+    }
+    // the derivative identity itself, by finite differences along q̇ = ½ q ω with constant ω and a(t) linear
+    let q0 = pose(&mut r);
+    let (w, a0, a1) = (vdq(&mut r), vdq(&mut r), vdq(&mut r));
+    let at = |t: f64| {
+        let qt = q0.mul(&freefloat_core::dualquat::exp(&w.scale(0.5 * t)));
+        qt.shift_in(&(a0 + a1.scale(t)))
+    };
+    let h = 1e-6;
+    let fd = (at(h) - at(-h)).scale(0.5 / h);
+    assert_dq!(fd, q0.shift_in(&a1) + q0.shift_in(&a0).cross(&w), 1e-8);
+}
+
+#[test]
+fn orbital_dual_forces() {
+    use freefloat_core::dualquat::orbital::{
+        gravity, gravity_gradient, gravity_gradient_old, j2, j2_acceleration, J2_EARTH, MU_EARTH, RE_EARTH,
+    };
+    let mut r = rng();
+    for _ in 0..50 {
+        let mi = random_inertia(&mut r);
+        let rb = v3(&mut r).normalize() * r.gen_range(6800.0..42000.0);
+        let g = gravity(&mi, &rb, MU_EARTH);
+        assert!(close3(&g.r.v, &(-rb * (mi.mass() * MU_EARTH / rb.norm().powi(3))), 1e-14) && g.d.v == V3::zeros());
+        // (2.67) = (2.68) = 0 + ε 3μ r × Īr / ‖r‖⁵ (2.63)
+        let tau = rb.cross(&(mi.i_com() * rb)) * (3.0 * MU_EARTH / rb.norm().powi(5));
+        for gg in [gravity_gradient(&mi, &rb, MU_EARTH), gravity_gradient_old(&mi, &rb, MU_EARTH)] {
+            assert!(gg.r.v.amax() == 0.0 && close3(&gg.d.v, &tau, 1e-12) && gg.is_vector(0.0));
+        }
+        // J2 (2.64) is the gradient of the J2 potential −μ J2 Re² (3z²/r² − 1)/(2 r³)
+        let pot = |p: &V3| {
+            let rn = p.norm();
+            -MU_EARTH * J2_EARTH * RE_EARTH * RE_EARTH * (3.0 * (p.z / rn).powi(2) - 1.0) / (2.0 * rn.powi(3))
+        };
+        let mut grad = V3::zeros();
+        for k in 0..3 {
+            let mut e = V3::zeros();
+            e[k] = 1e-3;
+            grad[k] = (pot(&(rb + e)) - pot(&(rb - e))) / 2e-3;
+        }
+        let a = j2_acceleration(&rb, MU_EARTH, J2_EARTH, RE_EARTH);
+        assert!((a - grad).amax() < 1e-7 * a.amax(), "{a:?} vs {grad:?}");
+        let q = pose(&mut r);
+        let f = j2(&mi, &q, &rb, MU_EARTH, J2_EARTH, RE_EARTH);
+        assert!(close3(&f.r.v, &(q.r.conj().rotate(&a) * mi.mass()), 1e-13) && f.d.v == V3::zeros());
+    }
+}

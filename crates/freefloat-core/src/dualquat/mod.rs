@@ -11,6 +11,7 @@ pub mod constraints;
 mod dual_quaternion;
 pub mod inertia;
 pub mod kinematics;
+pub mod orbital;
 pub mod pose;
 mod quaternion;
 pub mod screw;
