@@ -14,7 +14,7 @@ def run(*args, ok=True):
     return r
 
 
-@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"]])
+@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"], ["reactions"]])
 def test_every_command_has_help(cmd):
     r = run(*cmd, "--help")
     assert "Usage:" in r.stdout and len(r.stdout) > 200

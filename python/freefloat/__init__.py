@@ -8,7 +8,7 @@
 
 Conventions are in docs/architecture.md; every number is computed by the Rust engine."""
 
-from . import dq, estimation, models, telemetry, trajectories
+from . import dq, estimation, models, reactions, telemetry, trajectories
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,

@@ -25,7 +25,7 @@ from ._core import DualQuaternion
 
 __all__ = [
     "DualQuaternion", "from_pose", "identity", "vector", "exp", "screw", "dh", "dh_chain",
-    "line_of_sight", "approach_slope", "attitude", "distance_bound",
+    "line_of_sight", "approach_slope", "attitude", "distance_bound", "body_poses",
 ]
 
 
@@ -97,3 +97,11 @@ def attitude(q_bi, n_i, n_b, max_angle: float):
 def distance_bound(q, delta: float):
     """``|translation| <= delta`` as ``q o q - 1 - delta^2/4 <= 0`` (Lemmas 7, 10)."""
     return _cv(_core.dq_distance_bound(q, float(delta)))
+
+
+def body_poses(model, q, method: str = "chain") -> np.ndarray:
+    """Pose of every body as dual-quaternion coefficients, (nbodies, 8): ``method="chain"`` multiplies the
+    relative poses (3.43), ``"poe"`` uses the product of exponentials (3.19) with screws taken at the neutral
+    configuration (revolute, prismatic, spherical and fixed joints)."""
+    return _core.dq_body_poses(model, q, method)
+

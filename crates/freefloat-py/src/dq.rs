@@ -366,3 +366,29 @@ pub fn dq_distance_bound(q: &Bound<'_, PyAny>, delta: f64) -> PyResult<(f64, Vec
     let q = pose_arg(q, "q")?;
     guard(|| constraints::distance_bound(&q, delta)).map(cv)
 }
+
+/// Body poses of a model as dual quaternions, (nbodies, 8): `method` "chain" (the product of relative poses
+/// (3.43)) or "poe" (product of exponentials (3.19)).
+#[pyfunction]
+#[pyo3(signature = (model, q, method = "chain"))]
+pub fn dq_body_poses<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    method: &str,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let mb = crate::batch::model_arg(model)?;
+    let m = &mb.get().inner;
+    let qv = floats(q, "q", m.nq)?;
+    let poses = guard(|| {
+        let mut buf = Vec::new();
+        let qc = m.checked_q(&qv, &mut buf)?;
+        match method {
+            "chain" => freefloat_core::dualquat::kinematics::body_poses(m, qc),
+            "poe" => freefloat_core::dualquat::kinematics::ProductOfExponentials::new(m)?.body_poses(m, qc),
+            other => Err(freefloat_core::FfError::arg("method", format!("must be 'chain' or 'poe', got '{other}'"))),
+        }
+    })?;
+    let n = poses.len();
+    arr2(py, poses.iter().flat_map(|p| p.to_array()).collect(), n, 8)
+}

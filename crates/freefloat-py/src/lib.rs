@@ -45,6 +45,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dq::dq_screw, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_dh, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_dh_chain, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_body_poses, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_line_of_sight, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_approach_slope, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_attitude, m)?)?;
