@@ -2,6 +2,7 @@
 //! from one linear system solved through the Schur complement of the body block. Cross-checked against the
 //! engine's ABA (accelerations) and RNEA (transmitted wrenches) in tests/dqdynamics.rs.
 
+pub mod decoupled;
 pub mod joints;
 mod system;
 
