@@ -63,6 +63,7 @@ def bench(m, n, reps, rng):
         raise SystemExit(f"{m.name}: dq_dynamics differs from aba by {err:e}")
     fns = {
         "dq": lambda: ff.dq_dynamics(m, Q, V, T),
+        "decoupled": lambda: ff.dq_dynamics(m, Q, V, T, formulation="decoupled"),
         "aba": lambda: ff.aba(m, Q, V, T),
         "aba+rnea": lambda: (ff.rnea(m, Q, V, ff.aba(m, Q, V, T))),
     }
@@ -85,13 +86,15 @@ def main():
     robots += [ff.Model.from_yaml_string(random_tree_yaml(k, k)) for k in (5, 10, 20, 40, 60)]
     for m in robots:
         t, err = bench(m, n, reps, rng)
-        rows.append((m.name, m.nbodies, m.nv, t["dq"], t["aba"], t["aba+rnea"], err))
-        print(f"{m.name:28s} bodies {m.nbodies:3d}  dq {t['dq']:8.2f} us  aba {t['aba']:7.2f} us  "
-              f"aba+rnea {t['aba+rnea']:7.2f} us  dq/(aba+rnea) {t['dq'] / t['aba+rnea']:5.2f}  err {err:.1e}")
-    md = ["| robot | bodies | nv | dq_dynamics [µs] | ABA [µs] | ABA + RNEA [µs] | dq / (ABA+RNEA) | dq vs ABA rel. diff |",
-          "|---|---:|---:|---:|---:|---:|---:|---:|"]
+        rows.append((m.name, m.nbodies, m.nv, t["dq"], t["decoupled"], t["aba"], t["aba+rnea"], err))
+        print(f"{m.name:28s} bodies {m.nbodies:3d}  dq {t['dq']:8.2f} us  decoupled {t['decoupled']:8.2f} us  "
+              f"aba {t['aba']:7.2f} us  aba+rnea {t['aba+rnea']:7.2f} us  err {err:.1e}")
+    md = ["| robot | bodies | nv | dq_dynamics [µs] | decoupled (dense) [µs] | ABA [µs] | ABA + RNEA [µs] "
+          "| dq / (ABA+RNEA) | dq / decoupled | dq vs ABA rel. diff |",
+          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for r in rows:
-        md.append(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.2f} | {r[4]:.2f} | {r[5]:.2f} | {r[3] / r[5]:.2f} | {r[6]:.1e} |")
+        md.append(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.2f} | {r[4]:.2f} | {r[5]:.2f} | {r[6]:.2f} | "
+                  f"{r[3] / r[6]:.2f} | {r[3] / r[4]:.2f} | {r[7]:.1e} |")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "dq_dynamics.md").write_text(

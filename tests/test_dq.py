@@ -251,6 +251,9 @@ def test_dq_dynamics_equals_aba_and_balances_every_body():
         fext = desc.random_fext(rng)
         a, W = ff.dq_dynamics(m, q, v, tau, fext)
         rt.assert_close(a, ff.aba(m, q, v, tau, fext), rtol=1e-10, what=f"seed {seed} accelerations")
+        a2, W2 = ff.dq_dynamics(m, q, v, tau, fext, formulation="decoupled")
+        rt.assert_close(a2, a, rtol=1e-10, what=f"seed {seed} decoupled accelerations")
+        rt.assert_close(W2, W, rtol=1e-10, what=f"seed {seed} decoupled wrenches")
         assert W.shape == (m.nbodies, 6)
         fk = ff.forward_kinematics(m, q)
         V = ff.body_velocities(m, q, v)
@@ -297,6 +300,10 @@ def test_dq_dynamics_locked_and_batches():
     rt.assert_close(a_l, a_h, rtol=1e-10)
     with pytest.raises(ff.InputError, match="locked"):
         ff.dq_dynamics(m, Q[0], Vv[0], T[0], locked=["no_such_joint"])
+    with pytest.raises(ff.InputError, match="formulation"):
+        ff.dq_dynamics(m, Q[0], Vv[0], T[0], formulation="lagrange")
+    with pytest.raises(ff.InputError, match="locked"):
+        ff.dq_dynamics(m, Q[0], Vv[0], T[0], locked=lock, formulation="decoupled")
     with pytest.raises(ff.InputError, match="tau"):
         ff.dq_dynamics(m, Q[0], Vv[0], T[0][:-1])
     planar = ff.Model.from_yaml_string(desc.to_yaml().replace(f"base: {desc.base}", "base: planar"))

@@ -56,7 +56,7 @@ def hybrid_dynamics(model, q, v, tau, ddq, prescribed, fext=None):
     return _core.hybrid_dynamics(model, q, v, tau, ddq, list(prescribed), fext)
 
 
-def dq_dynamics(model, q, v, tau, fext=None, locked=None):
+def dq_dynamics(model, q, v, tau, fext=None, locked=None, formulation="dq"):
     """Forward dynamics and joint wrenches by the dual-quaternion Newton-Euler formulation
     (dissertation seed 003, ch. 5-6): one linear system for every body's acceleration and every joint's
     reaction, solved through the Schur complement (a symmetric positive-definite Delassus matrix).
@@ -69,7 +69,10 @@ def dq_dynamics(model, q, v, tau, fext=None, locked=None):
 
     `locked`: joint names held at zero acceleration (their `tau` entries are ignored; the torque they need
     is the actuated component of their row of `W`). Free or fixed base; revolute, prismatic, spherical
-    and fixed joints; every moving body needs a positive mass and a positive-definite inertia."""
+    and fixed joints; every moving body needs a positive mass and a positive-definite inertia.
+
+    `formulation="decoupled"` solves chapter 5's decoupled (3-vector) Newton-Euler system instead, with the
+    same outputs (no `locked`); the two agree to round-off."""
     if isinstance(locked, str):
         locked = [locked]
-    return _core.dq_dynamics(model, q, v, tau, fext, None if locked is None else list(locked))
+    return _core.dq_dynamics(model, q, v, tau, fext, None if locked is None else list(locked), formulation)

@@ -4,6 +4,7 @@
 use crate::algorithms::{fext_batch, run_rows, Arr};
 use crate::batch::{common_rows, model_arg, output, Batch};
 use crate::errors::input_err;
+use freefloat_core::dqdynamics::decoupled::decoupled_dynamics;
 use freefloat_core::dqdynamics::dq_dynamics as core_dq_dynamics;
 use freefloat_core::Model;
 use pyo3::prelude::*;
@@ -30,8 +31,10 @@ fn locked_mask(m: &Model, names: &[String]) -> PyResult<Vec<bool>> {
 /// Returns `(ddq, W)`: accelerations (nv) and, per joint, the wrench it transmits onto its child body
 /// (nbodies × 6, [force; torque about the child body origin], child body axes; row 0 is the base joint).
 /// Joints named in `locked` are held at zero acceleration and their `tau` entries are ignored.
+/// `formulation`: "dq" (chapter 6, default) or "decoupled" (chapter 5's vector formulation, no locking).
 #[pyfunction]
-#[pyo3(signature = (model, q, v, tau, fext = None, locked = None))]
+#[pyo3(signature = (model, q, v, tau, fext = None, locked = None, formulation = "dq"))]
+#[allow(clippy::too_many_arguments)]
 pub fn dq_dynamics<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -40,7 +43,15 @@ pub fn dq_dynamics<'py>(
     tau: Arr<'_, 'py>,
     fext: Option<Arr<'_, 'py>>,
     locked: Option<Vec<String>>,
+    formulation: &str,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let decoupled = match formulation {
+        "dq" => false,
+        "decoupled" => true,
+        other => {
+            return Err(input_err(format!("argument `formulation`: must be 'dq' or 'decoupled', got '{other}'")));
+        }
+    };
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
@@ -48,6 +59,9 @@ pub fn dq_dynamics<'py>(
         Some(names) => Some(locked_mask(m, names)?),
         None => None,
     };
+    if decoupled && mask.as_ref().is_some_and(|k| k.iter().any(|&x| x)) {
+        return Err(input_err("argument `locked`: locking joints is implemented in the 'dq' formulation only"));
+    }
     let (qb, vb, tb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("tau", tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
@@ -58,7 +72,12 @@ pub fn dq_dynamics<'py>(
     let (nv, nb) = (m.nv, m.nbodies());
     let width = nv + 6 * nb;
     let out = run_rows(py, model, rows, st, width, |m, _d, k, o, _buf| {
-        let r = core_dq_dynamics(m, qb.row(k), vb.row(k), tb.row(k), fb.as_ref().map(|f| f.row(k)), mask.as_deref())?;
+        let fx = fb.as_ref().map(|f| f.row(k));
+        let r = if decoupled {
+            decoupled_dynamics(m, qb.row(k), vb.row(k), tb.row(k), fx)?
+        } else {
+            core_dq_dynamics(m, qb.row(k), vb.row(k), tb.row(k), fx, mask.as_deref())?
+        };
         o[..nv].copy_from_slice(&r.ddq);
         for (i, w) in r.joint_wrenches.iter().enumerate() {
             w.write(&mut o[nv + 6 * i..nv + 6 * i + 6]);
