@@ -105,7 +105,7 @@ struct Joint {
     parent_twist_in_j: V6,
     /// actuation wrench in J (zero if locked)
     act: V6,
-    /// prescribed J-frame twist rate of a locked joint (zero)
+    /// prescribed J-frame twist rate `ω̇_pres` of a locked joint (6.28); locking uses zero
     presc: V6,
 }
 
@@ -191,7 +191,7 @@ pub fn dq_dynamics_with(
                 m.body_names[i]
             ))
         })?;
-        iinv.push(di.i_com().try_inverse().unwrap_or_else(nalgebra::Matrix3::zeros));
+        iinv.push(di.i_com_inverse());
         inert.push(Some(di));
     }
 
@@ -431,7 +431,7 @@ pub fn dq_dynamics_with(
     } else {
         // the ground's wrench on a fixed root: everything else on it, negated (its ẏ is zero)
         let w = -net[0];
-        out.joint_wrenches[0] = Force::from_v6(&flip(&(ad_out(&to_com[0]) * w)));
+        out.joint_wrenches[0] = Force::from_v6(&(ad_out(&to_com[0]) * w));
         out.reactions[0] = out.joint_wrenches[0];
     }
     for j in &joints {
@@ -442,14 +442,15 @@ pub fn dq_dynamics_with(
         for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
             out.ddq[m.idx_v[i] + c] = if j.locked { 0.0 } else { wdot[s] };
         }
-        // wrenches in J, then in the child body frame (rotation only, same origin)
+        // wrenches in J, then in the child body frame (rotation only, same origin); our wrench 6-vector
+        // [f; τ] is the engine's Force [force; moment]
         let mut react = V6::zeros();
         for (c, &s) in j.reaction.iter().enumerate() {
             react[s] = sol[j.off + c];
         }
         let total = react + j.act;
         let ad = ad_out(&j.align);
-        out.joint_wrenches[i] = Force::from_v6(&flip(&(ad * total)));
+        out.joint_wrenches[i] = Force::from_v6(&(ad * total));
         let mut pure = react;
         if j.locked {
             for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
@@ -457,16 +458,9 @@ pub fn dq_dynamics_with(
                 pure[swapped(s)] = 0.0;
             }
         }
-        out.reactions[i] = Force::from_v6(&flip(&(ad * pure)));
+        out.reactions[i] = Force::from_v6(&(ad * pure));
     }
     Ok(out)
-}
-
-/// `[f; τ]` in our slot order is already the engine's `[force; moment]`; kept as a named step so the
-/// convention change is visible in one place.
-#[inline]
-fn flip(w: &V6) -> V6 {
-    *w
 }
 
 /// Tree-sparse block Cholesky of K. Joint j couples only to joints sharing its child body i (i's children)

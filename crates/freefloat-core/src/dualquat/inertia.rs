@@ -35,6 +35,10 @@ impl DualInertia {
     pub fn i_com(&self) -> M3 {
         self.i_com
     }
+    /// `Ī⁻¹`.
+    pub fn i_com_inverse(&self) -> M3 {
+        self.i_inv
+    }
     /// From the engine's inertia (about the body origin): the same body seen from its CoM frame, which has
     /// the body frame's axes. Errors for a massless or singular body (the dual formulation needs `H(M)⁻¹`).
     pub fn from_inertia(inr: &Inertia) -> Result<DualInertia> {
