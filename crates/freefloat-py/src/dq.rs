@@ -116,6 +116,7 @@ impl PyDualQuaternion {
         arr1(py, self.inner.d.to_vec4().iter().copied().collect())
     }
     /// Pose in the engine convention: `(quat_xyzw, t)`. Raises InputError if not unit (`q q* = 1`).
+    #[allow(clippy::wrong_self_convention, clippy::type_complexity)]
     fn to_pose<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
         let q = guard(|| checked_pose("self", &self.inner))?;
         let (qx, t) = q.to_pose_xyzw();
