@@ -235,3 +235,30 @@ fn decoupled_formulation_agrees_with_dq_and_aba() {
     assert!(rel_err(&dec.ddq, &dq.ddq) < 1e-12);
     assert!(rel_err(&flat(&dec.joint_wrenches), &flat(&dq.joint_wrenches)) < 1e-12);
 }
+
+#[test]
+fn prescribed_accelerations_match_hybrid_aba() {
+    use freefloat_core::dqdynamics::dq_hybrid_dynamics;
+    let mut r = rng(31);
+    for case in 0..30 {
+        let m = random_model(&mut r, JointType::Free, 6, case % 2 == 0);
+        let q = random_q(&m, &mut r);
+        let v = random_vec(m.nv, &mut r);
+        let tau = random_vec(m.nv, &mut r);
+        let acc = random_vec(m.nv, &mut r);
+        let mask: Vec<bool> = (0..m.nbodies()).map(|i| i > 0 && m.nvs[i] > 0 && (i + case) % 2 == 0).collect();
+        let mut d = Data::new(&m);
+        hybrid_aba(&m, &mut d, &q, &v, &tau, None, Some(Prescribed { mask: &mask, ddq: &acc })).expect("hybrid");
+        let res = dq_hybrid_dynamics(&m, &q, &v, &tau, None, &mask, &acc).expect("dq");
+        assert!(rel_err(&res.ddq, &d.ddq) < 1e-10, "case {case}: {:e}", rel_err(&res.ddq, &d.ddq));
+        for i in 0..m.nbodies() {
+            for c in 0..m.nvs[i] {
+                let k = m.idx_v[i] + c;
+                if mask[i] {
+                    assert_eq!(res.ddq[k], acc[k]);
+                    assert!((res.locked_forces[k] - d.tau[k]).abs() < 1e-9 * (1.0 + d.tau[k].abs()), "case {case}");
+                }
+            }
+        }
+    }
+}

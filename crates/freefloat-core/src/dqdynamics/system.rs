@@ -143,6 +143,37 @@ pub fn dq_dynamics_with(
     locked: Option<&[bool]>,
     solver: Solver,
 ) -> Result<DqDynamics> {
+    solve_system(m, q, v, tau, fext, locked, None, solver)
+}
+
+/// Hybrid dynamics in the dual-quaternion formulation (§6.4 with the corrected recipe of digest §2.6): the
+/// joints flagged in `prescribed` (per body) follow the accelerations `ddq` (their entries of the nv-vector),
+/// the others respond to `tau`; `locked_forces` returns what the prescribed joints need. The engine's
+/// `hybrid_aba` with the same arguments gives the same result.
+pub fn dq_hybrid_dynamics(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    prescribed: &[bool],
+    ddq: &[f64],
+) -> Result<DqDynamics> {
+    crate::error::check_vec("ddq", ddq, m.nv)?;
+    solve_system(m, q, v, tau, fext, Some(prescribed), Some(ddq), Solver::Tree)
+}
+
+#[allow(clippy::too_many_arguments)]
+fn solve_system(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+    presc_ddq: Option<&[f64]>,
+    solver: Solver,
+) -> Result<DqDynamics> {
     let n = m.nbodies();
     let mut qbuf = Vec::new();
     let q = m.checked_q(q, &mut qbuf)?;
@@ -283,6 +314,13 @@ pub fn dq_dynamics_with(
             b1[i] += ad_in_oj * act;
             b1[k] -= ad_out_jo * act;
         }
+        // prescribed joint-frame twist rate ω̇_pres (6.28): the prescribed accelerations on the motion slots
+        let mut presc = V6::zeros();
+        if let (true, Some(a)) = (lk, presc_ddq) {
+            for (c, &s) in motion_slots(kind).iter().enumerate() {
+                presc[s] = a[m.idx_v[i] + c];
+            }
+        }
         joints.push(Joint {
             body: i,
             parent: k,
@@ -297,7 +335,7 @@ pub fn dq_dynamics_with(
             twist,
             parent_twist_in_j,
             act,
-            presc: V6::zeros(),
+            presc,
         });
         r_total += sl.reaction.len();
     }
@@ -440,7 +478,7 @@ pub fn dq_dynamics_with(
         // (6.15): ω̇^j = q_{o_i/j} ẏ_i q*_{o_i/j} − q*_{j/o_k} ẏ_k q_{j/o_k} − (q* ω_k q) × ω^j
         let wdot = j.ad_out_oj * ydot[i] - j.ad_in_jo * ydot[k] - cross6(&j.parent_twist_in_j, &j.twist);
         for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
-            out.ddq[m.idx_v[i] + c] = if j.locked { 0.0 } else { wdot[s] };
+            out.ddq[m.idx_v[i] + c] = if j.locked { j.presc[s] } else { wdot[s] };
         }
         // wrenches in J, then in the child body frame (rotation only, same origin); our wrench 6-vector
         // [f; τ] is the engine's Force [force; moment]
