@@ -50,7 +50,8 @@ struct J {
 }
 
 /// Forward dynamics and joint wrenches by the decoupled formulation; same conventions and output as
-/// `dq_dynamics` (`reactions` holds the constraint parts, `locked_forces` is unused here).
+/// `dq_dynamics` (`reactions` holds the constraint parts; `locked_forces`, `momentum` and `kinetic_energy`
+/// are not computed here and stay zero).
 pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Option<&[f64]>) -> Result<DqDynamics> {
     let n = m.nbodies();
     let mut qbuf = Vec::new();
@@ -266,6 +267,8 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
         joint_wrenches: vec![Force::ZERO; n],
         reactions: vec![Force::ZERO; n],
         locked_forces: vec![0.0; m.nv],
+        momentum: Force::ZERO,
+        kinetic_energy: 0.0,
     };
     let yb = |i: usize| -> (V3, V3) {
         if boff[i] == usize::MAX {

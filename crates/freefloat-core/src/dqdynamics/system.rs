@@ -35,6 +35,10 @@ pub struct DqDynamics {
     pub reactions: Vec<Force>,
     /// Per body: for locked joints, the generalized force the joint must supply (zero elsewhere), nv.
     pub locked_forces: Vec<f64>,
+    /// System dual momentum (2.53) about the inertial origin, inertial axes: [linear; angular].
+    pub momentum: Force,
+    /// System kinetic energy (2.54).
+    pub kinetic_energy: f64,
 }
 
 /// The 6×6 restriction of an 8×8 sandwich matrix to the vector slots (1..4, 5..8) — exact for unit q,
@@ -453,11 +457,24 @@ fn solve_system(
         .collect();
 
     // Generalized accelerations.
+    // (2.53) and (2.54) from the CoM poses q_{o_i/I} and twists
+    let mut h = DualQuat::ZERO;
+    let mut ke = 0.0;
+    for i in 0..n {
+        if let Some(mi) = &inert[i] {
+            let w =
+                DualQuat::vector(&tw_o[i].fixed_rows::<3>(0).into_owned(), &tw_o[i].fixed_rows::<3>(3).into_owned());
+            h = h + pose[i].mul(&to_com[i]).shift_out(&mi.momentum(&w));
+            ke += mi.kinetic_energy(&w);
+        }
+    }
     let mut out = DqDynamics {
         ddq: vec![0.0; m.nv],
         joint_wrenches: vec![Force::ZERO; n],
         reactions: vec![Force::ZERO; n],
         locked_forces: vec![0.0; m.nv],
+        momentum: Force::new(h.r.v, h.d.v),
+        kinetic_energy: ke,
     };
     if !root_fixed {
         // base: ẏ_0 = [ω̇; v̇_o], v_o = v_b + ω × c ⇒ v̇_b = v̇_o − ω̇ × c (c constant in the body)
