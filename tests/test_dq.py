@@ -336,3 +336,27 @@ def test_reactions_along_a_trajectory_and_cli(tmp_path):
     assert "peak" in out.stdout and (tmp_path / "reactions.png").exists()
     res = json.loads((tmp_path / "results.json").read_text())
     assert len(res["peaks"]) == m.nbodies
+
+
+def test_simulate_with_the_dq_formulation():
+    m = ff.models.load("thesis_ch7_two_arm")
+    rng = np.random.default_rng(2)
+    v0 = 0.1 * rng.normal(size=m.nv)
+    tau = np.tile(0.05 * rng.normal(size=m.nv), (501, 1))
+    a = ff.simulate(m, m.neutral(), v0, 0.5, 1e-3, torques=tau, record_every=50)
+    b = ff.simulate(m, m.neutral(), v0, 0.5, 1e-3, torques=tau, record_every=50, formulation="dq")
+    rt.assert_close(b.q, a.q, rtol=1e-12)
+    rt.assert_close(b.v, a.v, rtol=1e-12)
+    rt.assert_close(b.momentum, a.momentum, rtol=1e-10)  # (2.53) against the engine's momentum
+    rt.assert_close(b.kinetic_energy, a.kinetic_energy, rtol=1e-12)  # (2.54)
+    assert b.stats["formulation"] == "dq"
+    # prescribed joints go through dq_hybrid_dynamics
+    presc = ["J2"]
+    pres = lambda t: (m.neutral(), np.zeros(m.nv), np.full(m.nv, 0.2))  # noqa: E731
+    c = ff.simulate(m, m.neutral(), v0, 0.3, 1e-3, prescribed=presc, prescription=pres, record_every=50)
+    d = ff.simulate(m, m.neutral(), v0, 0.3, 1e-3, prescribed=presc, prescription=pres, record_every=50,
+                    formulation="dq")
+    rt.assert_close(d.v, c.v, rtol=1e-11)
+    rt.assert_close(d.tau, c.tau, rtol=1e-10)
+    with pytest.raises(ff.InputError, match="formulation"):
+        ff.simulate(m, m.neutral(), v0, 0.1, 1e-3, formulation="lagrange")

@@ -150,8 +150,10 @@ def models_cmd(show):
 @click.option("--q0", help="Initial configuration, nq comma-separated numbers (default: neutral).")
 @click.option("--v0", help="Initial velocity, nv comma-separated numbers (default: zero).")
 @click.option("--record-every", type=int, default=10, show_default=True, help="RK4: keep every n-th step.")
+@click.option("--formulation", type=click.Choice(["aba", "dq"]), default="aba", show_default=True,
+              help="Dynamics: the engine's ABA, or the dual-quaternion Newton-Euler system (seed 003 ch. 6).")
 @click.option("--out", help="FILE.parquet, or a directory (gets trajectory, results.json, figure).")
-def simulate_cmd(model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, out):
+def simulate_cmd(model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out):
     """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.
 
     The robot floats freely; joints are driven by --torques. The summary gives the drift of total
@@ -168,10 +170,11 @@ def simulate_cmd(model, base, t_final, dt, method, rtol, atol, torques, amplitud
         table = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, delimiter=",", ndmin=2)
         kw.update(torques=table, hold="zoh")
     t0 = time.perf_counter()
-    traj = simulate(m, q, v, t_final, dt, method=method, rtol=rtol, atol=atol, record_every=record_every, progress=True, **kw)
+    traj = simulate(m, q, v, t_final, dt, method=method, rtol=rtol, atol=atol, record_every=record_every, progress=True,
+                    formulation=formulation, **kw)
     s = summarize(traj, time.perf_counter() - t0)
     s["model"] = m.name
-    print_summary(f"{m.name}: {t_final} s, {method}", s)
+    print_summary(f"{m.name}: {t_final} s, {method}, {formulation}", s)
     write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation")
 
 
