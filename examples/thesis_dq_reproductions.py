@@ -9,7 +9,8 @@ What is and is not reproduced (honestly):
   = 1e-12; the thesis used MATLAB ode45 at 1e-14 / 2.2e-14 and 1e-13). The dual-quaternion and decoupled
   formulations give the same accelerations as the engine's ABA to ~1e-14 (checked here on the recorded states),
   so the trajectory is the thesis' motion; the thesis' *dual-quaternion state* integration (8B twists + base DQ,
-  with its own constraint drift) is not re-implemented, and neither is the condition number plot.
+  with its own constraint drift) is not re-implemented. The condition number of the system matrix S (6.17)
+  (Figs. 5.5, 7.x) is evaluated at every recorded configuration (`ff.dq.condition_number`).
 * Masses, inertias and geometry are the documented choices in models/thesis_ch5_single_arm.yaml and
   models/thesis_ch7_two_arm.yaml (the thesis gives none). Spherical-joint inputs use the digest's recommended
   mapping (phi -> tau_x, theta -> tau_y, psi -> tau_z).
@@ -69,6 +70,7 @@ def run(m, torques, t_final, dt_out, name, out: Path):
     ke, work = traj.kinetic_energy, traj.work
     r = ff.reactions.along(m, traj)
     a_dec, W_dec = ff.dq_dynamics(m, traj.q, traj.v, traj.tau, formulation="decoupled")
+    cond = ff.dq.condition_number(m, traj.q)
     summary = {
         "run": name, "model": m.name, "t_final": t_final, "samples": len(traj.t),
         "com_drift_max_m": float(np.linalg.norm(com - com[0], axis=1).max()),
@@ -78,21 +80,22 @@ def run(m, torques, t_final, dt_out, name, out: Path):
         "kinetic_energy_max_J": float(ke.max()),
         "dq_vs_engine_acceleration_rel": r.max_acceleration_mismatch,
         "dq_vs_decoupled_wrench_max_abs": float(np.abs(W_dec - r.wrench).max()),
+        "condition_number_min_max": [float(cond.min()), float(cond.max())],
         "peaks": r.peaks(),
     }
-    plot(traj, com, r, out / f"{name}.png", f"{m.name}: {name}")
+    plot(traj, com, r, cond, out / f"{name}.png", f"{m.name}: {name}")
     (out / f"{name}.json").write_text(json.dumps(summary, indent=2))
     print(f"{name:28s} CoM drift {summary['com_drift_max_m']:.1e} m, |dP| {summary['linear_momentum_drift_max']:.1e}, "
           f"|dL| {summary['angular_momentum_drift_max']:.1e}, |T - T0 - W| {summary['energy_minus_work_max_J']:.1e} J, "
-          f"dq vs decoupled {summary['dq_vs_decoupled_wrench_max_abs']:.1e}")
+          f"dq vs decoupled {summary['dq_vs_decoupled_wrench_max_abs']:.1e}, cond(S) {cond.min():.3g}..{cond.max():.3g}")
     return summary
 
 
-def plot(traj, com, r, path, title):
+def plot(traj, com, r, cond, path, title):
     from freefloat.plots import _plt
 
     plt = _plt()
-    fig, ax = plt.subplots(2, 3, figsize=(14, 7), sharex=True)
+    fig, ax = plt.subplots(2, 4, figsize=(18, 7), sharex=True)
     t = traj.t
     ax[0, 0].plot(t, np.linalg.norm(com - com[0], axis=1))
     ax[0, 0].set_ylabel("|CoM - CoM(0)| [m]")
@@ -112,6 +115,10 @@ def plot(traj, com, r, path, title):
     ax[1, 1].set_ylabel("|reaction force| [N]")
     ax[1, 2].set_ylabel("|reaction torque| [N m]")
     ax[1, 1].legend(fontsize="x-small", ncol=2)
+    ax[0, 3].plot(t, cond)
+    ax[0, 3].set_ylabel("cond(S), system matrix (6.17)")
+    ax[1, 3].plot(t, traj.ddq[:, 6:])
+    ax[1, 3].set_ylabel("joint accelerations")
     for a in ax[1]:
         a.set_xlabel("t [s]")
     fig.suptitle(title)

@@ -302,6 +302,9 @@ def test_dq_dynamics_locked_and_batches():
         ff.dq_dynamics(m, Q[0], Vv[0], T[0], locked=["no_such_joint"])
     with pytest.raises(ff.InputError, match="formulation"):
         ff.dq_dynamics(m, Q[0], Vv[0], T[0], formulation="lagrange")
+    c = ff.dq.condition_number(m, Q)
+    assert c.shape == (3,) and np.all(c >= 1) and np.isfinite(c).all()
+    assert ff.dq.condition_number(m, Q[0]) == pytest.approx(c[0], rel=1e-12)
     with pytest.raises(ff.InputError, match="locked"):
         ff.dq_dynamics(m, Q[0], Vv[0], T[0], locked=lock, formulation="decoupled")
     with pytest.raises(ff.InputError, match="tau"):

@@ -26,6 +26,7 @@ from ._core import DualQuaternion
 __all__ = [
     "DualQuaternion", "from_pose", "identity", "vector", "exp", "screw", "dh", "dh_chain",
     "line_of_sight", "approach_slope", "attitude", "distance_bound", "body_poses",
+    "condition_number",
 ]
 
 
@@ -104,4 +105,10 @@ def body_poses(model, q, method: str = "chain") -> np.ndarray:
     relative poses (3.43), ``"poe"`` uses the product of exponentials (3.19) with screws taken at the neutral
     configuration (revolute, prismatic, spherical and fixed joints)."""
     return _core.dq_body_poses(model, q, method)
+
+
+def condition_number(model, q):
+    """2-norm condition number of the dissertation's system matrix S (6.17) of the dual-quaternion dynamics at
+    configuration ``q`` (or each row of a (T, nq) array): the quantity of its Figs. 5.5 and 7.x."""
+    return _core.dq_condition_number(model, q)
 

@@ -112,6 +112,11 @@ fn literal_thesis_system_equals_dq_dynamics() {
             bk -= sub_k;
             b.rows_mut(8 * k, 8).copy_from(&bk);
         }
+        // the condition number of the thesis' matrix (Figs. 5.5, 7.x) from the library equals this one's
+        let sv = s.clone().singular_values();
+        let cond = sv.max() / sv.min();
+        let lib = freefloat_core::dqdynamics::condition_number(&m, &q).expect("condition");
+        assert!((lib - cond).abs() < 1e-8 * cond, "case {case}: {lib} vs {cond}");
         let y = s.clone().lu().solve(&b).expect("full system is nonsingular");
         assert!((&s * &y - &b).amax() < 1e-9 * (1.0 + b.amax()));
         let res = dq_dynamics(&m, &q, &v, &tau, None, None).expect("dq");

@@ -91,3 +91,22 @@ pub fn dq_dynamics<'py>(
     }
     Ok((output(py, a, rows, st, &[nv])?, output(py, w, rows, st, &[nb, 6])?))
 }
+
+/// 2-norm condition number of the thesis' system matrix S (6.17) at each configuration (one q or (T, nq)).
+#[pyfunction]
+pub fn dq_condition_number<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    q: Arr<'_, 'py>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = model_arg(model)?;
+    let model = mb.get();
+    let m = &model.inner;
+    let qb = Batch::new("q", q, &[m.nq])?;
+    let (rows, st) = common_rows(&[("q", &qb)])?;
+    let out = run_rows(py, model, rows, st, 1, |m, _d, k, o, _buf| {
+        o[0] = freefloat_core::dqdynamics::condition_number(m, qb.row(k))?;
+        Ok(())
+    })?;
+    output(py, out, rows, st, &[])
+}

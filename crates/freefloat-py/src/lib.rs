@@ -39,6 +39,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_dynamics, m)?)?;
+    m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
     m.add_class::<dq::PyDualQuaternion>()?;
     m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_exp, m)?)?;

@@ -6,4 +6,6 @@ pub mod decoupled;
 pub mod joints;
 mod system;
 
-pub use system::{ad_in, ad_out, dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, reduce, DqDynamics, Solver};
+pub use system::{
+    ad_in, ad_out, condition_number, dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, reduce, DqDynamics, Solver,
+};

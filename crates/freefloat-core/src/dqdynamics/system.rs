@@ -147,7 +147,7 @@ pub fn dq_dynamics_with(
     locked: Option<&[bool]>,
     solver: Solver,
 ) -> Result<DqDynamics> {
-    solve_system(m, q, v, tau, fext, locked, None, solver)
+    solve_system(m, q, v, tau, fext, locked, None, solver, None)
 }
 
 /// Hybrid dynamics in the dual-quaternion formulation (§6.4 with the corrected recipe of digest §2.6): the
@@ -164,7 +164,7 @@ pub fn dq_hybrid_dynamics(
     ddq: &[f64],
 ) -> Result<DqDynamics> {
     crate::error::check_vec("ddq", ddq, m.nv)?;
-    solve_system(m, q, v, tau, fext, Some(prescribed), Some(ddq), Solver::Tree)
+    solve_system(m, q, v, tau, fext, Some(prescribed), Some(ddq), Solver::Tree, None)
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -177,6 +177,7 @@ fn solve_system(
     locked: Option<&[bool]>,
     presc_ddq: Option<&[f64]>,
     solver: Solver,
+    cond_out: Option<&mut f64>,
 ) -> Result<DqDynamics> {
     let n = m.nbodies();
     let mut qbuf = Vec::new();
@@ -342,6 +343,10 @@ fn solve_system(
             presc,
         });
         r_total += sl.reaction.len();
+    }
+
+    if let Some(c) = cond_out {
+        *c = full_system_condition(&joints, &inert, n, r_total);
     }
 
     // B2 (6.23): Λ_j ((q* ω_k q) × ω^j) + Λ_j ω̇_pres, with Λ_j = V_jᵀ P_swap.
@@ -516,6 +521,57 @@ fn solve_system(
         out.reactions[i] = Force::from_v6(&(ad * pure));
     }
     Ok(out)
+}
+
+/// 2-norm condition number of the thesis' system matrix S (6.17) at configuration `q` (it does not depend
+/// on velocities or forces): the quantity of Figs. 5.5 and 7.x. Assembled densely from the same blocks as
+/// the solve: `S11 = blkdiag(H(M_i))`, `S12 = −G`, `S21 = Gᵀ P_swap` — the thesis' matrix up to a row
+/// permutation of S21 (its E-selector order), which leaves singular values unchanged. The scalar slots the
+/// 6-vectors drop are decoupled rows with singular value 1 (the ones of (2.45)), folded in at the end.
+pub fn condition_number(m: &Model, q: &[f64]) -> Result<f64> {
+    let (v, tau) = (vec![0.0; m.nv], vec![0.0; m.nv]);
+    let mut c = f64::NAN;
+    solve_system(m, q, &v, &tau, None, None, None, Solver::Tree, Some(&mut c))?;
+    Ok(c)
+}
+
+fn full_system_condition(joints: &[Joint], inert: &[Option<DualInertia>], n: usize, r_total: usize) -> f64 {
+    let mut boff = vec![usize::MAX; n];
+    let mut nb = 0;
+    for i in 0..n {
+        if inert[i].is_some() {
+            boff[i] = 6 * nb;
+            nb += 1;
+        }
+    }
+    let size = 6 * nb + r_total;
+    let mut s = DMatrix::<f64>::zeros(size, size);
+    for i in 0..n {
+        if let Some(mi) = &inert[i] {
+            // H(M) on [ω; v]: M (a)^s = [m v; Ī ω]
+            let o = boff[i];
+            for k in 0..3 {
+                s[(o + k, o + 3 + k)] = mi.mass();
+            }
+            s.view_mut((o + 3, o), (3, 3)).copy_from(&mi.i_com());
+        }
+    }
+    let p = |g: &M6| -> M6 { M6::from_fn(|r, c| g[((r + 3) % 6, c)]) }; // P_swap G
+    for j in joints {
+        let r = j.reaction.len();
+        for (body, g) in [(j.body, &j.g_dist), (j.parent, &j.g_prox)] {
+            if boff[body] == usize::MAX {
+                continue;
+            }
+            let o = boff[body];
+            s.view_mut((o, 6 * nb + j.off), (6, r)).copy_from(&(-g.columns(0, r)));
+            let pg = p(g);
+            s.view_mut((6 * nb + j.off, o), (r, 6)).copy_from(&pg.columns(0, r).transpose());
+        }
+    }
+    let sv = s.singular_values();
+    let (mx, mn) = (sv.max().max(1.0), sv.min().min(1.0));
+    mx / mn
 }
 
 /// Tree-sparse block Cholesky of K. Joint j couples only to joints sharing its child body i (i's children)
