@@ -2,10 +2,13 @@
 //! from one linear system solved through the Schur complement of the body block. Cross-checked against the
 //! engine's ABA (accelerations) and RNEA (transmitted wrenches) in tests/dqdynamics.rs.
 
+mod condition;
 pub mod decoupled;
 pub mod joints;
+mod sixvec;
 mod system;
+mod tree_solve;
 
-pub use system::{
-    ad_in, ad_out, condition_number, dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, reduce, DqDynamics, Solver,
-};
+pub use condition::condition_number;
+pub use sixvec::{ad_in, ad_out, reduce};
+pub use system::{dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, DqDynamics, Solver};

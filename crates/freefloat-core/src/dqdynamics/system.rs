@@ -12,15 +12,15 @@
 //! tree is chordal), see `solve_tree`.
 
 use super::joints::{alignment, motion_slots, slots, swapped};
+use super::sixvec::{ad_in, ad_out, cross6, minv, swap6, M6};
+use super::tree_solve::{solve_spd, solve_tree};
 use crate::dualquat::kinematics::joint_pose;
 use crate::dualquat::pose::translation;
 use crate::dualquat::{DualInertia, DualQuat};
 use crate::error::{FfError, Result};
 use crate::model::{JointType, Model};
 use crate::spatial::{Force, V3, V6};
-use nalgebra::{DMatrix, DVector, Matrix6};
-
-type M6 = Matrix6<f64>;
+use nalgebra::{DMatrix, DVector};
 
 /// Result of `dq_dynamics`.
 #[derive(Clone, Debug, Default)]
@@ -41,76 +41,27 @@ pub struct DqDynamics {
     pub kinetic_energy: f64,
 }
 
-/// The 6×6 restriction of an 8×8 sandwich matrix to the vector slots (1..4, 5..8) — exact for unit q,
-/// which maps vector dual quaternions to vector dual quaternions. The thesis' form; kept as the reference
-/// the closed forms below are tested against.
-pub fn reduce(m: &crate::dualquat::M8) -> M6 {
-    const IDX: [usize; 6] = [1, 2, 3, 5, 6, 7];
-    M6::from_fn(|r, c| m[(IDX[r], IDX[c])])
-}
-/// `x ↦ q* x q` ((2.41)/(2.43)) on 6-vectors, in closed form: `[Rᵀ, 0; −Rᵀ[t]ˣ, Rᵀ]` with `R = C(q_r)`,
-/// `t = 2 q_d q_r*` — the shifting law `s_r^Y + ε(s_d^Y + r^Y_{X/Y} × s_r^Y)` written as a matrix. It replaces
-/// `[[q*]]_L [[q]]_R` (two 8×8 products) in the hot loop.
-pub fn ad_in(q: &DualQuat) -> M6 {
-    let rt = q.r.rotation_matrix().transpose();
-    let t = q.translation();
-    let mut m = M6::zeros();
-    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&rt);
-    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&rt);
-    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-rt * crate::spatial::skew(&t)));
-    m
-}
-/// `x ↦ q x q*` ((2.42)/(2.44)) on 6-vectors: `[R, 0; [t]ˣ R, R]`.
-pub fn ad_out(q: &DualQuat) -> M6 {
-    let r = q.r.rotation_matrix();
-    let t = q.translation();
-    let mut m = M6::zeros();
-    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&r);
-    m.fixed_view_mut::<3, 3>(3, 3).copy_from(&r);
-    m.fixed_view_mut::<3, 3>(3, 0).copy_from(&(crate::spatial::skew(&t) * r));
-    m
-}
-/// The swap on 6-vectors: `[a; b] ↦ [b; a]`.
-fn swap6(x: &V6) -> V6 {
-    V6::new(x[3], x[4], x[5], x[0], x[1], x[2])
-}
-/// Dual-quaternion cross product (Table 2.4) of two vector dual quaternions as 6-vectors:
-/// `(a_r × b_r) + ε(a_d × b_r + a_r × b_d)`.
-fn cross6(a: &V6, b: &V6) -> V6 {
-    let (ar, ad) = (a.fixed_rows::<3>(0).into_owned(), a.fixed_rows::<3>(3).into_owned());
-    let (br, bd) = (b.fixed_rows::<3>(0).into_owned(), b.fixed_rows::<3>(3).into_owned());
-    let r = ar.cross(&br);
-    let d = ad.cross(&br) + ar.cross(&bd);
-    V6::new(r.x, r.y, r.z, d.x, d.y, d.z)
-}
-/// `M⁻¹ [f; τ] = [f/m; Ī⁻¹τ]`, i.e. `(ẏ)^s` from a wrench (Lemma 3 without the swap).
-fn minv(mi: &DualInertia, iinv: &nalgebra::Matrix3<f64>, w: &V6) -> V6 {
-    let f = w.fixed_rows::<3>(0) / mi.mass();
-    let t = iinv * w.fixed_rows::<3>(3);
-    V6::new(f.x, f.y, f.z, t.x, t.y, t.z)
-}
-
-struct Joint {
-    body: usize,
-    parent: usize,
+pub(super) struct Joint {
+    pub(super) body: usize,
+    pub(super) parent: usize,
     /// offset of W̃_j in the unknown vector, and its slots
-    off: usize,
-    reaction: &'static [usize],
-    locked: bool,
+    pub(super) off: usize,
+    pub(super) reaction: &'static [usize],
+    pub(super) locked: bool,
     /// q_{J/B} of the child body
-    align: DualQuat,
+    pub(super) align: DualQuat,
     /// `G` of the distal (child) and proximal (parent) body, 6 × r (first r columns used)
-    g_dist: M6,
-    g_prox: M6,
-    ad_out_oj: M6,
-    ad_in_jo: M6,
+    pub(super) g_dist: M6,
+    pub(super) g_prox: M6,
+    pub(super) ad_out_oj: M6,
+    pub(super) ad_in_jo: M6,
     /// joint twist ω^j (6.13) and `x = q*_{j/o_k} ω_k q_{j/o_k}`
-    twist: V6,
-    parent_twist_in_j: V6,
+    pub(super) twist: V6,
+    pub(super) parent_twist_in_j: V6,
     /// actuation wrench in J (zero if locked)
-    act: V6,
+    pub(super) act: V6,
     /// prescribed J-frame twist rate `ω̇_pres` of a locked joint (6.28); locking uses zero
-    presc: V6,
+    pub(super) presc: V6,
 }
 
 /// Forward dynamics and joint wrenches by the dual-quaternion formulation for a tree with a free or fixed
@@ -168,7 +119,7 @@ pub fn dq_hybrid_dynamics(
 }
 
 #[allow(clippy::too_many_arguments)]
-fn solve_system(
+pub(super) fn solve_system(
     m: &Model,
     q: &[f64],
     v: &[f64],
@@ -346,7 +297,7 @@ fn solve_system(
     }
 
     if let Some(c) = cond_out {
-        *c = full_system_condition(&joints, &inert, n, r_total);
+        *c = super::condition::full_system_condition(&joints, &inert, n, r_total);
     }
 
     // B2 (6.23): Λ_j ((q* ω_k q) × ω^j) + Λ_j ω̇_pres, with Λ_j = V_jᵀ P_swap.
@@ -521,141 +472,4 @@ fn solve_system(
         out.reactions[i] = Force::from_v6(&(ad * pure));
     }
     Ok(out)
-}
-
-/// 2-norm condition number of the thesis' system matrix S (6.17) at configuration `q` (it does not depend
-/// on velocities or forces): the quantity of Figs. 5.5 and 7.x. Assembled densely from the same blocks as
-/// the solve: `S11 = blkdiag(H(M_i))`, `S12 = −G`, `S21 = Gᵀ P_swap` — the thesis' matrix up to a row
-/// permutation of S21 (its E-selector order), which leaves singular values unchanged. The scalar slots the
-/// 6-vectors drop are decoupled rows with singular value 1 (the ones of (2.45)), folded in at the end.
-pub fn condition_number(m: &Model, q: &[f64]) -> Result<f64> {
-    let (v, tau) = (vec![0.0; m.nv], vec![0.0; m.nv]);
-    let mut c = f64::NAN;
-    solve_system(m, q, &v, &tau, None, None, None, Solver::Tree, Some(&mut c))?;
-    Ok(c)
-}
-
-fn full_system_condition(joints: &[Joint], inert: &[Option<DualInertia>], n: usize, r_total: usize) -> f64 {
-    let mut boff = vec![usize::MAX; n];
-    let mut nb = 0;
-    for i in 0..n {
-        if inert[i].is_some() {
-            boff[i] = 6 * nb;
-            nb += 1;
-        }
-    }
-    let size = 6 * nb + r_total;
-    let mut s = DMatrix::<f64>::zeros(size, size);
-    for i in 0..n {
-        if let Some(mi) = &inert[i] {
-            // H(M) on [ω; v]: M (a)^s = [m v; Ī ω]
-            let o = boff[i];
-            for k in 0..3 {
-                s[(o + k, o + 3 + k)] = mi.mass();
-            }
-            s.view_mut((o + 3, o), (3, 3)).copy_from(&mi.i_com());
-        }
-    }
-    let p = |g: &M6| -> M6 { M6::from_fn(|r, c| g[((r + 3) % 6, c)]) }; // P_swap G
-    for j in joints {
-        let r = j.reaction.len();
-        for (body, g) in [(j.body, &j.g_dist), (j.parent, &j.g_prox)] {
-            if boff[body] == usize::MAX {
-                continue;
-            }
-            let o = boff[body];
-            s.view_mut((o, 6 * nb + j.off), (6, r)).copy_from(&(-g.columns(0, r)));
-            let pg = p(g);
-            s.view_mut((6 * nb + j.off, o), (r, 6)).copy_from(&pg.columns(0, r).transpose());
-        }
-    }
-    let sv = s.singular_values();
-    let (mx, mn) = (sv.max().max(1.0), sv.min().min(1.0));
-    mx / mn
-}
-
-/// Tree-sparse block Cholesky of K. Joint j couples only to joints sharing its child body i (i's children)
-/// or its parent body k (k's distal joint and k's other children). Eliminating joints in decreasing index
-/// (children before parents) leaves, when j's turn comes, only body i's block of j (its children's Schur
-/// updates already folded in) and neighbours that all share body k: their updates land in body k's blocks,
-/// so there is no fill-in outside the per-body blocks. Every block is a stack 6×6 (padding dimensions get
-/// a unit pivot and stay zero).
-fn solve_tree(
-    joints: &[Joint],
-    inc: &[Vec<usize>],
-    start: &[usize],
-    blocks: &mut [M6],
-    rhs: &mut [V6],
-) -> Result<Vec<V6>> {
-    let nj = joints.len();
-    let singular = || {
-        FfError::Numerical("the dual-quaternion constraint system (Delassus matrix) is singular or indefinite".into())
-    };
-    let mut eliminated = vec![false; nj];
-    let mut pivots: Vec<Option<nalgebra::Cholesky<f64, nalgebra::U6>>> = vec![None; nj];
-    // couplings C[a, j] of joint j to the joints solved before it: flat, joint j owns cstart[j]..cstart[j+1]
-    let mut coupling: Vec<(usize, M6)> = Vec::with_capacity(2 * nj);
-    let mut cstart = vec![0; nj + 1];
-    let mut cend = vec![0; nj];
-    let mut rest: Vec<(usize, usize)> = Vec::new(); // (joint, position in its parent body's list)
-    for jj in (0..nj).rev() {
-        let (i, k, rj) = (joints[jj].body, joints[jj].parent, joints[jj].reaction.len());
-        let mut p = blocks[start[i]];
-        rest.clear();
-        let (lk, pos) = (inc[k].len(), inc[k].iter().position(|&x| x == jj));
-        if let Some(pos) = pos {
-            p += blocks[start[k] + pos * lk + pos];
-            for (pa, &ja) in inc[k].iter().enumerate() {
-                if ja != jj && !eliminated[ja] {
-                    rest.push((ja, pa));
-                }
-            }
-        }
-        for d in rj..6 {
-            p[(d, d)] = 1.0;
-        }
-        let ch = nalgebra::Cholesky::new(p).ok_or_else(singular)?;
-        let y_rhs = ch.solve(&rhs[jj]);
-        cstart[jj] = coupling.len();
-        if let Some(pos) = pos {
-            for &(ja, pa) in &rest {
-                let c_a = blocks[start[k] + pa * lk + pos]; // C[a, j]
-                let y_a = ch.solve(&c_a.transpose()); // P⁻¹ C[j, a]
-                rhs[ja] -= c_a * y_rhs;
-                for &(_, pb) in &rest {
-                    let c_b = blocks[start[k] + pb * lk + pos];
-                    blocks[start[k] + pb * lk + pa] -= c_b * y_a;
-                }
-                coupling.push((ja, c_a));
-            }
-        }
-        cend[jj] = coupling.len();
-        pivots[jj] = Some(ch);
-        eliminated[jj] = true;
-    }
-    cstart[nj] = coupling.len();
-    // back substitution, parents first: x_j = P⁻¹ (rhs_j − Σ_a C[a, j]ᵀ x_a)
-    let mut x = vec![V6::zeros(); nj];
-    for jj in 0..nj {
-        let mut b = rhs[jj];
-        for (ja, c) in &coupling[cstart[jj]..cend[jj]] {
-            b -= c.transpose() * x[*ja];
-        }
-        x[jj] = pivots[jj].as_ref().ok_or_else(singular)?.solve(&b);
-    }
-    Ok(x)
-}
-
-/// Solve the symmetric positive-definite Delassus system by Cholesky; a failure means dependent constraint
-/// rows (e.g. degenerate joint axes) or a non-physical body.
-fn solve_spd(k: DMatrix<f64>, rhs: DVector<f64>) -> Result<DVector<f64>> {
-    if k.nrows() == 0 {
-        return Ok(rhs);
-    }
-    match k.cholesky() {
-        Some(ch) => Ok(ch.solve(&rhs)),
-        None => Err(FfError::Numerical(
-            "the dual-quaternion constraint system (Delassus matrix) is singular or indefinite".into(),
-        )),
-    }
 }
