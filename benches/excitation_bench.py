@@ -295,7 +295,9 @@ def main():
         rb = d.evaluate(X)
         seq = np.array([d.evaluate(xi)["objective"][0] for xi in X])
         agreement["batch_vs_sequential_max_rel"] = float(np.max(np.abs(rb["objective"] - seq) / np.abs(seq)))
-        ok = (reg_err <= REGRESSOR_RTOL and agreement["batch_vs_sequential_max_rel"] <= 1e-12
+        # A single evaluation splits its rows over both threads, a batch gives each path one thread: the Gram
+        # blocks are summed in a different order, so the two agree to rounding (not bitwise).
+        ok = (reg_err <= REGRESSOR_RTOL and agreement["batch_vs_sequential_max_rel"] <= 1e-9
               and all(agreement[k] <= AGREE_RTOL for k in ("condition_number_rel", "mean_square_rel", "objective_rel")))
         if not ok:
             raise SystemExit(f"ABORT: peer and freefloat disagree: {agreement}")

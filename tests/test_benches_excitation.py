@@ -24,7 +24,7 @@ def test_excitation_bench_quick_runs_and_agrees(tmp_path):
     for key in ("condition_number_rel", "mean_square_rel", "objective_rel"):
         assert agree[key] <= 1e-6, (key, agree[key])
     assert agree["regressor_max_rel"] <= 1e-9
-    assert agree["batch_vs_sequential_max_rel"] <= 1e-12
+    assert agree["batch_vs_sequential_max_rel"] <= 1e-9  # Gram blocks summed in another order
     assert res["problem"]["intervals"] == 256 and res["problem"]["regressor_shape"] == [7680, 52]
     assert res["gradient_batch_evaluations"] == 13
     for name, s in res["objective_seconds"].items():

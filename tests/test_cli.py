@@ -17,7 +17,7 @@ def run(*args, ok=True):
     return r
 
 
-@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"], ["excite"]])
+@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"], ["excite"], ["reactions"], ["scenarios"], ["identify", "postcapture"]])
 def test_every_command_has_help(cmd):
     r = run(*cmd, "--help")
     assert "Usage:" in r.stdout and len(r.stdout) > 200

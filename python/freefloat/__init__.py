@@ -8,7 +8,7 @@
 
 Conventions are in docs/architecture.md; every number is computed by the Rust engine."""
 
-from . import estimation, excitation, models, online, telemetry, trajectories
+from . import dq, estimation, excitation, models, online, reactions, telemetry, trajectories
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
@@ -17,6 +17,7 @@ from .algorithms import (
     center_of_mass,
     centroidal_momentum_matrix,
     crba,
+    dq_dynamics,
     dynamics_regressor,
     forward_kinematics,
     frame_jacobian,
@@ -37,8 +38,8 @@ from .identify import IdentificationResult, identify_minimal
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Trajectory", "models", "online", "simulate", "telemetry", "trajectories", "excitation", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
-    "aba", "rnea", "crba", "hybrid_dynamics",
+    "Model", "Trajectory", "models", "dq", "online", "simulate", "telemetry", "trajectories", "excitation", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
+    "aba", "rnea", "crba", "hybrid_dynamics", "dq_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
     "momentum_regressor", "dynamics_regressor",

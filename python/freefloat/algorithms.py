@@ -31,7 +31,7 @@ from ._core import (
 
 __all__ = [
     "aba", "body_accelerations", "body_velocities", "center_of_mass", "centroidal_momentum_matrix", "crba",
-    "dynamics_regressor", "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian",
+    "dq_dynamics", "dynamics_regressor", "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian",
     "hybrid_dynamics", "kinetic_energy", "momentum", "momentum_regressor", "rnea",
 ]
 
@@ -54,3 +54,25 @@ def hybrid_dynamics(model, q, v, tau, ddq, prescribed, fext=None):
     if isinstance(prescribed, str):
         prescribed = [prescribed]
     return _core.hybrid_dynamics(model, q, v, tau, ddq, list(prescribed), fext)
+
+
+def dq_dynamics(model, q, v, tau, fext=None, locked=None, formulation="dq"):
+    """Forward dynamics and joint wrenches by the dual-quaternion Newton-Euler formulation
+    (dissertation seed 003, ch. 5-6): one linear system for every body's acceleration and every joint's
+    reaction, solved through the Schur complement (a symmetric positive-definite Delassus matrix).
+
+    Returns (a, W): `a` (nv,) the generalized accelerations, equal to `aba(model, q, v, tau, fext)`;
+    `W` (nbodies, 6) per joint the wrench it transmits onto its child body -- reaction plus actuation --
+    as [force; torque about the child body origin] in child body axes, equal to the spatial force the
+    engine's RNEA recovers at those accelerations. Row 0 is the base joint (a free base: `tau[:6]`).
+    The pure reaction of a revolute joint is `W` without its torque about the joint axis (which is tau).
+
+    `locked`: joint names held at zero acceleration (their `tau` entries are ignored; the torque they need
+    is the actuated component of their row of `W`). Free or fixed base; revolute, prismatic, spherical
+    and fixed joints; every moving body needs a positive mass and a positive-definite inertia.
+
+    `formulation="decoupled"` solves chapter 5's decoupled (3-vector) Newton-Euler system instead, with the
+    same outputs (no `locked`); the two agree to round-off."""
+    if isinstance(locked, str):
+        locked = [locked]
+    return _core.dq_dynamics(model, q, v, tau, fext, None if locked is None else list(locked), formulation)

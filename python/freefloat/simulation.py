@@ -145,6 +145,7 @@ def simulate(
     prescription=None,
     progress=False,
     max_steps: int = 50_000_000,
+    formulation: str = "aba",
 ) -> Trajectory:
     """Simulate the model from (q0, v0) for t_final seconds.
 
@@ -160,7 +161,11 @@ def simulate(
     prescribed / prescription: joint names that follow prescription(t) -> (q, v, a) (full-length
       arrays; only the prescribed joints' entries are used) while the rest responds (hybrid
       dynamics); the recorded tau then holds the forces these joints needed.
-    progress: True for a progress bar, or a callable progress(fraction) returning False to abort."""
+    progress: True for a progress bar, or a callable progress(fraction) returning False to abort.
+    formulation: "aba" (the engine's articulated-body algorithm) or "dq" (the dual-quaternion Newton-Euler
+      system of seed 003 ch. 6, `dq_dynamics`: same motion to round-off, slower; free or fixed base with
+      revolute, prismatic, spherical and fixed joints). With "dq" the recorded momentum and kinetic energy
+      are the formulation's own (2.53)/(2.54)."""
     if not isinstance(model, Model):
         raise TypeError(f"expected a freefloat.Model, got {type(model).__name__}")
     if isinstance(prescribed, str):
@@ -180,12 +185,13 @@ def simulate(
         out = _core.simulate(
             model._core, as_f64(q0, "q0"), as_f64(v0, "v0"), float(t_final), float(dt), method, rtol, atol, max_step,
             int(record_every), torques, tt, hold, controller, controller_period, prescribed, prescription, int(max_steps), cb,
+            formulation,
         )
     finally:
         if bar is not None:
             bar.close()
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
-    stats.update(method=method, dt=dt, t_final=t_final, total_mass=model.total_mass, radius=_radius(model, q0))
+    stats.update(method=method, formulation=formulation, dt=dt, t_final=t_final, total_mass=model.total_mass, radius=_radius(model, q0))
     return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
 
 

@@ -10,6 +10,8 @@
 
 pub mod config;
 pub mod data;
+pub mod dqdynamics;
+pub mod dualquat;
 pub mod dynamics;
 pub mod error;
 pub mod estimation;

@@ -13,9 +13,9 @@ use nalgebra::{Dyn, MatrixViewMut};
 use pyo3::prelude::*;
 
 /// An argument that is read as an array of float64 (anything numpy can convert).
-type Arr<'a, 'py> = &'a Bound<'py, PyAny>;
+pub(crate) type Arr<'a, 'py> = &'a Bound<'py, PyAny>;
 
-fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
+pub(crate) fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
     if !stacked {
         return e;
     }
@@ -29,7 +29,14 @@ fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
 /// Evaluate `f` on every sample, each writing `width` numbers. Stacked inputs run with the GIL
 /// released; a single sample does not, since releasing and retaking it costs more than most
 /// single evaluations.
-fn run_rows<F>(py: Python<'_>, model: &PyModel, rows: usize, stacked: bool, width: usize, f: F) -> PyResult<Vec<f64>>
+pub(crate) fn run_rows<F>(
+    py: Python<'_>,
+    model: &PyModel,
+    rows: usize,
+    stacked: bool,
+    width: usize,
+    f: F,
+) -> PyResult<Vec<f64>>
 where
     F: Fn(&Model, &mut Data, usize, &mut [f64], &mut Vec<f64>) -> Result<(), FfError> + Send + Sync,
 {
@@ -52,7 +59,7 @@ where
     }
 }
 
-fn fext_batch(m: &Model, fext: Option<Arr>) -> PyResult<Option<Batch>> {
+pub(crate) fn fext_batch(m: &Model, fext: Option<Arr>) -> PyResult<Option<Batch>> {
     fext.map(|f| Batch::new("fext", f, &[m.nbodies(), 6])).transpose()
 }
 

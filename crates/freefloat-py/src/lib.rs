@@ -3,6 +3,8 @@
 
 mod algorithms;
 mod batch;
+mod dq;
+mod dqdynamics;
 mod errors;
 mod estimation;
 mod excitation;
@@ -43,5 +45,18 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(postcapture::postcapture_simulate, m)?)?;
     m.add_class::<postcapture::PyRls>()?;
     m.add_class::<postcapture::PyModifiedRls>()?;
+    m.add_function(wrap_pyfunction!(dqdynamics::dq_dynamics, m)?)?;
+    m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
+    m.add_class::<dq::PyDualQuaternion>()?;
+    m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_exp, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_screw, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_dh, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_dh_chain, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_body_poses, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_line_of_sight, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_approach_slope, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_attitude, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_distance_bound, m)?)?;
     Ok(())
 }

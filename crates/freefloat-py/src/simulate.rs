@@ -50,7 +50,7 @@ fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'st
 #[pyo3(signature = (
     model, q0, v0, t_final, dt, method = "rk4", rtol = 1e-9, atol = 1e-12, max_step = None, record_every = 1,
     torques = None, torque_times = None, hold = "zoh", controller = None, controller_period = None,
-    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None
+    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba"
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -74,8 +74,14 @@ pub fn simulate<'py>(
     prescription: Option<Bound<'py, PyAny>>,
     max_steps: usize,
     progress: Option<Bound<'py, PyAny>>,
+    formulation: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model.inner.clone();
+    let formulation = match formulation {
+        "aba" => sim::Formulation::Aba,
+        "dq" => sim::Formulation::DualQuaternion,
+        other => return Err(input_err(format!("argument `formulation`: must be 'aba' or 'dq', got '{other}'"))),
+    };
     let method = match method {
         "rk4" => Method::Rk4,
         "rk45" | "dopri5" => Method::Rk45 { rtol, atol, max_step: max_step.unwrap_or(f64::INFINITY) },
@@ -194,7 +200,7 @@ pub fn simulate<'py>(
             }
         });
         let pr: Option<sim::Progress> = prog.as_mut().map(|p| p as &mut dyn FnMut(f64) -> bool);
-        guard(|| sim::simulate(&m, &q0, &v0, &opts, inputs, pr))
+        guard(|| sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, pr))
     } else {
         // No Python code runs during the simulation: release the GIL; the inputs are built from
         // plain data on the detached side.
@@ -208,7 +214,8 @@ pub fn simulate<'py>(
                     Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
                     None => TorqueSource::Zero,
                 };
-                sim::simulate(&m, &q0, &v0, &opts, Inputs { torques, ..Default::default() }, None)
+                let inputs = Inputs { torques, ..Default::default() };
+                sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, None)
             })
         })
     };

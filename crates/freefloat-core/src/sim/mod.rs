@@ -36,6 +36,17 @@ pub struct SimOptions {
     pub max_steps: usize,
 }
 
+/// Which formulation gives the accelerations at every stage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Formulation {
+    /// The engine's articulated-body algorithm (hybrid ABA with prescribed joints).
+    #[default]
+    Aba,
+    /// The dual-quaternion Newton–Euler system of seed 003 ch. 6 (`dqdynamics`); same results to round-off,
+    /// slower, free or fixed base with revolute, prismatic, spherical and fixed joints only.
+    DualQuaternion,
+}
+
 /// Everything that acts on the robot during a simulation.
 pub struct Inputs<'a> {
     pub torques: TorqueSource<'a>,
@@ -55,6 +66,7 @@ pub type Progress<'a> = &'a mut dyn FnMut(f64) -> bool;
 /// Work buffers of one simulation.
 struct Stepper<'m, 'i> {
     m: &'m Model,
+    formulation: Formulation,
     d: Data,
     inputs: Inputs<'i>,
     held: Vec<f64>,
@@ -87,6 +99,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
         }
         Ok(Stepper {
             m,
+            formulation: Formulation::Aba,
             d: Data::new(m),
             inputs,
             held: vec![0.0; m.nv],
@@ -131,7 +144,27 @@ impl<'m, 'i> Stepper<'m, 'i> {
         }
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
-        hybrid_aba(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?;
+        match self.formulation {
+            Formulation::Aba => hybrid_aba(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?,
+            Formulation::DualQuaternion => {
+                // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
+                let r = match presc {
+                    Some(p) => crate::dqdynamics::dq_hybrid_dynamics(m, &qs, &vs, &self.tau, None, p.mask, p.ddq)?,
+                    None => crate::dqdynamics::dq_dynamics(m, &qs, &vs, &self.tau, None, None)?,
+                };
+                self.d.ddq.copy_from_slice(&r.ddq);
+                self.d.tau.copy_from_slice(&self.tau);
+                // recorded conservation quantities from the formulation's own algebra, (2.53)/(2.54)
+                self.d.aba_momentum = r.momentum;
+                self.d.aba_kinetic_energy = r.kinetic_energy;
+                for (i, &on) in self.presc_mask.iter().enumerate() {
+                    if on && presc.is_some() {
+                        let k = m.idx_v[i];
+                        self.d.tau[k..k + m.nvs[i]].copy_from_slice(&r.locked_forces[k..k + m.nvs[i]]);
+                    }
+                }
+            }
+        }
         if let Some(k) = self.d.ddq.iter().position(|x| !x.is_finite()) {
             return Err(FfError::Numerical(format!("acceleration {k} became non-finite at t = {t}")));
         }
@@ -226,6 +259,19 @@ pub fn simulate(
     v0: &[f64],
     opts: &SimOptions,
     inputs: Inputs,
+    progress: Option<Progress>,
+) -> Result<Trajectory> {
+    simulate_with(m, q0, v0, opts, inputs, Formulation::Aba, progress)
+}
+
+/// `simulate` with a choice of the formulation that computes the accelerations.
+pub fn simulate_with(
+    m: &Model,
+    q0: &[f64],
+    v0: &[f64],
+    opts: &SimOptions,
+    inputs: Inputs,
+    formulation: Formulation,
     mut progress: Option<Progress>,
 ) -> Result<Trajectory> {
     let mut qbuf = Vec::new();
@@ -255,6 +301,7 @@ pub fn simulate(
         }
     };
     let mut st = Stepper::new(m, inputs, tab.stages())?;
+    st.formulation = formulation;
     let expected = match opts.method {
         Method::Rk4 => (opts.t_final / opts.dt).round() as usize / opts.record_every + 2,
         Method::Rk45 { .. } => (opts.t_final / opts.dt).ceil() as usize + 2,

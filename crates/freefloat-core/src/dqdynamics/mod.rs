@@ -1,0 +1,14 @@
+//! Dual-quaternion multibody dynamics (seed 003, Ch. 5–6): accelerations and every joint's reaction wrench
+//! from one linear system solved through the Schur complement of the body block. Cross-checked against the
+//! engine's ABA (accelerations) and RNEA (transmitted wrenches) in tests/dqdynamics.rs.
+
+mod condition;
+pub mod decoupled;
+pub mod joints;
+mod sixvec;
+mod system;
+mod tree_solve;
+
+pub use condition::condition_number;
+pub use sixvec::{ad_in, ad_out, reduce};
+pub use system::{dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, DqDynamics, Solver};

@@ -1,0 +1,475 @@
+//! Assembly and solution of the dual-quaternion Newton–Euler system (seed 003, §6.3, (6.17)–(6.27)).
+//!
+//! Unknowns: every body's CoM-frame twist rate `ẏ_i` and every joint's reduced reaction `W̃_j`. With
+//! `G_ij` the map from joint j's reduced wrench to the wrench on body i at its CoM (6.20), the body rows are
+//! `M_i (ẏ_i)^s = B1_i + Σ_j G_ij W̃_j` ((2.56) with (6.22)) and the joint rows (6.16) are
+//! `Σ_i G_ijᵀ (ẏ_i)^s = B2_j`; we take the constraint selector `Λ_j = V_jᵀ P_swap` (the symmetric variant,
+//! digest §2.5), which makes `S21 = G_physᵀ P_swap` because `Ad_inᵀ P_swap = P_swap Ad_out` (power is frame
+//! invariant). Eliminating `ẏ` (Schur complement on S11, (6.24)–(6.27)) leaves
+//!   `K W̃ = B2 − Σ_i G_iᵀ M_i⁻¹ B1_i`,  `K = Σ_i G_iᵀ M_i⁻¹ G_i = −S21 S11⁻¹ S12`,
+//! K symmetric positive definite (the Delassus matrix), solved by Cholesky. K has a block for every pair of
+//! joints sharing a body; eliminating joints from the leaves up creates no fill-in (the joint graph of a
+//! tree is chordal), see `solve_tree`.
+
+use super::joints::{alignment, motion_slots, slots, swapped};
+use super::sixvec::{ad_in, ad_out, cross6, minv, swap6, M6};
+use super::tree_solve::{solve_spd, solve_tree};
+use crate::dualquat::kinematics::joint_pose;
+use crate::dualquat::pose::translation;
+use crate::dualquat::{DualInertia, DualQuat};
+use crate::error::{FfError, Result};
+use crate::model::{JointType, Model};
+use crate::spatial::{Force, V3, V6};
+use nalgebra::{DMatrix, DVector};
+
+/// Result of `dq_dynamics`.
+#[derive(Clone, Debug, Default)]
+pub struct DqDynamics {
+    /// Generalized accelerations (nv), the engine's convention.
+    pub ddq: Vec<f64>,
+    /// Per body: the total wrench its joint transmits onto it (reaction + actuation), child body frame,
+    /// about the body origin — the engine's RNEA `f_i`.
+    pub joint_wrenches: Vec<Force>,
+    /// Per body: the constraint (reaction) part alone, `V_j W̃_j` (for a locked joint: all but the actuated
+    /// slots; for a free base: zero), same frame.
+    pub reactions: Vec<Force>,
+    /// Per body: for locked joints, the generalized force the joint must supply (zero elsewhere), nv.
+    pub locked_forces: Vec<f64>,
+    /// System dual momentum (2.53) about the inertial origin, inertial axes: [linear; angular].
+    pub momentum: Force,
+    /// System kinetic energy (2.54).
+    pub kinetic_energy: f64,
+}
+
+pub(super) struct Joint {
+    pub(super) body: usize,
+    pub(super) parent: usize,
+    /// offset of W̃_j in the unknown vector, and its slots
+    pub(super) off: usize,
+    pub(super) reaction: &'static [usize],
+    pub(super) locked: bool,
+    /// q_{J/B} of the child body
+    pub(super) align: DualQuat,
+    /// `G` of the distal (child) and proximal (parent) body, 6 × r (first r columns used)
+    pub(super) g_dist: M6,
+    pub(super) g_prox: M6,
+    pub(super) ad_out_oj: M6,
+    pub(super) ad_in_jo: M6,
+    /// joint twist ω^j (6.13) and `x = q*_{j/o_k} ω_k q_{j/o_k}`
+    pub(super) twist: V6,
+    pub(super) parent_twist_in_j: V6,
+    /// actuation wrench in J (zero if locked)
+    pub(super) act: V6,
+    /// prescribed J-frame twist rate `ω̇_pres` of a locked joint (6.28); locking uses zero
+    pub(super) presc: V6,
+}
+
+/// Forward dynamics and joint wrenches by the dual-quaternion formulation for a tree with a free or fixed
+/// base and revolute, prismatic, spherical and fixed joints. `locked[i]` (per body, optional) holds joint i
+/// at zero joint acceleration (§6.4); its entry of `tau` is ignored and the force it needs is returned.
+/// `fext`: nbodies × 6 body-frame wrenches [force; torque about the body origin], as in the engine.
+pub fn dq_dynamics(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+) -> Result<DqDynamics> {
+    dq_dynamics_with(m, q, v, tau, fext, locked, Solver::Tree)
+}
+
+/// How the Delassus system `K W̃ = rhs` is solved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Solver {
+    /// Assemble the R×R matrix and factor it densely (O(R³)): the thesis' (6.27) as written.
+    Dense,
+    /// Block elimination from the leaves up with no fill-in (O(number of bodies) for bounded fan-out).
+    Tree,
+}
+
+/// `dq_dynamics` with a choice of solver (the two agree to round-off; `Dense` is the reference).
+pub fn dq_dynamics_with(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+    solver: Solver,
+) -> Result<DqDynamics> {
+    solve_system(m, q, v, tau, fext, locked, None, solver, None)
+}
+
+/// Hybrid dynamics in the dual-quaternion formulation (§6.4 with the corrected recipe of digest §2.6): the
+/// joints flagged in `prescribed` (per body) follow the accelerations `ddq` (their entries of the nv-vector),
+/// the others respond to `tau`; `locked_forces` returns what the prescribed joints need. The engine's
+/// `hybrid_aba` with the same arguments gives the same result.
+pub fn dq_hybrid_dynamics(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    prescribed: &[bool],
+    ddq: &[f64],
+) -> Result<DqDynamics> {
+    crate::error::check_vec("ddq", ddq, m.nv)?;
+    solve_system(m, q, v, tau, fext, Some(prescribed), Some(ddq), Solver::Tree, None)
+}
+
+#[allow(clippy::too_many_arguments)]
+pub(super) fn solve_system(
+    m: &Model,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+    presc_ddq: Option<&[f64]>,
+    solver: Solver,
+    cond_out: Option<&mut f64>,
+) -> Result<DqDynamics> {
+    let n = m.nbodies();
+    let mut qbuf = Vec::new();
+    let q = m.checked_q(q, &mut qbuf)?;
+    crate::error::check_vec("v", v, m.nv)?;
+    crate::error::check_vec("tau", tau, m.nv)?;
+    if let Some(f) = fext {
+        crate::error::check_vec("fext", f, 6 * n)?;
+    }
+    if let Some(l) = locked {
+        if l.len() != n {
+            return Err(FfError::arg("locked", format!("expected {n} flags (one per joint), got {}", l.len())));
+        }
+    }
+    let is_locked = |i: usize| locked.map(|l| l[i]).unwrap_or(false);
+    let root_fixed = match m.joint_types[0] {
+        JointType::Free => false,
+        JointType::FixedBase => true,
+        other => {
+            return Err(FfError::Model(format!(
+                "dq_dynamics supports a free or fixed base, not a {} base",
+                other.name()
+            )))
+        }
+    };
+    if is_locked(0) {
+        return Err(FfError::arg("locked", "the base joint cannot be locked (lock the joints of the arm)"));
+    }
+    // Which bodies carry unknowns: all but a fixed root.
+    let dynamic = |i: usize| !(i == 0 && root_fixed);
+
+    // Mass properties in each body's CoM frame o_i (axes of the body frame B_i).
+    let mut inert = Vec::with_capacity(n);
+    let mut iinv = Vec::with_capacity(n);
+    let mut com = Vec::with_capacity(n);
+    for i in 0..n {
+        let inr = &m.inertias[i];
+        com.push(if inr.mass > 0.0 { inr.com() } else { V3::zeros() });
+        if !dynamic(i) {
+            inert.push(None);
+            iinv.push(nalgebra::Matrix3::zeros());
+            continue;
+        }
+        let di = DualInertia::from_inertia(inr).map_err(|e| {
+            FfError::Model(format!(
+                "body '{}' cannot enter the dual-quaternion formulation, which needs H(M)⁻¹ for every moving body: {e}",
+                m.body_names[i]
+            ))
+        })?;
+        iinv.push(di.i_com_inverse());
+        inert.push(Some(di));
+    }
+
+    // Kinematics in dual-quaternion form: poses (3.43), CoM twists via (2.43).
+    let mut local = Vec::with_capacity(n); // q_{B_i/B_p}
+    let mut pose = Vec::with_capacity(n); // q_{B_i/I}
+    let mut tw_b: Vec<V6> = Vec::with_capacity(n);
+    for i in 0..n {
+        let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
+        let l = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+        // joint twist S q̇ in B_i as [ω; v]
+        let mut sj = V6::zeros();
+        let s = &m.subspaces[i];
+        for c in 0..m.nvs[i] {
+            let x = v[m.idx_v[i] + c];
+            for r in 0..3 {
+                sj[r] += s[(r + 3, c)] * x;
+                sj[r + 3] += s[(r, c)] * x;
+            }
+        }
+        let (p, t) = match m.parents[i] {
+            Some(p) => (pose[p], ad_in(&l) * tw_b[p] + sj),
+            None => (DualQuat::ONE, sj),
+        };
+        pose.push(p.mul(&l));
+        tw_b.push(t);
+        local.push(l);
+    }
+    let to_com: Vec<DualQuat> = com.iter().map(translation).collect(); // q_{o_i/B_i}
+    let tw_o: Vec<V6> = (0..n).map(|i| ad_in(&to_com[i]) * tw_b[i]).collect();
+
+    // Body right-hand sides B1 (6.22): −ω × (M ω^s) + gravity + external + actuation.
+    let mut b1 = vec![V6::zeros(); n];
+    for i in 0..n {
+        let w = &tw_o[i];
+        if let Some(mi) = &inert[i] {
+            let h = mi.apply(&crate::dualquat::DualQuat::vector(
+                &w.fixed_rows::<3>(3).into_owned(),
+                &w.fixed_rows::<3>(0).into_owned(),
+            ));
+            b1[i] -= cross6(w, &V6::new(h.r.v.x, h.r.v.y, h.r.v.z, h.d.v.x, h.d.v.y, h.d.v.z));
+        }
+        // gravity m g at the CoM, o_i coordinates
+        let g = pose[i].r.conj().rotate(&m.gravity) * m.inertias[i].mass;
+        b1[i] += V6::new(g.x, g.y, g.z, 0.0, 0.0, 0.0);
+        if let Some(f) = fext {
+            let fe = &f[6 * i..6 * i + 6];
+            b1[i] += ad_in(&to_com[i]) * V6::from_column_slice(fe);
+        }
+    }
+    if !root_fixed {
+        // free-base actuation: a wrench on the base at its origin, base axes
+        b1[0] += ad_in(&to_com[0]) * V6::from_column_slice(&tau[0..6]);
+    }
+
+    // Joints.
+    let mut joints: Vec<Joint> = Vec::with_capacity(n.saturating_sub(1));
+    let mut r_total = 0;
+    for i in 1..n {
+        let Some(k) = m.parents[i] else {
+            return Err(FfError::Model(format!(
+                "body '{}' has no parent; dq_dynamics needs one root",
+                m.body_names[i]
+            )));
+        };
+        let kind = m.joint_types[i];
+        let lk = is_locked(i);
+        let sl = slots(kind, lk);
+        let align = alignment(kind, &m.axes[i]);
+        let q_jo = to_com[k].conj().mul(&local[i]).mul(&align); // q_{j/o_k}
+        let q_oj = align.conj().mul(&to_com[i]); // q_{o_i/j}
+        let (ad_out_oj, ad_in_oj) = (ad_out(&q_oj), ad_in(&q_oj));
+        let (ad_in_jo, ad_out_jo) = (ad_in(&q_jo), ad_out(&q_jo));
+        let mut g_dist = M6::zeros();
+        let mut g_prox = M6::zeros();
+        for (c, &s) in sl.reaction.iter().enumerate() {
+            g_dist.set_column(c, &ad_in_oj.column(s));
+            g_prox.set_column(c, &(-ad_out_jo.column(s)));
+        }
+        // joint twist (6.13) and the parent twist seen in J
+        let parent_twist_in_j = ad_in_jo * tw_o[k];
+        let twist = ad_out_oj * tw_o[i] - parent_twist_in_j;
+        // actuation (Table 6.3): the swaps of the motion slots carry tau
+        let mut act = V6::zeros();
+        if !lk {
+            for (c, &s) in motion_slots(kind).iter().enumerate() {
+                act[swapped(s)] = tau[m.idx_v[i] + c];
+            }
+            b1[i] += ad_in_oj * act;
+            b1[k] -= ad_out_jo * act;
+        }
+        // prescribed joint-frame twist rate ω̇_pres (6.28): the prescribed accelerations on the motion slots
+        let mut presc = V6::zeros();
+        if let (true, Some(a)) = (lk, presc_ddq) {
+            for (c, &s) in motion_slots(kind).iter().enumerate() {
+                presc[s] = a[m.idx_v[i] + c];
+            }
+        }
+        joints.push(Joint {
+            body: i,
+            parent: k,
+            off: r_total,
+            reaction: sl.reaction,
+            locked: lk,
+            align,
+            g_dist,
+            g_prox,
+            ad_out_oj,
+            ad_in_jo,
+            twist,
+            parent_twist_in_j,
+            act,
+            presc,
+        });
+        r_total += sl.reaction.len();
+    }
+
+    if let Some(c) = cond_out {
+        *c = super::condition::full_system_condition(&joints, &inert, n, r_total);
+    }
+
+    // B2 (6.23): Λ_j ((q* ω_k q) × ω^j) + Λ_j ω̇_pres, with Λ_j = V_jᵀ P_swap.
+    let mut rhs = DVector::zeros(r_total);
+    for j in &joints {
+        let c = cross6(&j.parent_twist_in_j, &j.twist) + j.presc;
+        for (r, &s) in j.reaction.iter().enumerate() {
+            rhs[j.off + r] = c[swapped(s)];
+        }
+    }
+    // rhs −= Σ_i G_ijᵀ M_i⁻¹ B1_i
+    let mb1: Vec<V6> = (0..n)
+        .map(|i| match &inert[i] {
+            Some(mi) => minv(mi, &iinv[i], &b1[i]),
+            None => V6::zeros(),
+        })
+        .collect();
+    for j in &joints {
+        let r = j.reaction.len();
+        for c in 0..r {
+            let mut x = j.g_dist.column(c).dot(&mb1[j.body]);
+            if dynamic(j.parent) {
+                x += j.g_prox.column(c).dot(&mb1[j.parent]);
+            }
+            rhs[j.off + c] -= x;
+        }
+    }
+
+    // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i as 6×6 blocks (each reduced reaction padded to 6 by the zero
+    // columns of its G), one set per body over the joints incident to it: its distal joint first, then its
+    // children. Block (b, a) of body i is `blocks[start[i] + b·L_i + a]`.
+    let mut inc: Vec<Vec<usize>> = vec![Vec::new(); n];
+    for (jj, j) in joints.iter().enumerate() {
+        inc[j.body].push(jj);
+        if dynamic(j.parent) {
+            inc[j.parent].push(jj);
+        }
+    }
+    let mut start = Vec::with_capacity(n);
+    let mut blocks: Vec<M6> = Vec::new();
+    let mut mg: Vec<M6> = Vec::new();
+    for i in 0..n {
+        start.push(blocks.len());
+        let Some(mi) = &inert[i] else { continue };
+        let g_of = |jj: usize| if joints[jj].body == i { &joints[jj].g_dist } else { &joints[jj].g_prox };
+        mg.clear();
+        for &ja in &inc[i] {
+            // M⁻¹ G = [G_top / m; Ī⁻¹ G_bottom]
+            let g = g_of(ja);
+            let mut x = *g / mi.mass();
+            x.fixed_rows_mut::<3>(3).copy_from(&(iinv[i] * g.fixed_rows::<3>(3)));
+            mg.push(x);
+        }
+        for &jb in &inc[i] {
+            let gt = g_of(jb).transpose();
+            for x in &mg {
+                blocks.push(gt * x);
+            }
+        }
+    }
+    let mut rhs6: Vec<V6> = joints
+        .iter()
+        .map(|j| {
+            let mut x = V6::zeros();
+            for c in 0..j.reaction.len() {
+                x[c] = rhs[j.off + c];
+            }
+            x
+        })
+        .collect();
+    let sol = match solver {
+        Solver::Dense => {
+            let mut kmat = DMatrix::zeros(r_total, r_total);
+            for i in 0..n {
+                let l = inc[i].len();
+                for (pb, &jb) in inc[i].iter().enumerate() {
+                    for (pa, &ja) in inc[i].iter().enumerate() {
+                        let (ra, rb) = (joints[ja].reaction.len(), joints[jb].reaction.len());
+                        let blk = blocks[start[i] + pb * l + pa].view((0, 0), (rb, ra)).clone_owned();
+                        let mut dst = kmat.view_mut((joints[jb].off, joints[ja].off), (rb, ra));
+                        dst += blk;
+                    }
+                }
+            }
+            solve_spd(kmat, rhs)?
+        }
+        Solver::Tree => {
+            let x = solve_tree(&joints, &inc, &start, &mut blocks, &mut rhs6)?;
+            let mut out = DVector::zeros(r_total);
+            for (j, xj) in joints.iter().zip(&x) {
+                for c in 0..j.reaction.len() {
+                    out[j.off + c] = xj[c];
+                }
+            }
+            out
+        }
+    };
+
+    // Body accelerations: (ẏ_i)^s = M_i⁻¹ (B1_i + Σ G W̃).
+    let mut net = b1.clone();
+    for j in &joints {
+        let w = DVector::from_iterator(j.reaction.len(), (0..j.reaction.len()).map(|c| sol[j.off + c]));
+        for c in 0..j.reaction.len() {
+            net[j.body] += j.g_dist.column(c) * w[c];
+            net[j.parent] += j.g_prox.column(c) * w[c];
+        }
+    }
+    let ydot: Vec<V6> = (0..n)
+        .map(|i| match &inert[i] {
+            Some(mi) => swap6(&minv(mi, &iinv[i], &net[i])),
+            None => V6::zeros(),
+        })
+        .collect();
+
+    // Generalized accelerations.
+    // (2.53) and (2.54) from the CoM poses q_{o_i/I} and twists
+    let mut h = DualQuat::ZERO;
+    let mut ke = 0.0;
+    for i in 0..n {
+        if let Some(mi) = &inert[i] {
+            let w =
+                DualQuat::vector(&tw_o[i].fixed_rows::<3>(0).into_owned(), &tw_o[i].fixed_rows::<3>(3).into_owned());
+            h = h + pose[i].mul(&to_com[i]).shift_out(&mi.momentum(&w));
+            ke += mi.kinetic_energy(&w);
+        }
+    }
+    let mut out = DqDynamics {
+        ddq: vec![0.0; m.nv],
+        joint_wrenches: vec![Force::ZERO; n],
+        reactions: vec![Force::ZERO; n],
+        locked_forces: vec![0.0; m.nv],
+        momentum: Force::new(h.r.v, h.d.v),
+        kinetic_energy: ke,
+    };
+    if !root_fixed {
+        // base: ẏ_0 = [ω̇; v̇_o], v_o = v_b + ω × c ⇒ v̇_b = v̇_o − ω̇ × c (c constant in the body)
+        let wd = ydot[0].fixed_rows::<3>(0).into_owned();
+        let vd = ydot[0].fixed_rows::<3>(3).into_owned() - wd.cross(&com[0]);
+        out.ddq[0..3].copy_from_slice(vd.as_slice());
+        out.ddq[3..6].copy_from_slice(wd.as_slice());
+        out.joint_wrenches[0] = Force::from_slice(&tau[0..6]);
+    } else {
+        // the ground's wrench on a fixed root: everything else on it, negated (its ẏ is zero)
+        let w = -net[0];
+        out.joint_wrenches[0] = Force::from_v6(&(ad_out(&to_com[0]) * w));
+        out.reactions[0] = out.joint_wrenches[0];
+    }
+    for j in &joints {
+        let i = j.body;
+        let k = j.parent;
+        // (6.15): ω̇^j = q_{o_i/j} ẏ_i q*_{o_i/j} − q*_{j/o_k} ẏ_k q_{j/o_k} − (q* ω_k q) × ω^j
+        let wdot = j.ad_out_oj * ydot[i] - j.ad_in_jo * ydot[k] - cross6(&j.parent_twist_in_j, &j.twist);
+        for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
+            out.ddq[m.idx_v[i] + c] = if j.locked { j.presc[s] } else { wdot[s] };
+        }
+        // wrenches in J, then in the child body frame (rotation only, same origin); our wrench 6-vector
+        // [f; τ] is the engine's Force [force; moment]
+        let mut react = V6::zeros();
+        for (c, &s) in j.reaction.iter().enumerate() {
+            react[s] = sol[j.off + c];
+        }
+        let total = react + j.act;
+        let ad = ad_out(&j.align);
+        out.joint_wrenches[i] = Force::from_v6(&(ad * total));
+        let mut pure = react;
+        if j.locked {
+            for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
+                out.locked_forces[m.idx_v[i] + c] = react[swapped(s)];
+                pure[swapped(s)] = 0.0;
+            }
+        }
+        out.reactions[i] = Force::from_v6(&(ad * pure));
+    }
+    Ok(out)
+}

@@ -1,0 +1,67 @@
+//! External dual forces on an Earth-orbiting body (seed 003, §2.3.3, (2.61)–(2.68)) and the relative pose
+//! (error) dynamics (2.58). All wrenches are `f + ετ` about the body's CoM in body coordinates. Units are the
+//! caller's: with `MU_EARTH` in km³/s², positions are in km.
+
+use super::dual_quaternion::DualQuat;
+use super::inertia::DualInertia;
+use crate::spatial::V3;
+
+/// Earth's gravitational parameter μ [km³/s²] (seed 003, after (2.62)).
+pub const MU_EARTH: f64 = 398600.4418;
+/// Earth's J2 coefficient and equatorial radius [km] (after (2.64)).
+pub const J2_EARTH: f64 = 0.0010826267;
+pub const RE_EARTH: f64 = 6378.137;
+
+/// (2.62)/(2.65): `f_g = M ⋆ (a_g + ε0) = m a_g + ε0`, `a_g = −μ r/‖r‖³`, r = r^B_{B/I} (body coordinates).
+pub fn gravity(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
+    let a = -r_b * (mu / r_b.norm().powi(3));
+    m.apply(&DualQuat::vector(&a, &V3::zeros()))
+}
+
+/// Gravity gradient, the thesis' "new" form (2.67): `3μ/‖r‖⁵ (r̂)^s × (M ⋆ r̂)` with `r̂ = 0 + ε r`.
+/// Equals `0 + ε 3μ r × (Ī r)/‖r‖⁵` (2.63).
+pub fn gravity_gradient(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
+    let rd = DualQuat::vector(&V3::zeros(), r_b);
+    rd.swap().cross(&m.apply(&rd)).scale(3.0 * mu / r_b.norm().powi(5))
+}
+
+/// Gravity gradient, the "old" form of [50] (2.68): `3μ/‖r‖⁵ r̂ × (M ⋆ r̂^s)` with `r̂ = r + ε0`.
+pub fn gravity_gradient_old(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
+    let rr = DualQuat::vector(r_b, &V3::zeros());
+    rr.cross(&m.apply(&rr.swap())).scale(3.0 * mu / r_b.norm().powi(5))
+}
+
+/// J2 acceleration (2.64) in inertial coordinates for the inertial position `r_i`.
+pub fn j2_acceleration(r_i: &V3, mu: f64, j2: f64, re: f64) -> V3 {
+    let r = r_i.norm();
+    let z2 = (r_i.z / r).powi(2);
+    let k = -1.5 * mu * j2 * re * re / r.powi(4);
+    V3::new(k * (1.0 - 5.0 * z2) * r_i.x / r, k * (1.0 - 5.0 * z2) * r_i.y / r, k * (3.0 - 5.0 * z2) * r_i.z / r)
+}
+
+/// (2.66): `f_J2 = M ⋆ (a_J2^B + ε0)` with `a_J2^B = q_{B/I}* a_J2^I q_{B/I}` (the rotation the text implies).
+pub fn j2(m: &DualInertia, q_bi: &DualQuat, r_i: &V3, mu: f64, j2: f64, re: f64) -> DualQuat {
+    let a_b = q_bi.r.conj().rotate(&j2_acceleration(r_i, mu, j2, re));
+    m.apply(&DualQuat::vector(&a_b, &V3::zeros()))
+}
+
+/// Relative pose dynamics (2.58): the body-frame rate of the error twist `ω^B_{B/D}`, given the error pose
+/// `q_{B/D}`, the desired frame's twist `ω^D_{D/I}` and its rate (both in D), and the net dual force `f^B`:
+/// `M(ω̇_{B/D})^s = f − (ω_{B/D} + ω^B_{D/I}) × M((ω_{B/D})^s + (ω^B_{D/I})^s) − M(q* ω̇^D_{D/I} q)^s
+///  − M(ω^B_{D/I} × ω_{B/D})^s`, with `ω^B_{D/I} = q* ω^D_{D/I} q`.
+pub fn pose_error_acceleration(
+    m: &DualInertia,
+    q_bd: &DualQuat,
+    w_bd: &DualQuat,
+    w_di_d: &DualQuat,
+    wdot_di_d: &DualQuat,
+    f_b: &DualQuat,
+) -> DualQuat {
+    let w_di = q_bd.shift_in(w_di_d);
+    let total = *w_bd + w_di;
+    let rhs = *f_b
+        - total.cross(&(m.momentum(w_bd) + m.momentum(&w_di)))
+        - m.apply(&q_bd.shift_in(wdot_di_d).swap())
+        - m.apply(&w_di.cross(w_bd).swap());
+    m.solve_swapped(&rhs)
+}
