@@ -38,7 +38,7 @@ from .identify import IdentificationResult, identify_minimal
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Trajectory", "models", "dq", "online", "simulate", "telemetry", "trajectories", "excitation", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
+    "Model", "Trajectory", "models", "dq", "online", "reactions", "simulate", "telemetry", "trajectories", "excitation", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
     "aba", "rnea", "crba", "hybrid_dynamics", "dq_dynamics",
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",

@@ -23,6 +23,17 @@ def tqdm_bar(total: int, desc: str):
     return tqdm(total=total, desc=desc, leave=False)
 
 
+def torque_options(m: Model, torques: str, amplitude: float) -> dict:
+    """`simulate` keyword arguments for the --torques option: 'zero', 'sine' or a .npy/.csv table (T, nv)."""
+    if torques == "zero":
+        return {}
+    if torques == "sine":
+        return {"torques": sine_torques(m, amplitude)}
+    p = Path(torques)
+    table = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, delimiter=",", ndmin=2)
+    return {"torques": table, "hold": "zoh"}
+
+
 def _scenario(name: str) -> Path:
     """A file shipped in the repository's scenarios/ directory (next to the package source)."""
     p = Path(__file__).resolve().parents[2] / "scenarios" / name
@@ -176,13 +187,7 @@ def simulate_cmd(model, base, t_final, dt, method, rtol, atol, torques, amplitud
     m = load_model(model, base)
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
-    kw = {}
-    if torques == "sine":
-        kw["torques"] = sine_torques(m, amplitude)
-    elif torques != "zero":
-        p = Path(torques)
-        table = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, delimiter=",", ndmin=2)
-        kw.update(torques=table, hold="zoh")
+    kw = torque_options(m, torques, amplitude)
     t0 = time.perf_counter()
     traj = simulate(m, q, v, t_final, dt, method=method, rtol=rtol, atol=atol, record_every=record_every, progress=True,
                     formulation=formulation, **kw)
@@ -211,13 +216,7 @@ def reactions_cmd(model, base, t_final, dt, torques, amplitude, record_every, ou
     from . import reactions as rx
 
     m = load_model(model, base)
-    kw = {}
-    if torques == "sine":
-        kw["torques"] = sine_torques(m, amplitude)
-    elif torques != "zero":
-        p = Path(torques)
-        table = np.load(p) if p.suffix == ".npy" else np.loadtxt(p, delimiter=",", ndmin=2)
-        kw.update(torques=table, hold="zoh")
+    kw = torque_options(m, torques, amplitude)
     traj = simulate(m, m.neutral(), np.zeros(m.nv), t_final, dt, record_every=record_every, progress=True, **kw)
     r = rx.along(m, traj)
     click.echo(f"{m.name}: {t_final} s, {len(r.t)} samples; dq vs ABA accelerations agree to {r.max_acceleration_mismatch:.1e}")

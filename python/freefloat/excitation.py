@@ -305,43 +305,17 @@ class ExcitationDesign:
     # -- the three steps ----------------------------------------------------------------------------------
     def optimize(self, directions, x0=None, maxiter: int = 100, progress=None) -> StepResult:
         """SLSQP over the 2n seeds on log C with forward-difference gradients (one batched Rust call each)."""
-        from scipy.optimize import minimize
-
         dirs = np.asarray(directions)
         x0 = self.feasible_start(dirs, x0)
         A, b = self.linear_constraints(dirs)
-        cache = {}
-        count = [0]
-
-        def fun_and_grad(x):
-            key = x.tobytes()
-            if key not in cache:
-                h = 1e-6 * np.maximum(1.0, np.abs(x))
-                X = np.vstack([x, x + np.diag(h)])
-                r = self.evaluate(X, dirs)
-                count[0] += len(X)
-                f = _log_objective(r["objective"])
-                cache.clear()
-                cache[key] = (f[0], (f[1:] - f[0]) / h, r)
-            return cache[key]
-
-        it = [0]
-
-        def callback(xk):
-            it[0] += 1
-            if progress is not None:
-                progress(it[0], float(np.exp(fun_and_grad(xk)[0])))
-
-        res = minimize(lambda x: fun_and_grad(x)[0], x0, jac=lambda x: fun_and_grad(x)[1], method="SLSQP",
-                       bounds=self.bounds(), constraints=[{"type": "ineq", "fun": lambda x: A @ x - b, "jac": lambda x: A}],
-                       options={"maxiter": maxiter, "ftol": 1e-9}, callback=callback)
+        res, count = _slsqp(lambda X: self.evaluate(X, dirs), x0, A, b, self.bounds(), maxiter, progress)
         x = np.asarray(res.x, dtype=float)
         # SLSQP may end a hair outside a bound: put the result back inside before reporting it.
         lo, hi = np.array(self.bounds()).T
         x = self.feasible_start(dirs, np.clip(x, lo, hi))
         r = self.evaluate(x, dirs)
         return StepResult(x=x, objective=float(r["objective"][0]), condition_number=float(r["condition_number"][0]),
-                          mean_square=float(r["mean_square"][0]), iterations=int(res.nit), evaluations=count[0],
+                          mean_square=float(r["mean_square"][0]), iterations=int(res.nit), evaluations=count,
                           message=str(res.message), significant=significant(r["singular_values"][0], DELTA))
 
     def prune(self, x, directions=None, u_max: int = U_MAX, delta: float = DELTA, min_gain: float = MIN_GAIN) -> PruneResult:
@@ -390,8 +364,6 @@ class ExcitationDesign:
         """Optimise a 5-term Fourier series per arm joint (11 variables each, 5.5× the cycloid's 2) on the same
         objective (eq. 32) over the same duration; limits enforced on `grid` time points (linear in the
         coefficients).  Returns (StepResult with x = coefficients, trajectory)."""
-        from scipy.optimize import minimize
-
         dirs = np.asarray(directions)
         n, k = self.n_arm, 2 * n_terms + 1
         duration = len(dirs) * self.interval
@@ -424,38 +396,16 @@ class ExcitationDesign:
             c0[j, 1 + hs] = amp(hs)
             c0[j, 1 + n_terms + hc] = amp(hc)
         t = self._grid(len(dirs))
-        cache = {}
 
-        def fun_and_grad(x):
-            key = x.tobytes()
-            if key not in cache:
-                h = 1e-6 * np.maximum(1.0, np.abs(x))
-                X = np.vstack([x, x + np.diag(h)])
-                Q, QD = [], []
-                for xx in X:
-                    q, qd, _ = self.fourier(xx, dirs, n_terms).evaluate(t)
-                    Q.append(q)
-                    QD.append(qd)
-                r = self._objective(np.array(Q), np.array(QD))
-                f = _log_objective(r["objective"])
-                cache.clear()
-                cache[key] = (f[0], (f[1:] - f[0]) / h, r)
-            return cache[key]
+        def evaluate(X):
+            paths = [self.fourier(xx, dirs, n_terms).evaluate(t)[:2] for xx in X]
+            return self._objective(np.array([p[0] for p in paths]), np.array([p[1] for p in paths]))
 
-        it = [0]
-
-        def callback(xk):
-            it[0] += 1
-            if progress is not None:
-                progress(it[0], float(np.exp(fun_and_grad(xk)[0])))
-
-        res = minimize(lambda x: fun_and_grad(x)[0], c0.ravel(), jac=lambda x: fun_and_grad(x)[1], method="SLSQP",
-                       constraints=[{"type": "ineq", "fun": lambda x: A @ x - b, "jac": lambda x: A}],
-                       options={"maxiter": maxiter, "ftol": 1e-9}, callback=callback)
+        res, count = _slsqp(evaluate, c0.ravel(), A, b, None, maxiter, progress)
         x = np.asarray(res.x)
-        r = fun_and_grad(x)[2]
+        r = evaluate(x[None])
         step = StepResult(x=x, objective=float(r["objective"][0]), condition_number=float(r["condition_number"][0]),
-                          mean_square=float(r["mean_square"][0]), iterations=int(res.nit), evaluations=0,
+                          mean_square=float(r["mean_square"][0]), iterations=int(res.nit), evaluations=count,
                           message=str(res.message), significant=significant(r["singular_values"][0], DELTA))
         return step, self.fourier(x, dirs, n_terms)
 
@@ -476,6 +426,36 @@ class ExcitationDesign:
         finally:
             if bar is not None:
                 bar.close()
+
+
+def _slsqp(evaluate, x0, A, b, bounds, maxiter: int, progress):
+    """SLSQP on log C (eq. 32) under A x >= b and `bounds`. `evaluate(X)` takes a batch of points; the value and
+    its forward-difference gradient (steps 1e-6 relative) come from one batched call per point, cached so
+    SLSQP's separate value and gradient requests cost one call. Returns (scipy result, evaluations)."""
+    from scipy.optimize import minimize
+
+    cache, count, it = {}, [0], [0]
+
+    def fun_and_grad(x):
+        key = x.tobytes()
+        if key not in cache:
+            h = 1e-6 * np.maximum(1.0, np.abs(x))
+            X = np.vstack([x, x + np.diag(h)])
+            f = _log_objective(evaluate(X)["objective"])
+            count[0] += len(X)
+            cache.clear()
+            cache[key] = (f[0], (f[1:] - f[0]) / h)
+        return cache[key]
+
+    def callback(xk):
+        it[0] += 1
+        if progress is not None:
+            progress(it[0], float(np.exp(fun_and_grad(xk)[0])))
+
+    res = minimize(lambda x: fun_and_grad(x)[0], x0, jac=lambda x: fun_and_grad(x)[1], method="SLSQP", bounds=bounds,
+                   constraints=[{"type": "ineq", "fun": lambda x: A @ x - b, "jac": lambda x: A}],
+                   options={"maxiter": maxiter, "ftol": 1e-9}, callback=callback)
+    return res, count[0]
 
 
 def _log_objective(c):

@@ -23,6 +23,16 @@ fn paths_arg(obj: Arr, name: &str, n: usize) -> PyResult<(Vec<f64>, usize, usize
     Ok((data, b, s))
 }
 
+/// Angles and rates of B paths, checked to have the same shape: (q, qd, B, S).
+fn path_pair(q: Arr, qd: Arr, n: usize) -> PyResult<(Vec<f64>, Vec<f64>, usize, usize)> {
+    let (qa, b, s) = paths_arg(q, "q", n)?;
+    let (qda, b2, s2) = paths_arg(qd, "qd", n)?;
+    if (b, s) != (b2, s2) {
+        return Err(input_err(format!("arguments `q`, `qd`: shapes differ ({b}×{s} and {b2}×{s2} samples)")));
+    }
+    Ok((qa, qda, b, s))
+}
+
 /// Evaluate seed 001 eq. (32) for B joint paths at once (worker threads, GIL released).
 /// q (B, S, n) / qd: driven joints' angles and rates on a grid of `step` seconds; iq, iv: their q and v
 /// indices; q0 (nq,): start configuration (base pose, other joints); rows at grid points offset + k·stride;
@@ -52,11 +62,7 @@ pub fn excitation_objective<'py>(
     let model = mb.get();
     let m = &model.inner;
     let n = iq.len();
-    let (qa, b, s) = paths_arg(q, "q", n)?;
-    let (qda, b2, s2) = paths_arg(qd, "qd", n)?;
-    if (b, s) != (b2, s2) {
-        return Err(input_err("arguments `q`, `qd`: shapes differ"));
-    }
+    let (qa, qda, b, s) = path_pair(q, qd, n)?;
     if columns.is_empty() {
         return Err(input_err("argument `columns`: no regressor columns"));
     }
@@ -105,9 +111,8 @@ pub fn excitation_rows_py<'py>(
     let model = mb.get();
     let m = &model.inner;
     let n = iq.len();
-    let (qa, b, s) = paths_arg(q, "q", n)?;
-    let (qda, b2, s2) = paths_arg(qd, "qd", n)?;
-    if b != 1 || (b, s) != (b2, s2) {
+    let (qa, qda, b, _) = path_pair(q, qd, n)?;
+    if b != 1 {
         return Err(input_err("arguments `q`, `qd`: expected one path, (S, n) each"));
     }
     let path = JointPath { step, iq: &iq, iv: &iv, q: &qa, qd: &qda };
