@@ -489,9 +489,9 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
               help="Relative decrease of the condition number that counts as an improvement in the pruning "
                    "(default 0.01; 0 is Algorithm 1 as printed, which keeps nearly every interval).")
 @click.option("--maxiter", type=int, default=100, show_default=True, help="SQP iterations per optimisation step.")
-@click.option("--q-limit", type=float, default=270.0, show_default=True, help="Arm joint position limit ±[deg].")
-@click.option("--rate-limit", type=float, default=5.0265, show_default=True, help="Arm joint rate limit [rad/s] (1.6π).")
-@click.option("--acc-limit", type=float, default=15.791, show_default=True, help="Arm joint acceleration limit [rad/s²] (1.6π²).")
+@click.option("--q-limit", type=float, default=None, help="Arm joint position limit ±[deg] (default 270).")
+@click.option("--rate-limit", type=float, default=None, help="Arm joint rate limit [rad/s] (default 1.6π ≈ 5.03).")
+@click.option("--acc-limit", type=float, default=None, help="Arm joint acceleration limit [rad/s²] (default 1.6π² ≈ 15.79).")
 @click.option("--compare/--no-compare", default=False, show_default=True,
               help="Then simulate MODEL along the designed trajectory, along the same number of un-designed intervals "
                    "and along the un-pruned step-1 trajectory, with the paper's noise, and compare identification errors.")
@@ -514,8 +514,13 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
     m = load_model(model)
     g = m if guess is None else load_model(guess)
     n_arm = len(g.joints_tagged("arm_"))
-    limits = exc.Limits(np.full(n_arm, -np.deg2rad(q_limit)), np.full(n_arm, np.deg2rad(q_limit)),
-                        np.full(n_arm, rate_limit), np.full(n_arm, acc_limit))
+    limits = exc.Limits.seed001(n_arm)  # the documented defaults, overridden option by option
+    if q_limit is not None:
+        limits.q_min, limits.q_max = np.full(n_arm, -np.deg2rad(q_limit)), np.full(n_arm, np.deg2rad(q_limit))
+    if rate_limit is not None:
+        limits.qd_max = np.full(n_arm, rate_limit)
+    if acc_limit is not None:
+        limits.qdd_max = np.full(n_arm, acc_limit)
     kw = {} if weight is None else {"weight": weight}
     design = exc.ExcitationDesign(g, limits=limits, **kw)
     click.echo(f"designing an exciting trajectory for {m.name} (guess: {g.name}): {design.n_arm} arm joints, "
