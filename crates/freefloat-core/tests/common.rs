@@ -36,7 +36,8 @@ pub fn random_model(r: &mut StdRng, base: JointType, n: usize, gravity: bool) ->
     if gravity {
         b.set_gravity(V3::new(0.3, -1.2, -9.81));
     }
-    let kinds = [JointType::Revolute, JointType::Prismatic, JointType::Spherical, JointType::Fixed];
+    let kinds =
+        [JointType::Revolute, JointType::Prismatic, JointType::Spherical, JointType::Cylindrical, JointType::Fixed];
     for i in 1..=n {
         let parent = r.gen_range(0..i);
         let kind = kinds[r.gen_range(0..kinds.len())];

@@ -22,6 +22,8 @@ fn thesis_slots(kind: JointType) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
         JointType::Revolute => (vec![1, 2, 3, 5, 6], vec![1, 2, 5, 6, 7], vec![7]), // V = E158ᵀ, Λ = E145
         JointType::Prismatic => (vec![1, 2, 5, 6, 7], vec![1, 2, 3, 5, 6], vec![3]), // V = E145ᵀ, Λ = E158
         JointType::Spherical => (vec![1, 2, 3], vec![5, 6, 7], vec![5, 6, 7]),      // V = E15678ᵀ, Λ = E12345
+        // cylindrical (not in Table 6.2): the revolute and prismatic reactions intersected; q = [θ, d]
+        JointType::Cylindrical => (vec![1, 2, 5, 6], vec![1, 2, 5, 6], vec![7, 3]),
         _ => (vec![1, 2, 3, 5, 6, 7], vec![1, 2, 3, 5, 6, 7], vec![]),
     }
 }

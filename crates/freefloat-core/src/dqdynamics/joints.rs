@@ -22,7 +22,8 @@ const ALL: &[usize] = &[0, 1, 2, 3, 4, 5];
 
 /// R: reaction `[f_x, f_y, f_z, τ_x, τ_y]` (V = E₁₅₈ᵀ), free `ω_z`. P: reaction `[f_x, f_y, τ_x, τ_y, τ_z]`
 /// (V = E₁₄₅ᵀ), free `v_z`. S: reaction `[f_x, f_y, f_z]` (V = E₁₅₆₇₈ᵀ), free `ω`. Fixed, or any locked
-/// joint: all six slots are reactions (the locking recipe of §6.4 with the full wrench unknown).
+/// joint: all six slots are reactions. C (cylindrical, not in the thesis' tables): reaction
+/// `[f_x, f_y, τ_x, τ_y]`, free `ω_z` and `v_z` — the revolute and prismatic selectors intersected. (the locking recipe of §6.4 with the full wrench unknown).
 pub fn slots(kind: JointType, locked: bool) -> JointSlots {
     if locked {
         return JointSlots { reaction: ALL };
@@ -31,25 +32,29 @@ pub fn slots(kind: JointType, locked: bool) -> JointSlots {
         JointType::Revolute => JointSlots { reaction: &[0, 1, 2, 3, 4] },
         JointType::Prismatic => JointSlots { reaction: &[0, 1, 3, 4, 5] },
         JointType::Spherical => JointSlots { reaction: &[0, 1, 2] },
+        JointType::Cylindrical => JointSlots { reaction: &[0, 1, 3, 4] },
         _ => JointSlots { reaction: ALL },
     }
 }
 
-/// Twist slots along which joint `kind` moves (whatever locking): where `S q̇` lands in J_j.
+/// Twist slots along which joint `kind` moves (whatever locking): where `S q̇` lands in J_j, in the
+/// order of the joint's velocity coordinates (cylindrical: θ̇ then ḋ).
 pub fn motion_slots(kind: JointType) -> &'static [usize] {
     match kind {
         JointType::Revolute => &[2],
         JointType::Prismatic => &[5],
         JointType::Spherical => &[0, 1, 2],
+        JointType::Cylindrical => &[2, 5],
         _ => &[],
     }
 }
 
-/// `q_{J/B}`: the rotation taking the child body frame's z-axis onto the joint axis (revolute, prismatic),
+/// `q_{J/B}`: the rotation taking the child body frame's z-axis onto the joint axis (revolute, prismatic,
+/// cylindrical),
 /// identity otherwise. For a spherical joint J = B, so J-frame angular rates are the engine's `v`.
 pub fn alignment(kind: JointType, axis: &V3) -> DualQuat {
     match kind {
-        JointType::Revolute | JointType::Prismatic => rotation(&z_to(axis)),
+        JointType::Revolute | JointType::Prismatic | JointType::Cylindrical => rotation(&z_to(axis)),
         _ => DualQuat::ONE,
     }
 }

@@ -23,6 +23,8 @@ pub fn joint_pose(kind: JointType, axis: &V3, q: &[f64]) -> Result<DualQuat> {
     Ok(match kind {
         JointType::Revolute => rotation(&Quat::from_axis_angle(axis, q[0])),
         JointType::Prismatic => translation(&(axis * q[0])),
+        // rotation and translation along one axis commute
+        JointType::Cylindrical => translation(&(axis * q[1])).mul(&rotation(&Quat::from_axis_angle(axis, q[0]))),
         JointType::Spherical => rotation(&Quat::new(q[3], q[0], q[1], q[2])),
         JointType::Free => DualQuat::from_pose_xyzw(&[q[3], q[4], q[5], q[6]], &V3::new(q[0], q[1], q[2])),
         JointType::Planar => {
@@ -88,6 +90,8 @@ impl ProductOfExponentials {
             JointType::Revolute => screw_exp(qi[0], 0.0, &self.axes[i], &p.cross(&self.axes[i])),
             // θ = 0: exp(½ d (0 + ε ℓ)) (digest §5); the moment does not enter.
             JointType::Prismatic => screw_exp(0.0, qi[0], &self.axes[i], &V3::zeros()),
+            // a general screw (3.10): rotation θ and translation d along the same line
+            JointType::Cylindrical => screw_exp(qi[0], qi[1], &self.axes[i], &p.cross(&self.axes[i])),
             JointType::Spherical => {
                 let s = screw_log(&rotation(&Quat::new(qi[3], qi[0], qi[1], qi[2])))?;
                 let l = self.home[i].r.rotate(&s.l);

@@ -18,6 +18,10 @@ pub enum JointType {
     Prismatic,
     /// Ball joint: q = quat xyzw of the child relative to the joint frame, v = angular velocity (child frame).
     Spherical,
+    /// Rotation about and translation along the same axis: q = v = [θ, d] (child frame). Its motion
+    /// subspace [[0, a]; [a, 0]] is constant in the child frame because `a` is invariant under the
+    /// rotation about itself (Featherstone, RBDA Table 4.1, "cylindrical").
+    Cylindrical,
     Fixed,
 }
 
@@ -27,6 +31,7 @@ impl JointType {
             JointType::Free => 7,
             JointType::Planar => 3,
             JointType::Spherical => 4,
+            JointType::Cylindrical => 2,
             JointType::Revolute | JointType::Prismatic => 1,
             JointType::FixedBase | JointType::Fixed => 0,
         }
@@ -35,6 +40,7 @@ impl JointType {
         match self {
             JointType::Free => 6,
             JointType::Planar | JointType::Spherical => 3,
+            JointType::Cylindrical => 2,
             JointType::Revolute | JointType::Prismatic => 1,
             JointType::FixedBase | JointType::Fixed => 0,
         }
@@ -51,6 +57,7 @@ impl JointType {
             JointType::Revolute => "revolute",
             JointType::Prismatic => "prismatic",
             JointType::Spherical => "spherical",
+            JointType::Cylindrical => "cylindrical",
             JointType::Fixed => "fixed",
         }
     }
@@ -67,9 +74,14 @@ impl JointType {
             "revolute" | "continuous" => Some(JointType::Revolute),
             "prismatic" => Some(JointType::Prismatic),
             "spherical" | "ball" => Some(JointType::Spherical),
+            "cylindrical" => Some(JointType::Cylindrical),
             "fixed" => Some(JointType::Fixed),
             _ => None,
         }
+    }
+    /// Whether the joint is defined by a unit axis (which the model builder normalises).
+    pub fn has_axis(self) -> bool {
+        matches!(self, JointType::Revolute | JointType::Prismatic | JointType::Cylindrical)
     }
     /// Whether the joint's q holds a quaternion that must stay unit (its offset inside the joint's q).
     pub fn quaternion_offset(self) -> Option<usize> {
@@ -97,6 +109,11 @@ impl JointType {
             }
             JointType::Revolute => s.fixed_view_mut::<3, 1>(3, 0).copy_from(axis),
             JointType::Prismatic => s.fixed_view_mut::<3, 1>(0, 0).copy_from(axis),
+            JointType::Cylindrical => {
+                // column 0: rotation θ about a; column 1: translation d along a (q order)
+                s.fixed_view_mut::<3, 1>(3, 0).copy_from(axis);
+                s.fixed_view_mut::<3, 1>(0, 1).copy_from(axis);
+            }
             JointType::FixedBase | JointType::Fixed => {}
         }
         s
@@ -109,6 +126,8 @@ impl JointType {
         match self {
             JointType::Revolute => Se3::new(rotation_about_axis(axis, q[0]), V3::zeros()),
             JointType::Prismatic => Se3::new(M3::identity(), axis * q[0]),
+            // Rotation and translation along one axis commute, so their order does not matter.
+            JointType::Cylindrical => Se3::new(rotation_about_axis(axis, q[0]), axis * q[1]),
             JointType::Free => Se3::new(rot_from_quat(&q[3..7]), V3::new(q[0], q[1], q[2])),
             JointType::Planar => {
                 let (s, c) = q[2].sin_cos();

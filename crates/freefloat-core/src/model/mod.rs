@@ -46,7 +46,7 @@ pub struct Model {
     /// Parent body of each body; `None` for the base (body 0). Always `parents[i] < i`.
     pub parents: Vec<Option<usize>>,
     pub joint_types: Vec<JointType>,
-    /// Joint axis in the joint frame (unit; meaningful for revolute/prismatic only).
+    /// Joint axis in the joint frame (unit; meaningful for revolute/prismatic/cylindrical only).
     pub axes: Vec<V3>,
     /// Rest placement of each joint frame in its parent body frame (the base: in the inertial frame).
     pub placements: Vec<Se3>,
@@ -138,7 +138,7 @@ impl ModelBuilder {
             )));
         }
         let mut axis = b.axis;
-        if matches!(b.joint_type, JointType::Revolute | JointType::Prismatic) {
+        if b.joint_type.has_axis() {
             let n = axis.norm();
             if !(n > 1e-12) || !n.is_finite() {
                 return Err(FfError::Model(format!(
