@@ -213,6 +213,7 @@ def test_generator_covers_every_feature():
     needed = ["base:free", "base:planar", "base:fixed", "gravity:zero", "gravity:nonzero", "angles:rad",
               "angles:deg", "omit_base_key", "omit_gravity_key", "non_depth_first_order", "many_bodies", "frames",
               "form:com", "form:origin", "form:params", "joint:revolute", "joint:prismatic", "joint:spherical",
+              "joint:cylindrical",
               "joint:fixed", "default_joint_name", "mdh", "mdh+origin", "omitted_axis", "scaled_axis", "limits",
               "fixed_on_fixed", "moving_under_fixed", "welded_to_fixed_base", "frame_on_fixed_body"]
     missing = [k for k in needed if seen[k] == 0]
@@ -252,7 +253,8 @@ def test_layout_maps(seed):
             assert moved.size and set(moved) <= set(range(qs.start, qs.stop)), (i, k, dq)
     # our neutral configuration is Pinocchio's neutral
     q0 = np.concatenate([{"free": [0, 0, 0, 0, 0, 0, 1], "planar": [0, 0, 0], "spherical": [0, 0, 0, 1],
-                          "revolute": [0], "prismatic": [0], "fixed": []}[b.joint_type] for b in d.bodies]).astype(float)
+                          "revolute": [0], "prismatic": [0], "cylindrical": [0, 0],
+                          "fixed": []}[b.joint_type] for b in d.bodies]).astype(float)
     assert_close(p.q_to_pin(q0), pin.neutral(p.model), rtol=0, atol=0, what="neutral")
 
 

@@ -54,6 +54,9 @@ def reaction_part(model, W: np.ndarray) -> np.ndarray:
             R[..., i, 3:] -= np.einsum("...k,k->...", R[..., i, 3:], a)[..., None] * a
         elif kind == "prismatic":
             R[..., i, :3] -= np.einsum("...k,k->...", R[..., i, :3], a)[..., None] * a
+        elif kind == "cylindrical":  # actuated: the force along and the torque about the axis
+            R[..., i, :3] -= np.einsum("...k,k->...", R[..., i, :3], a)[..., None] * a
+            R[..., i, 3:] -= np.einsum("...k,k->...", R[..., i, 3:], a)[..., None] * a
         elif kind == "spherical":
             R[..., i, 3:] = 0.0
     return R

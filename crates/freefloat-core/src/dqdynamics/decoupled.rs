@@ -122,6 +122,14 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
             // free rotation about and translation along a: both constraints projected off the axis
             JointType::Cylindrical => (e.to_vec(), e.to_vec()),
             JointType::Fixed => (all.clone(), all.clone()),
+            // its blocked rotation direction turns with θ2: not derived for this formulation
+            JointType::Universal => {
+                return Err(FfError::Model(format!(
+                    "joint '{}': the decoupled formulation does not support universal joints; use the \
+                     dual-quaternion formulation (formulation=\"dq\")",
+                    m.joint_names[i]
+                )))
+            }
             other => return Err(FfError::Model(format!("joint type {} is not supported", other.name()))),
         };
         let len = bf.len() + bt.len();

@@ -13,7 +13,8 @@ use crate::spatial::V3;
 
 /// Relative pose of a joint's child frame in its rest frame, `q_{i/i0}(Γ)` (digest §2.2 table), for the
 /// engine's joint coordinates `q` (length nq). Quaternions are used as given (normalise them first).
-pub fn joint_pose(kind: JointType, axis: &V3, q: &[f64]) -> Result<DualQuat> {
+/// `axis2` is a universal joint's second axis (ignored by the other joints).
+pub fn joint_pose(kind: JointType, axis: &V3, axis2: &V3, q: &[f64]) -> Result<DualQuat> {
     if q.len() != kind.nq() {
         return Err(FfError::arg(
             "q",
@@ -30,6 +31,8 @@ pub fn joint_pose(kind: JointType, axis: &V3, q: &[f64]) -> Result<DualQuat> {
         JointType::Planar => {
             translation(&V3::new(q[0], q[1], 0.0)).mul(&rotation(&Quat::from_axis_angle(&V3::z(), q[2])))
         }
+        // R(a1, θ1) R(a2, θ2): the second rotation about the intermediate frame's axis
+        JointType::Universal => rotation(&Quat::from_axis_angle(axis, q[0]).mul(&Quat::from_axis_angle(axis2, q[1]))),
         JointType::Fixed | JointType::FixedBase => DualQuat::ONE,
     })
 }
@@ -41,7 +44,8 @@ pub fn body_poses(m: &Model, q: &[f64]) -> Result<Vec<DualQuat>> {
     let mut out: Vec<DualQuat> = Vec::with_capacity(m.nbodies());
     for i in 0..m.nbodies() {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
-        let local = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+        let local =
+            DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], &m.axes2[i], qi)?);
         let pose = match m.parents[i] {
             Some(p) => out[p].mul(&local),
             None => local,
@@ -119,7 +123,12 @@ impl ProductOfExponentials {
             let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
             match m.parents[i] {
                 None => {
-                    root = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+                    root = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(
+                        m.joint_types[i],
+                        &m.axes[i],
+                        &m.axes2[i],
+                        qi,
+                    )?);
                     out[i] = root;
                 }
                 Some(p) => {

@@ -1,7 +1,7 @@
 use super::gravity_acceleration;
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::forward_kinematics;
+use crate::kinematics::{forward_kinematics, joint_bias};
 use crate::model::Model;
 use crate::spatial::{Force, Motion, M6, V6};
 use nalgebra::Matrix3;
@@ -49,7 +49,7 @@ pub fn hybrid_aba(
         let iv = m.idx_v[i];
         let mut vj = Motion::ZERO;
         for c in 0..k {
-            let s = omi.act_motion(&Motion::from_v6(&m.subspaces[i].column(c).into_owned()));
+            let s = omi.act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
             d.os[i].set_column(c, &s.to_v6());
             vj += s * v[iv + c];
         }
@@ -58,8 +58,8 @@ pub fn hybrid_aba(
             None => vj,
         };
         d.ov[i] = vi;
-        // d/dt(oS q̇) with S fixed in the body: v × (oS q̇).
-        d.oc[i] = vi.cross_motion(&vj);
+        // d/dt(oS q̇) = v × (oS q̇) + o(Ṡ q̇); the second term is non-zero for universal joints only.
+        d.oc[i] = vi.cross_motion(&vj) + omi.act_motion(&joint_bias(m, d, i, v));
         let oi = m.inertias[i].transformed(&omi);
         d.ia[i] = oi.to_matrix();
         let hi = oi.mul_motion(&vi);
