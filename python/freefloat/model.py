@@ -75,6 +75,8 @@ class Model:
     nqs = property(lambda self: self._core.nqs)
     nvs = property(lambda self: self._core.nvs)
     joint_axes = property(lambda self: self._core.joint_axes)
+    joint_axes2 = property(lambda self: self._core.joint_axes2,
+                           doc="Second axis of each universal joint (intermediate frame); z for other joints.")
     placements = property(lambda self: self._core.placements, doc="(nbodies, 4, 4) rest placement of each joint frame in its parent.")
     limits = property(lambda self: self._core.limits)
     tags = property(lambda self: self._core.tags)

@@ -68,7 +68,7 @@ pub struct ProductOfExponentials {
 }
 
 impl ProductOfExponentials {
-    /// Revolute, prismatic, spherical and fixed joints below a free, planar or fixed root.
+    /// Revolute, prismatic, spherical, cylindrical, universal and fixed joints below a free, planar or fixed root.
     pub fn new(m: &Model) -> Result<ProductOfExponentials> {
         let n = m.nbodies();
         let mut home = vec![DualQuat::ONE; n];
@@ -100,6 +100,17 @@ impl ProductOfExponentials {
                 let s = screw_log(&rotation(&Quat::new(qi[3], qi[0], qi[1], qi[2])))?;
                 let l = self.home[i].r.rotate(&s.l);
                 screw_exp(s.theta, 0.0, &l, &p.cross(&l))
+            }
+            // two screws through the joint origin: a1 (home), then a2 — at home the intermediate frame is the
+            // joint frame, so a2's home line is fixed too and (3.19)'s product applies factor by factor
+            JointType::Universal => {
+                let l2 = self.home[i].r.rotate(&m.axes2[i]);
+                screw_exp(qi[0], 0.0, &self.axes[i], &p.cross(&self.axes[i])).mul(&screw_exp(
+                    qi[1],
+                    0.0,
+                    &l2,
+                    &p.cross(&l2),
+                ))
             }
             JointType::Fixed => DualQuat::ONE,
             other => {
