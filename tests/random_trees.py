@@ -31,9 +31,11 @@ import numpy as np
 TREE_SEEDS = tuple(range(60))
 
 BASE_TYPES = ("free", "planar", "fixed")
-JOINT_TYPES = ("revolute", "prismatic", "spherical", "fixed")
-JOINT_NQ = {"free": 7, "planar": 3, "fixed": 0, "revolute": 1, "prismatic": 1, "spherical": 4}
-JOINT_NV = {"free": 6, "planar": 3, "fixed": 0, "revolute": 1, "prismatic": 1, "spherical": 3}
+JOINT_TYPES = ("revolute", "prismatic", "spherical", "cylindrical", "universal", "fixed")
+JOINT_NQ = {"free": 7, "planar": 3, "fixed": 0, "revolute": 1, "prismatic": 1, "spherical": 4, "cylindrical": 2,
+            "universal": 2}
+JOINT_NV = {"free": 6, "planar": 3, "fixed": 0, "revolute": 1, "prismatic": 1, "spherical": 3, "cylindrical": 2,
+            "universal": 2}
 INERTIAL_FORMS = ("com", "origin", "params")
 
 
@@ -154,13 +156,14 @@ def yaml_list(values) -> str:
 class Body:
     name: str
     parent: int                      # -1 for the base
-    joint_type: str                  # base: free|planar|fixed; others: revolute|prismatic|spherical|fixed
+    joint_type: str                  # base: free|planar|fixed; others: revolute|prismatic|spherical|cylindrical|universal|fixed
     mass: float
     com: np.ndarray                  # (3,) body frame
     inertia_com: np.ndarray          # (3,3) about the CoM, body axes
     inertial_form: str = "com"       # which YAML form renders the inertia (all three must load the same)
     joint_name: str | None = None    # None: rely on the documented default "<body>_joint"
-    axis: np.ndarray | None = None   # unit axis (revolute/prismatic)
+    axis: np.ndarray | None = None   # unit axis (revolute/prismatic/cylindrical; universal: the first)
+    axis2: np.ndarray | None = None  # universal: second axis (intermediate frame), orthogonal to `axis`
     axis_scale: float = 1.0          # the YAML file holds axis * scale; the loader must normalise it
     omit_axis: bool = False          # render without `axis:` (documented default z; used with mdh rows)
     origin_xyz: np.ndarray | None = None   # None: no `origin` key (identity)
@@ -269,6 +272,10 @@ class TreeDescription:
                 parts.append([rng.uniform(-1.0, 1.0)])
             elif t == "spherical":
                 parts.append(random_unit_quaternion(rng))
+            elif t == "cylindrical":
+                parts.append([rng.uniform(-math.pi, math.pi), rng.uniform(-1.0, 1.0)])
+            elif t == "universal":
+                parts.append(rng.uniform(-math.pi, math.pi, 2))
         return np.concatenate(parts) if parts else np.zeros(0)
 
     def random_v(self, rng, scale=1.0) -> np.ndarray:
@@ -292,6 +299,10 @@ class TreeDescription:
             return homogeneous(p=b.axis * qi[0])
         if t == "spherical":
             return homogeneous(quat_to_matrix(qi))
+        if t == "cylindrical":  # q = [angle about the axis, slide along it]
+            return homogeneous(axis_angle_matrix(b.axis, qi[0]), b.axis * qi[1])
+        if t == "universal":  # first about axis, then about axis2 of the intermediate frame
+            return homogeneous(axis_angle_matrix(b.axis, qi[0]) @ axis_angle_matrix(b.axis2, qi[1]))
         return np.eye(4)  # fixed
 
     def body_placements(self, q) -> list[np.ndarray]:
@@ -352,6 +363,8 @@ class TreeDescription:
                 lines.append(f"      type: {b.joint_type}")
                 if b.axis is not None and not b.omit_axis:
                     lines.append(f"      axis: {yaml_list(b.axis * b.axis_scale)}")
+                if b.axis2 is not None:
+                    lines.append(f"      axis2: {yaml_list(b.axis2 * b.axis_scale)}")
                 if b.limits is not None:
                     lim = b.limits
                     conv = self._angle if b.joint_type == "revolute" else yaml_float
@@ -397,8 +410,8 @@ class TreeDescription:
                 f'    </inertial>\n  </link>')
             if b.parent < 0:
                 continue
-            if b.joint_type == "spherical":
-                raise ValueError("URDF has no spherical joint")
+            if b.joint_type in ("spherical", "cylindrical", "universal"):
+                raise ValueError(f"URDF has no {b.joint_type} joint")
             T = b.rest_placement()
             jtype = b.joint_type
             if jtype == "revolute" and b.limits is None and rng.random() < 0.5:
@@ -452,7 +465,7 @@ def random_axis(rng):
 
 
 def random_tree(rng, name="random_tree", n_children=None, base=None, gravity=None,
-                joint_types=JOINT_TYPES, joint_p=(0.4, 0.2, 0.2, 0.2)) -> TreeDescription:
+                joint_types=JOINT_TYPES, joint_p=(0.3, 0.15, 0.1, 0.1, 0.15, 0.2)) -> TreeDescription:
     """A random tree: random base type, 1-20 child joints, random placements, inertias and parents."""
     base = base or str(rng.choice(BASE_TYPES, p=[0.5, 0.25, 0.25]))
     n = int(n_children if n_children is not None else rng.integers(1, 21))
@@ -471,6 +484,17 @@ def random_tree(rng, name="random_tree", n_children=None, base=None, gravity=Non
         b = Body(name=f"b{i}", parent=parent, joint_type=jt, mass=m, com=c, inertia_com=I,
                  inertial_form=str(rng.choice(INERTIAL_FORMS)),
                  joint_name=f"j{i}" if rng.random() < 0.5 else None)
+        if jt in ("cylindrical", "universal"):
+            b.axis = random_axis(rng)
+            if jt == "universal":
+                # orthogonal second axis (a Cardan joint); often a coordinate axis with a coordinate first axis
+                other = random_axis(rng)
+                while abs(other @ b.axis) > 0.95:
+                    other = random_axis(rng)
+                b.axis2 = np.cross(b.axis, other)
+                b.axis2 /= np.linalg.norm(b.axis2)
+            if rng.random() < 0.2:
+                b.axis_scale = float(rng.uniform(0.3, 3.0))
         if jt in ("revolute", "prismatic"):
             b.axis = random_axis(rng)
             if rng.random() < 0.2:
@@ -743,6 +767,15 @@ def build_pinocchio(desc: TreeDescription) -> PinTree:
                     jm = pin.JointModelPrismaticUnaligned(np.array(b.axis, float))
                 elif t == "spherical":
                     jm = pin.JointModelSpherical()
+                elif t == "cylindrical":
+                    # Pinocchio has no cylindrical joint: a composite of a revolute and a prismatic joint on
+                    # the same axis (they commute), q = [angle, slide] as ours, subspace in the child frame
+                    a = np.array(b.axis, float)
+                    jm = pin.JointModelComposite(pin.JointModelRevoluteUnaligned(a))
+                    jm.addJoint(pin.JointModelPrismaticUnaligned(a))
+                elif t == "universal":
+                    # Pinocchio's universal joint: R = R(axis1, q1) R(axis2, q2), q and v as ours
+                    jm = pin.JointModelUniversal(np.array(b.axis, float), np.array(b.axis2, float))
                 else:
                     raise ValueError(f"unknown joint type {t!r}")
                 jid = model.addJoint(pj, jm, X_parent, b.effective_joint_name)

@@ -163,3 +163,24 @@ def test_simulation_bad_input_and_callback_errors():
         ff.simulate(m, q, v, 1.0, 1e-3, torques=lambda t, q, v: np.full(m.nv, np.nan))
     with pytest.raises(ff.InputError, match="strictly"):
         ff.simulate(m, q, v, 1.0, 1e-3, torques=np.zeros((3, m.nv)), torque_times=[0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize("joint, msg", [
+    ("{type: universal, axis: [1, 0, 0]}", "needs `axis2`"),
+    ("{type: universal, axis: [1, 0, 0], axis2: [1, 1, 0]}", "must be orthogonal"),
+    ("{type: universal, axis: [1, 0, 0], axis2: [0, 0, 0]}", "zero length"),
+    ("{type: revolute, axis: [1, 0, 0], axis2: [0, 1, 0]}", "only meaningful for a universal joint"),
+    ("{type: cylindrical, axis: [0, 0, 0]}", "zero length"),
+])
+def test_cylindrical_and_universal_joint_errors(joint, msg):
+    with pytest.raises(ff.ModelError, match=msg) as e:
+        ff.Model.from_yaml_string(GOOD_YAML.replace("{type: revolute, axis: [0, 0, 1]}", joint))
+    assert "arm" in str(e.value)
+
+
+@pytest.mark.parametrize("joint", ["{type: cylindrical, axis: [0, 0, 1]}",
+                                   "{type: universal, axis: [1, 0, 0], axis2: [0, 1, 0]}"])
+def test_urdf_has_no_cylindrical_or_universal_joint(joint):
+    m = ff.Model.from_yaml_string(GOOD_YAML.replace("{type: revolute, axis: [0, 0, 1]}", joint))
+    with pytest.raises(ff.ModelError, match="URDF has no such joint type"):
+        m.to_urdf()

@@ -82,7 +82,8 @@ def _parse_yaml_model(text):
     ang = (lambda a: math.radians(a)) if deg else (lambda a: a)
     names = [b["name"] for b in doc["bodies"]]
     out = {"base": doc.get("base", "free"), "gravity": np.array(doc.get("gravity", [0.0, 0.0, 0.0]), float),
-           "names": names, "parents": [], "types": [], "axes": [], "placements": [], "params": [], "jnames": []}
+           "names": names, "parents": [], "types": [], "axes": [], "axes2": [], "placements": [], "params": [],
+           "jnames": []}
     for k, b in enumerate(doc["bodies"]):
         inertial = b["inertial"]
         if "params" in inertial:
@@ -101,6 +102,7 @@ def _parse_yaml_model(text):
             out["parents"].append(-1)
             out["types"].append(out["base"])
             out["axes"].append(None)
+            out["axes2"].append(None)
             out["placements"].append(np.eye(4))
             out["jnames"].append(None)
             continue
@@ -108,11 +110,13 @@ def _parse_yaml_model(text):
         out["parents"].append(names.index(b["parent"]))
         out["types"].append(j["type"])
         out["jnames"].append(j.get("name", f"{b['name']}_joint"))
-        if j["type"] in ("revolute", "prismatic"):
+        if j["type"] in ("revolute", "prismatic", "cylindrical", "universal"):
             ax = np.array(j.get("axis", [0.0, 0.0, 1.0]), float)
             out["axes"].append(ax / np.linalg.norm(ax))
         else:
             out["axes"].append(None)
+        ax2 = np.array(j["axis2"], float) if "axis2" in j else None
+        out["axes2"].append(None if ax2 is None else ax2 / np.linalg.norm(ax2))
         T = np.eye(4)
         if "origin" in b:
             o = b["origin"]
@@ -163,6 +167,10 @@ def test_yaml_round_trips_to_the_description(seed):
         assert_close(y["placements"][i], b.rest_placement(), rtol=1e-14, atol=1e-15, what=f"placement of {b.name}")
         if b.axis is not None:
             assert_close(y["axes"][i], b.axis, rtol=1e-15, atol=1e-16, what=f"axis of {b.name}")
+        if b.axis2 is not None:
+            assert_close(y["axes2"][i], b.axis2, rtol=1e-15, atol=1e-16, what=f"axis2 of {b.name}")
+        else:
+            assert y["axes2"][i] is None, f"{b.name}: axis2 rendered for a {b.joint_type} joint"
     for f in d.frames:
         body, T = y["frames"][f.name]
         assert body == f.body
@@ -213,6 +221,7 @@ def test_generator_covers_every_feature():
     needed = ["base:free", "base:planar", "base:fixed", "gravity:zero", "gravity:nonzero", "angles:rad",
               "angles:deg", "omit_base_key", "omit_gravity_key", "non_depth_first_order", "many_bodies", "frames",
               "form:com", "form:origin", "form:params", "joint:revolute", "joint:prismatic", "joint:spherical",
+              "joint:cylindrical", "joint:universal",
               "joint:fixed", "default_joint_name", "mdh", "mdh+origin", "omitted_axis", "scaled_axis", "limits",
               "fixed_on_fixed", "moving_under_fixed", "welded_to_fixed_base", "frame_on_fixed_body"]
     missing = [k for k in needed if seen[k] == 0]
@@ -252,7 +261,8 @@ def test_layout_maps(seed):
             assert moved.size and set(moved) <= set(range(qs.start, qs.stop)), (i, k, dq)
     # our neutral configuration is Pinocchio's neutral
     q0 = np.concatenate([{"free": [0, 0, 0, 0, 0, 0, 1], "planar": [0, 0, 0], "spherical": [0, 0, 0, 1],
-                          "revolute": [0], "prismatic": [0], "fixed": []}[b.joint_type] for b in d.bodies]).astype(float)
+                          "revolute": [0], "prismatic": [0], "cylindrical": [0, 0], "universal": [0, 0],
+                          "fixed": []}[b.joint_type] for b in d.bodies]).astype(float)
     assert_close(p.q_to_pin(q0), pin.neutral(p.model), rtol=0, atol=0, what="neutral")
 
 

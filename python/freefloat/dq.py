@@ -103,7 +103,7 @@ def distance_bound(q, delta: float):
 def body_poses(model, q, method: str = "chain") -> np.ndarray:
     """Pose of every body as dual-quaternion coefficients, (nbodies, 8): ``method="chain"`` multiplies the
     relative poses (3.43), ``"poe"`` uses the product of exponentials (3.19) with screws taken at the neutral
-    configuration (revolute, prismatic, spherical and fixed joints)."""
+    configuration (revolute, prismatic, spherical, cylindrical, universal and fixed joints)."""
     return _core.dq_body_poses(model, q, method)
 
 

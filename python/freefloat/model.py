@@ -75,6 +75,8 @@ class Model:
     nqs = property(lambda self: self._core.nqs)
     nvs = property(lambda self: self._core.nvs)
     joint_axes = property(lambda self: self._core.joint_axes)
+    joint_axes2 = property(lambda self: self._core.joint_axes2,
+                           doc="Second axis of each universal joint (intermediate frame); z for other joints.")
     placements = property(lambda self: self._core.placements, doc="(nbodies, 4, 4) rest placement of each joint frame in its parent.")
     limits = property(lambda self: self._core.limits)
     tags = property(lambda self: self._core.tags)
@@ -117,6 +119,12 @@ class Model:
                 q[s + 2] = rng.uniform(-np.pi, np.pi)
             elif jt == "spherical":
                 q[s:s + 4] = _random_quat(rng)
+            elif jt == "cylindrical":
+                # the model's limits are scalars per joint: they are not applied to 2-coordinate joints
+                q[s] = rng.uniform(-np.pi, np.pi)
+                q[s + 1] = rng.uniform(-position_range, position_range)
+            elif jt == "universal":
+                q[s:s + 2] = rng.uniform(-np.pi, np.pi, 2)
             elif jt in ("revolute", "prismatic"):
                 default = np.pi if jt == "revolute" else position_range
                 a = lo[i] if np.isfinite(lo[i]) else -default
@@ -125,7 +133,8 @@ class Model:
         return q
 
     def q_labels(self) -> list[str]:
-        """A name for every entry of q, e.g. base.x … base.qw, J1, ball.qx …"""
+        """A name for every entry of q, e.g. base.x … base.qw, J1, ball.qx …, cyl.theta, cyl.d, cardan.theta1,
+        cardan.theta2 (the two coordinates of a cylindrical or universal joint name the same thing in q and v)."""
         return self._labels(("x", "y", "z", "qx", "qy", "qz", "qw"), ("x", "y", "yaw"), ("qx", "qy", "qz", "qw"), self.nqs)
 
     def v_labels(self) -> list[str]:
@@ -136,7 +145,8 @@ class Model:
         out = []
         for i, (jt, n) in enumerate(zip(self.joint_types, sizes)):
             owner = self.body_names[0] if i == 0 else self.joint_names[i]
-            parts = {"free": free, "planar": planar, "spherical": spherical}.get(jt) if n > 1 else None
+            parts = {"free": free, "planar": planar, "spherical": spherical,
+                     "cylindrical": ("theta", "d"), "universal": ("theta1", "theta2")}.get(jt) if n > 1 else None
             out += [f"{owner}.{p}" for p in parts] if parts else ([owner] if n == 1 else [])
         return out
 

@@ -7,7 +7,9 @@
 
 Wrenches are [force; torque about the child body origin] in child body axes (see `dq_dynamics`). The
 actuated component is the projection on the joint's motion: the torque along a revolute axis, the force
-along a prismatic axis, the whole torque of a spherical joint; a fixed joint has none.
+along a prismatic axis, both of these for a cylindrical joint, the torque in the plane of a universal
+joint's two axes (which turns with its second angle), the whole torque of a spherical joint; a fixed joint
+has none.
 """
 
 from __future__ import annotations
@@ -40,10 +42,17 @@ class Reactions:
         return out
 
 
-def reaction_part(model, W: np.ndarray) -> np.ndarray:
-    """Remove the actuated components from joint wrenches W (..., nbodies, 6)."""
+def reaction_part(model, W: np.ndarray, q: np.ndarray | None = None) -> np.ndarray:
+    """Remove the actuated components from joint wrenches W (..., nbodies, 6). A universal joint's motion
+    directions depend on the configuration, so models with one need `q` (..., nq) matching W's samples."""
     R = np.array(W, dtype=float, copy=True)
     axes = np.asarray(model.joint_axes, float)
+    if "universal" in model.joint_types:
+        if q is None:
+            raise ValueError("reaction_part: the model has universal joints, whose motion directions depend on q; "
+                             "pass q")
+        q = np.asarray(q, float)
+        axes2 = np.asarray(model.joint_axes2, float)
     for i, kind in enumerate(model.joint_types):
         if model.parents[i] < 0:
             if kind != "fixed":
@@ -54,6 +63,18 @@ def reaction_part(model, W: np.ndarray) -> np.ndarray:
             R[..., i, 3:] -= np.einsum("...k,k->...", R[..., i, 3:], a)[..., None] * a
         elif kind == "prismatic":
             R[..., i, :3] -= np.einsum("...k,k->...", R[..., i, :3], a)[..., None] * a
+        elif kind == "cylindrical":  # actuated: the force along and the torque about the axis
+            R[..., i, :3] -= np.einsum("...k,k->...", R[..., i, :3], a)[..., None] * a
+            R[..., i, 3:] -= np.einsum("...k,k->...", R[..., i, 3:], a)[..., None] * a
+        elif kind == "universal":
+            # torque along R(a2, θ2)ᵀ a1 and along a2 (orthonormal): the two actuated directions
+            a2 = axes2[i] / np.linalg.norm(axes2[i])
+            th = q[..., model.idx_q[i] + 1]
+            c, s = np.cos(th)[..., None], np.sin(th)[..., None]
+            # Rodrigues for R(a2, -θ) a with a ⟂ a2: a cos θ − (a2 × a) sin θ
+            s1 = a * c - np.cross(a2, a) * s
+            R[..., i, 3:] -= np.einsum("...k,...k->...", R[..., i, 3:], s1)[..., None] * s1
+            R[..., i, 3:] -= np.einsum("...k,k->...", R[..., i, 3:], a2)[..., None] * a2
         elif kind == "spherical":
             R[..., i, 3:] = 0.0
     return R
@@ -65,7 +86,7 @@ def along(model, traj, fext=None) -> Reactions:
     scale = max(1.0, float(np.abs(traj.ddq).max())) if traj.ddq.size else 1.0
     mismatch = float(np.abs(a - traj.ddq).max()) / scale if a.size else 0.0
     return Reactions(np.asarray(traj.t), list(model.joint_names), list(model.joint_types), W,
-                     reaction_part(model, W), mismatch)
+                     reaction_part(model, W, traj.q), mismatch)
 
 
 def plot(r: Reactions, path, title: str | None = None):

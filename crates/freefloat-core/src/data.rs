@@ -25,6 +25,9 @@ pub struct Data {
     pub oa: Vec<Motion>,
     pub oc: Vec<Motion>,
     pub of: Vec<Force>,
+    /// Motion subspace of each joint in its child frame at the last `forward_kinematics` call: a copy
+    /// of `Model::subspaces`, whose universal-joint columns forward kinematics refreshes.
+    pub s: Vec<M6>,
     /// Motion subspace of each joint in inertial coordinates (nv columns used; ABA, CRBA).
     pub os: Vec<M6>,
     /// By-products of ABA's first pass: total momentum (about the inertial origin, inertial frame)
@@ -65,6 +68,7 @@ impl Data {
             oa: vec![Motion::ZERO; n],
             oc: vec![Motion::ZERO; n],
             of: vec![Force::ZERO; n],
+            s: m.subspaces.clone(),
             os: vec![M6::zeros(); n],
             aba_momentum: Force::ZERO,
             aba_kinetic_energy: 0.0,

@@ -31,15 +31,32 @@ pub fn random_inertia(r: &mut StdRng) -> Inertia {
     Inertia::from_com(mass, com, ic)
 }
 
+/// Every joint type below the base.
+pub const KINDS: [JointType; 6] = [
+    JointType::Revolute,
+    JointType::Prismatic,
+    JointType::Spherical,
+    JointType::Cylindrical,
+    JointType::Universal,
+    JointType::Fixed,
+];
+
 pub fn random_model(r: &mut StdRng, base: JointType, n: usize, gravity: bool) -> Model {
+    random_model_of(r, base, n, gravity, &KINDS)
+}
+
+/// A random tree whose joints are drawn from `kinds`.
+pub fn random_model_of(r: &mut StdRng, base: JointType, n: usize, gravity: bool, kinds: &[JointType]) -> Model {
     let mut b = ModelBuilder::new("random", "base", base, random_inertia(r)).unwrap();
     if gravity {
         b.set_gravity(V3::new(0.3, -1.2, -9.81));
     }
-    let kinds = [JointType::Revolute, JointType::Prismatic, JointType::Spherical, JointType::Fixed];
     for i in 1..=n {
         let parent = r.gen_range(0..i);
         let kind = kinds[r.gen_range(0..kinds.len())];
+        let axis = unit(r);
+        // a universal joint's second axis: orthogonal to the first (a Cardan joint)
+        let axis2 = axis.cross(&unit(r)).normalize();
         let rpy = V3::new(r.gen_range(-3.0..3.0), r.gen_range(-1.5..1.5), r.gen_range(-3.0..3.0));
         let pl =
             Se3::new(rpy_to_rot(&rpy), V3::new(r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)));
@@ -48,7 +65,8 @@ pub fn random_model(r: &mut StdRng, base: JointType, n: usize, gravity: bool) ->
             parent,
             joint_name: format!("j{i}"),
             joint_type: kind,
-            axis: unit(r),
+            axis,
+            axis2,
             placement: pl,
             inertia: random_inertia(r),
             limits: JointLimits::default(),

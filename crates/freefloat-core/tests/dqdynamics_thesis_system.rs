@@ -8,7 +8,8 @@ mod common;
 
 use common::{random_model, random_q, random_vec, rel_err, rng};
 use freefloat_core::data::Data;
-use freefloat_core::dqdynamics::{dq_dynamics, joints::alignment};
+use freefloat_core::dqdynamics::dq_dynamics;
+use freefloat_core::dqdynamics::joints::{alignment, universal_alignment, universal_frame_rate};
 use freefloat_core::dualquat::pose::{translation, twist_from_motion};
 use freefloat_core::dualquat::{DualInertia, DualQuat, M8};
 use freefloat_core::kinematics::forward_velocities;
@@ -22,6 +23,10 @@ fn thesis_slots(kind: JointType) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
         JointType::Revolute => (vec![1, 2, 3, 5, 6], vec![1, 2, 5, 6, 7], vec![7]), // V = E158ᵀ, Λ = E145
         JointType::Prismatic => (vec![1, 2, 5, 6, 7], vec![1, 2, 3, 5, 6], vec![3]), // V = E145ᵀ, Λ = E158
         JointType::Spherical => (vec![1, 2, 3], vec![5, 6, 7], vec![5, 6, 7]),      // V = E15678ᵀ, Λ = E12345
+        // cylindrical (not in Table 6.2): the revolute and prismatic reactions intersected; q = [θ, d]
+        JointType::Cylindrical => (vec![1, 2, 5, 6], vec![1, 2, 5, 6], vec![7, 3]),
+        // universal (not in Table 6.2), in its turning joint frame: reaction f and τ_z, free ω_x, ω_y
+        JointType::Universal => (vec![1, 2, 3, 7], vec![3, 5, 6, 7], vec![5, 6]),
         _ => (vec![1, 2, 3, 5, 6, 7], vec![1, 2, 3, 5, 6, 7], vec![]),
     }
 }
@@ -54,12 +59,19 @@ fn literal_thesis_system_equals_dq_dynamics() {
         let mut rr = 0;
         for i in 1..n {
             let k = m.parents[i].expect("tree");
-            let al = alignment(m.joint_types[i], &m.axes[i]);
+            let (al, rho) = if m.joint_types[i] == JointType::Universal {
+                let (iq, iv) = (m.idx_q[i], m.idx_v[i]);
+                let r6 = universal_frame_rate(v[iv + 1]);
+                let rho = DualQuat::vector(&nalgebra::Vector3::new(r6[0], r6[1], r6[2]), &nalgebra::Vector3::zeros());
+                (universal_alignment(&m.axes[i], &m.axes2[i], q[iq + 1]), rho)
+            } else {
+                (alignment(m.joint_types[i], &m.axes[i]), DualQuat::ZERO)
+            };
             let q_jo = to_com[k].conj().mul(&DualQuat::from_se3(&d.li_mi[i])).mul(&al);
             let q_oj = al.conj().mul(&to_com[i]);
             let (vs, ls, acts) = thesis_slots(m.joint_types[i]);
             let len = vs.len();
-            js.push((i, k, q_jo, q_oj, vs, ls, acts, rr, al));
+            js.push((i, k, q_jo, q_oj, vs, ls, acts, rr, al, rho));
             rr += len;
         }
         let size = 8 * n + rr;
@@ -78,7 +90,7 @@ fn literal_thesis_system_equals_dq_dynamics() {
         let mut b0 = b.rows(0, 8).clone_owned();
         b0 += wb.to_vec8();
         b.rows_mut(0, 8).copy_from(&b0);
-        for (i, k, q_jo, q_oj, vs, ls, acts, off, _) in &js {
+        for (i, k, q_jo, q_oj, vs, ls, acts, off, _, rho) in &js {
             let (i, k, off) = (*i, *k, *off);
             // (6.20): S12
             let dist = -(q_oj.conj().left_matrix() * q_oj.right_matrix());
@@ -93,7 +105,8 @@ fn literal_thesis_system_equals_dq_dynamics() {
             // (6.23): B2 = Λ (q* ω_k q) × ω^j, with ω^j from (6.13)
             let wk_j = q_jo.shift_in(&w[k]);
             let wj = q_oj.shift_out(&w[i]) - wk_j;
-            let c = wk_j.cross(&wj).to_vec8();
+            // a turning joint frame (universal) adds its rate ρ to the parent twist (see dqdynamics::system)
+            let c = (wk_j + *rho).cross(&wj).to_vec8();
             for (row, &sl) in ls.iter().enumerate() {
                 b[8 * n + off + row] = c[sl];
             }
@@ -126,7 +139,7 @@ fn literal_thesis_system_equals_dq_dynamics() {
         let vb = vo - wd.cross(&com[0]);
         let base = [vb.x, vb.y, vb.z, wd.x, wd.y, wd.z];
         assert!(rel_err(&res.ddq[0..6], &base) < 1e-10, "case {case}");
-        for (i, _k, _q_jo, _q_oj, vs, _ls, acts, off, al) in &js {
+        for (i, _k, _q_jo, _q_oj, vs, _ls, acts, off, al, _) in &js {
             let mut wj = nalgebra::SVector::<f64, 8>::zeros();
             for (c, &sl) in vs.iter().enumerate() {
                 wj[sl] = y[8 * n + off + c];

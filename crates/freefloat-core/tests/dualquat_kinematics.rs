@@ -109,6 +109,7 @@ fn dh_chain_matches_engine_model() {
             joint_name: format!("j{i}"),
             joint_type: JointType::Revolute,
             axis: V3::z(),
+            axis2: V3::z(),
             placement,
             inertia: inr,
             limits: JointLimits::default(),

@@ -164,3 +164,38 @@ fn planar_base_matches_free_base_in_plane() {
     assert!(rel_err(&dp.ddq, &inplane) < 1e-12, "{:?} vs {:?}", dp.ddq, inplane);
     assert!(df.ddq[2].abs() < 1e-12 && df.ddq[3].abs() < 1e-12 && df.ddq[4].abs() < 1e-12);
 }
+
+/// Body accelerations from `forward_accelerations` are the time derivatives of the body twists
+/// (body coordinates), checked by central differences along `q(t) = q + v t + a t²/2`, `v(t) = v + a t`.
+/// This is what catches a missing or wrong joint bias `Ṡ q̇` (universal joints), which ABA, RNEA and
+/// CRBA would otherwise share consistently.
+#[test]
+fn body_accelerations_are_twist_derivatives() {
+    use freefloat_core::kinematics::{forward_accelerations, forward_velocities};
+    use freefloat_core::model::JointType;
+    let mut r = rng(77);
+    let kinds = [JointType::Universal, JointType::Cylindrical, JointType::Revolute, JointType::Prismatic];
+    for trial in 0..20 {
+        // fixed base and scalar-coordinate joints: q is a vector space, so q(t) is exact
+        let m = random_model_of(&mut r, JointType::FixedBase, 2 + trial % 6, false, &kinds);
+        let q = random_q(&m, &mut r);
+        let v = random_vec(m.nv, &mut r);
+        let a = random_vec(m.nv, &mut r);
+        let mut d = Data::new(&m);
+        forward_accelerations(&m, &mut d, &q, &v, &a);
+        let acc = d.a.clone();
+        let h = 1e-5;
+        let twists = |t: f64, d: &mut Data| {
+            let qt: Vec<f64> = (0..m.nq).map(|k| q[k] + v[k] * t + 0.5 * a[k] * t * t).collect();
+            let vt: Vec<f64> = (0..m.nv).map(|k| v[k] + a[k] * t).collect();
+            forward_velocities(&m, d, &qt, &vt);
+            d.v.clone()
+        };
+        let (vp, vm) = (twists(h, &mut d), twists(-h, &mut d));
+        for i in 0..m.nbodies() {
+            let fd = (vp[i].to_v6() - vm[i].to_v6()) / (2.0 * h);
+            let err = (fd - acc[i].to_v6()).amax();
+            assert!(err < 1e-6 * (1.0 + acc[i].to_v6().amax()), "trial {trial}, body {i}: {err:e}");
+        }
+    }
+}

@@ -139,6 +139,12 @@ impl PyModel {
         let v: Vec<f64> = self.inner.axes.iter().flat_map(|a| a.iter().copied().collect::<Vec<_>>()).collect();
         PyArray1::from_vec(py, v).reshape([self.inner.nbodies(), 3])
     }
+    /// Second axes of universal joints (nbodies, 3; intermediate frame); z for every other joint.
+    #[getter]
+    fn joint_axes2<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let v: Vec<f64> = self.inner.axes2.iter().flat_map(|a| a.iter().copied().collect::<Vec<_>>()).collect();
+        PyArray1::from_vec(py, v).reshape([self.inner.nbodies(), 3])
+    }
     /// Rest placement of each joint frame in its parent body, as (nbodies, 4, 4) homogeneous matrices.
     #[getter]
     fn placements<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {

@@ -119,7 +119,17 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
             JointType::Revolute => (all.clone(), e.to_vec()),
             JointType::Spherical => (all.clone(), vec![]),
             JointType::Prismatic => (e.to_vec(), all.clone()),
+            // free rotation about and translation along a: both constraints projected off the axis
+            JointType::Cylindrical => (e.to_vec(), e.to_vec()),
             JointType::Fixed => (all.clone(), all.clone()),
+            // its blocked rotation direction turns with θ2: not derived for this formulation
+            JointType::Universal => {
+                return Err(FfError::Model(format!(
+                    "joint '{}': the decoupled formulation does not support universal joints; use the \
+                     dual-quaternion formulation (formulation=\"dq\")",
+                    m.joint_names[i]
+                )))
+            }
             other => return Err(FfError::Model(format!("joint type {} is not supported", other.name()))),
         };
         let len = bf.len() + bt.len();
@@ -187,6 +197,7 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
             JointType::Revolute => (V3::zeros(), j.a * tau[iv]),
             JointType::Spherical => (V3::zeros(), V3::new(tau[iv], tau[iv + 1], tau[iv + 2])),
             JointType::Prismatic => (j.a * tau[iv], V3::zeros()),
+            JointType::Cylindrical => (j.a * tau[iv + 1], j.a * tau[iv]),
             _ => (V3::zeros(), V3::zeros()),
         };
         add3(&mut b1, od, &fa);
@@ -200,10 +211,15 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
         let (wk, wd, vk, vd) = (w[j.k], w[j.d], vo[j.k], vo[j.d]);
         let ak = rt * j.a;
         let lin_rows: Vec<V3> = match j.kind {
-            JointType::Prismatic => perp(&ak).to_vec(),
+            JointType::Prismatic | JointType::Cylindrical => perp(&ak).to_vec(),
             _ => vec![V3::x(), V3::y(), V3::z()],
         };
-        let sdot = if j.kind == JointType::Prismatic { v[iv] } else { 0.0 };
+        // sliding rate along a (its Coriolis term 2 ω_k × ṡ a enters the linear constraint)
+        let sdot = match j.kind {
+            JointType::Prismatic => v[iv],
+            JointType::Cylindrical => v[iv + 1],
+            _ => 0.0,
+        };
         let lin_rhs = wk.cross(&vk) + wk.cross(&wk.cross(&j.rk)) + wk.cross(&(ak * (2.0 * sdot)))
             - rt * (wd.cross(&vd) + wd.cross(&wd.cross(&j.rd)));
         let mut row = j.off;
@@ -220,7 +236,7 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
             row += 1;
         }
         let ang_rows: Vec<V3> = match j.kind {
-            JointType::Revolute => perp(&j.a).to_vec(),
+            JointType::Revolute | JointType::Cylindrical => perp(&j.a).to_vec(),
             JointType::Spherical => vec![],
             _ => vec![V3::x(), V3::y(), V3::z()],
         };
@@ -293,13 +309,17 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
         match j.kind {
             JointType::Revolute => out.ddq[iv] = j.a.dot(&ang),
             JointType::Spherical => out.ddq[iv..iv + 3].copy_from_slice(ang.as_slice()),
-            JointType::Prismatic => {
+            JointType::Prismatic | JointType::Cylindrical => {
                 // s̈ a = Rᵀ a_point_d − a_point_k − 2 ω_k × ṡ a  (k axes)
                 let (wk, wd) = (w[j.k], w[j.d]);
                 let apd = vdd + wd.cross(&vo[j.d]) + wdd.cross(&j.rd) + wd.cross(&wd.cross(&j.rd));
                 let apk = vdk + wk.cross(&vo[j.k]) + wdk.cross(&j.rk) + wk.cross(&wk.cross(&j.rk));
                 let ak = rt * j.a;
-                out.ddq[iv] = ak.dot(&(rt * apd - apk - wk.cross(&(ak * (2.0 * v[iv])))));
+                let is = if j.kind == JointType::Cylindrical { iv + 1 } else { iv };
+                out.ddq[is] = ak.dot(&(rt * apd - apk - wk.cross(&(ak * (2.0 * v[is])))));
+                if j.kind == JointType::Cylindrical {
+                    out.ddq[iv] = j.a.dot(&ang);
+                }
             }
             _ => {}
         }
@@ -316,6 +336,7 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
             JointType::Revolute => (V3::zeros(), j.a * tau[iv]),
             JointType::Spherical => (V3::zeros(), V3::new(tau[iv], tau[iv + 1], tau[iv + 2])),
             JointType::Prismatic => (j.a * tau[iv], V3::zeros()),
+            JointType::Cylindrical => (j.a * tau[iv + 1], j.a * tau[iv]),
             _ => (V3::zeros(), V3::zeros()),
         };
         out.joint_wrenches[j.d] = Force::new(f + fa, t + ta);

@@ -11,14 +11,14 @@
 //! joints sharing a body; eliminating joints from the leaves up creates no fill-in (the joint graph of a
 //! tree is chordal), see `solve_tree`.
 
-use super::joints::{alignment, motion_slots, slots, swapped};
+use super::joints::{alignment, motion_slots, slots, swapped, universal_alignment, universal_frame_rate};
 use super::sixvec::{ad_in, ad_out, cross6, minv, swap6, M6};
 use super::tree_solve::{solve_spd, solve_tree};
 use crate::dualquat::kinematics::joint_pose;
 use crate::dualquat::pose::translation;
 use crate::dualquat::{DualInertia, DualQuat};
 use crate::error::{FfError, Result};
-use crate::model::{JointType, Model};
+use crate::model::{universal_first_axis, JointType, Model};
 use crate::spatial::{Force, V3, V6};
 use nalgebra::{DMatrix, DVector};
 
@@ -58,6 +58,10 @@ pub(super) struct Joint {
     /// joint twist ω^j (6.13) and `x = q*_{j/o_k} ω_k q_{j/o_k}`
     pub(super) twist: V6,
     pub(super) parent_twist_in_j: V6,
+    /// twist `[ρ; 0]` of J relative to the child body, in J: zero except for a universal joint, whose J turns
+    /// with θ2. Differentiating `ω^j` in a turning J adds `ρ × ω^j` to (6.15)'s `(q* ω_k q) × ω^j` (the
+    /// derivative of `Ad_{J←o}` is `−(twist of J relative to o) × Ad_{J←o}`, applied to both bodies' terms).
+    pub(super) frame_rate: V6,
     /// actuation wrench in J (zero if locked)
     pub(super) act: V6,
     /// prescribed J-frame twist rate `ω̇_pres` of a locked joint (6.28); locking uses zero
@@ -188,10 +192,14 @@ pub(super) fn solve_system(
     let mut tw_b: Vec<V6> = Vec::with_capacity(n);
     for i in 0..n {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
-        let l = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+        let l = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], &m.axes2[i], qi)?);
         // joint twist S q̇ in B_i as [ω; v]
         let mut sj = V6::zeros();
-        let s = &m.subspaces[i];
+        let mut s = m.subspaces[i];
+        if m.joint_types[i] == JointType::Universal {
+            // the first column turns with θ2 (the engine refreshes it in forward kinematics)
+            s.fixed_view_mut::<3, 1>(3, 0).copy_from(&universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]));
+        }
         for c in 0..m.nvs[i] {
             let x = v[m.idx_v[i] + c];
             for r in 0..3 {
@@ -247,7 +255,12 @@ pub(super) fn solve_system(
         let kind = m.joint_types[i];
         let lk = is_locked(i);
         let sl = slots(kind, lk);
-        let align = alignment(kind, &m.axes[i]);
+        let (align, frame_rate) = if kind == JointType::Universal {
+            let iq = m.idx_q[i];
+            (universal_alignment(&m.axes[i], &m.axes2[i], q[iq + 1]), universal_frame_rate(v[m.idx_v[i] + 1]))
+        } else {
+            (alignment(kind, &m.axes[i]), V6::zeros())
+        };
         let q_jo = to_com[k].conj().mul(&local[i]).mul(&align); // q_{j/o_k}
         let q_oj = align.conj().mul(&to_com[i]); // q_{o_i/j}
         let (ad_out_oj, ad_in_oj) = (ad_out(&q_oj), ad_in(&q_oj));
@@ -290,6 +303,7 @@ pub(super) fn solve_system(
             ad_in_jo,
             twist,
             parent_twist_in_j,
+            frame_rate,
             act,
             presc,
         });
@@ -303,7 +317,7 @@ pub(super) fn solve_system(
     // B2 (6.23): Λ_j ((q* ω_k q) × ω^j) + Λ_j ω̇_pres, with Λ_j = V_jᵀ P_swap.
     let mut rhs = DVector::zeros(r_total);
     for j in &joints {
-        let c = cross6(&j.parent_twist_in_j, &j.twist) + j.presc;
+        let c = cross6(&(j.parent_twist_in_j + j.frame_rate), &j.twist) + j.presc;
         for (r, &s) in j.reaction.iter().enumerate() {
             rhs[j.off + r] = c[swapped(s)];
         }
@@ -449,7 +463,8 @@ pub(super) fn solve_system(
         let i = j.body;
         let k = j.parent;
         // (6.15): ω̇^j = q_{o_i/j} ẏ_i q*_{o_i/j} − q*_{j/o_k} ẏ_k q_{j/o_k} − (q* ω_k q) × ω^j
-        let wdot = j.ad_out_oj * ydot[i] - j.ad_in_jo * ydot[k] - cross6(&j.parent_twist_in_j, &j.twist);
+        let wdot =
+            j.ad_out_oj * ydot[i] - j.ad_in_jo * ydot[k] - cross6(&(j.parent_twist_in_j + j.frame_rate), &j.twist);
         for (c, &s) in motion_slots(m.joint_types[i]).iter().enumerate() {
             out.ddq[m.idx_v[i] + c] = if j.locked { j.presc[s] } else { wdot[s] };
         }

@@ -13,7 +13,8 @@ use crate::spatial::V3;
 
 /// Relative pose of a joint's child frame in its rest frame, `q_{i/i0}(Γ)` (digest §2.2 table), for the
 /// engine's joint coordinates `q` (length nq). Quaternions are used as given (normalise them first).
-pub fn joint_pose(kind: JointType, axis: &V3, q: &[f64]) -> Result<DualQuat> {
+/// `axis2` is a universal joint's second axis (ignored by the other joints).
+pub fn joint_pose(kind: JointType, axis: &V3, axis2: &V3, q: &[f64]) -> Result<DualQuat> {
     if q.len() != kind.nq() {
         return Err(FfError::arg(
             "q",
@@ -23,11 +24,15 @@ pub fn joint_pose(kind: JointType, axis: &V3, q: &[f64]) -> Result<DualQuat> {
     Ok(match kind {
         JointType::Revolute => rotation(&Quat::from_axis_angle(axis, q[0])),
         JointType::Prismatic => translation(&(axis * q[0])),
+        // rotation and translation along one axis commute
+        JointType::Cylindrical => translation(&(axis * q[1])).mul(&rotation(&Quat::from_axis_angle(axis, q[0]))),
         JointType::Spherical => rotation(&Quat::new(q[3], q[0], q[1], q[2])),
         JointType::Free => DualQuat::from_pose_xyzw(&[q[3], q[4], q[5], q[6]], &V3::new(q[0], q[1], q[2])),
         JointType::Planar => {
             translation(&V3::new(q[0], q[1], 0.0)).mul(&rotation(&Quat::from_axis_angle(&V3::z(), q[2])))
         }
+        // R(a1, θ1) R(a2, θ2): the second rotation about the intermediate frame's axis
+        JointType::Universal => rotation(&Quat::from_axis_angle(axis, q[0]).mul(&Quat::from_axis_angle(axis2, q[1]))),
         JointType::Fixed | JointType::FixedBase => DualQuat::ONE,
     })
 }
@@ -39,7 +44,8 @@ pub fn body_poses(m: &Model, q: &[f64]) -> Result<Vec<DualQuat>> {
     let mut out: Vec<DualQuat> = Vec::with_capacity(m.nbodies());
     for i in 0..m.nbodies() {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
-        let local = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+        let local =
+            DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], &m.axes2[i], qi)?);
         let pose = match m.parents[i] {
             Some(p) => out[p].mul(&local),
             None => local,
@@ -62,7 +68,7 @@ pub struct ProductOfExponentials {
 }
 
 impl ProductOfExponentials {
-    /// Revolute, prismatic, spherical and fixed joints below a free, planar or fixed root.
+    /// Revolute, prismatic, spherical, cylindrical, universal and fixed joints below a free, planar or fixed root.
     pub fn new(m: &Model) -> Result<ProductOfExponentials> {
         let n = m.nbodies();
         let mut home = vec![DualQuat::ONE; n];
@@ -88,10 +94,23 @@ impl ProductOfExponentials {
             JointType::Revolute => screw_exp(qi[0], 0.0, &self.axes[i], &p.cross(&self.axes[i])),
             // θ = 0: exp(½ d (0 + ε ℓ)) (digest §5); the moment does not enter.
             JointType::Prismatic => screw_exp(0.0, qi[0], &self.axes[i], &V3::zeros()),
+            // a general screw (3.10): rotation θ and translation d along the same line
+            JointType::Cylindrical => screw_exp(qi[0], qi[1], &self.axes[i], &p.cross(&self.axes[i])),
             JointType::Spherical => {
                 let s = screw_log(&rotation(&Quat::new(qi[3], qi[0], qi[1], qi[2])))?;
                 let l = self.home[i].r.rotate(&s.l);
                 screw_exp(s.theta, 0.0, &l, &p.cross(&l))
+            }
+            // two screws through the joint origin: a1 (home), then a2 — at home the intermediate frame is the
+            // joint frame, so a2's home line is fixed too and (3.19)'s product applies factor by factor
+            JointType::Universal => {
+                let l2 = self.home[i].r.rotate(&m.axes2[i]);
+                screw_exp(qi[0], 0.0, &self.axes[i], &p.cross(&self.axes[i])).mul(&screw_exp(
+                    qi[1],
+                    0.0,
+                    &l2,
+                    &p.cross(&l2),
+                ))
             }
             JointType::Fixed => DualQuat::ONE,
             other => {
@@ -115,7 +134,12 @@ impl ProductOfExponentials {
             let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
             match m.parents[i] {
                 None => {
-                    root = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], qi)?);
+                    root = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(
+                        m.joint_types[i],
+                        &m.axes[i],
+                        &m.axes2[i],
+                        qi,
+                    )?);
                     out[i] = root;
                 }
                 Some(p) => {

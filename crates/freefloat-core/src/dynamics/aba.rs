@@ -1,7 +1,7 @@
 use super::gravity_acceleration;
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::forward_kinematics;
+use crate::kinematics::{forward_kinematics, joint_bias};
 use crate::model::Model;
 use crate::spatial::{Force, Motion, M6, V6};
 use nalgebra::Matrix3;
@@ -49,7 +49,7 @@ pub fn hybrid_aba(
         let iv = m.idx_v[i];
         let mut vj = Motion::ZERO;
         for c in 0..k {
-            let s = omi.act_motion(&Motion::from_v6(&m.subspaces[i].column(c).into_owned()));
+            let s = omi.act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
             d.os[i].set_column(c, &s.to_v6());
             vj += s * v[iv + c];
         }
@@ -58,8 +58,8 @@ pub fn hybrid_aba(
             None => vj,
         };
         d.ov[i] = vi;
-        // d/dt(oS q̇) with S fixed in the body: v × (oS q̇).
-        d.oc[i] = vi.cross_motion(&vj);
+        // d/dt(oS q̇) = v × (oS q̇) + o(Ṡ q̇); the second term is non-zero for universal joints only.
+        d.oc[i] = vi.cross_motion(&vj) + omi.act_motion(&joint_bias(m, d, i, v));
         let oi = m.inertias[i].transformed(&omi);
         d.ia[i] = oi.to_matrix();
         let hi = oi.mul_motion(&vi);
@@ -107,7 +107,7 @@ pub fn hybrid_aba(
                 }
                 continue;
             }
-            // Multi-DoF joint (k = 3: spherical or planar; k = 6: free), with fixed-size products.
+            // Multi-DoF joint (k = 2: cylindrical; 3: spherical or planar; 6: free).
             let ia = d.ia[i];
             if k == 6 {
                 // Only the base can have a free joint (the model builder enforces it), so there is
@@ -121,30 +121,13 @@ pub fn hybrid_aba(
                 d.uu[i].copy_from_slice(uu.as_slice());
                 continue;
             }
-            let s3 = s.fixed_columns::<3>(0);
-            let u3 = ia * s3;
-            let dm3 = s3.transpose() * u3;
-            let uu3 = nalgebra::Vector3::new(tau[iv], tau[iv + 1], tau[iv + 2]) - s3.transpose() * pa6;
-            d.u[i] = M6::zeros();
-            d.u[i].fixed_columns_mut::<3>(0).copy_from(&u3);
-            d.uu[i][..3].copy_from_slice(uu3.as_slice());
-            let Some(p) = parent else {
-                d.dinv[i] = M6::zeros();
-                d.dinv[i].fixed_view_mut::<3, 3>(0, 0).copy_from(&dm3);
-                continue;
+            // k = 2 (cylindrical) or 3 (spherical, planar base): fixed-size products.
+            let ok = match k {
+                2 => reduce_multi_dof::<2>(m, d, i, tau, pa6),
+                3 => reduce_multi_dof::<3>(m, d, i, tau, pa6),
+                _ => unreachable!("joints have 0, 1, 2, 3 or 6 velocity coordinates"),
             };
-            let dinv3 = dm3
-                .cholesky()
-                .map(|c| c.inverse())
-                .filter(|x| x.iter().all(|v| v.is_finite()))
-                .ok_or_else(|| singular(m, i))?;
-            let ud = u3 * dinv3;
-            let ia_a = ia - ud * u3.transpose();
-            let pa = pa6 + ia_a * d.oc[i].to_v6() + ud * uu3;
-            d.dinv[i] = M6::zeros();
-            d.dinv[i].fixed_view_mut::<3, 3>(0, 0).copy_from(&dinv3);
-            d.ia[p] += ia_a;
-            d.of[p] += Force::from_v6(&pa);
+            ok?;
         } else if let Some(p) = parent {
             // Fixed or prescribed joint: the child moves with a known relative acceleration.
             let mut ac = d.oc[i].to_v6();
@@ -207,6 +190,35 @@ pub fn hybrid_aba(
         }
         d.oa[i] = Motion::from_v6(&a);
     }
+    Ok(())
+}
+
+/// Pass-2 step of a K-DoF joint (Featherstone, RBDA §7.3, eqs. 7.43–7.45 in inertial coordinates):
+/// `U = Iᴬ S`, `D = Sᵀ U`, `u = τ − Sᵀ pᴬ`; the parent receives `Iᴬ − U D⁻¹ Uᵀ` and
+/// `pᴬ + Iᵃ c + U D⁻¹ u`. A multi-DoF root keeps D itself for pass 3 (nothing to pass on).
+fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f64], pa6: V6) -> Result<()> {
+    let iv = m.idx_v[i];
+    let ia = d.ia[i];
+    let sk = d.os[i].fixed_columns::<K>(0).into_owned();
+    let uk = ia * sk;
+    let dm = sk.transpose() * uk;
+    let uu = nalgebra::SVector::<f64, K>::from_column_slice(&tau[iv..iv + K]) - sk.transpose() * pa6;
+    d.u[i] = M6::zeros();
+    d.u[i].fixed_columns_mut::<K>(0).copy_from(&uk);
+    d.uu[i][..K].copy_from_slice(uu.as_slice());
+    d.dinv[i] = M6::zeros();
+    let Some(p) = m.parents[i] else {
+        d.dinv[i].fixed_view_mut::<K, K>(0, 0).copy_from(&dm);
+        return Ok(());
+    };
+    let dinv =
+        dm.cholesky().map(|c| c.inverse()).filter(|x| x.iter().all(|v| v.is_finite())).ok_or_else(|| singular(m, i))?;
+    let ud = uk * dinv;
+    let ia_a = ia - ud * uk.transpose();
+    let pa = pa6 + ia_a * d.oc[i].to_v6() + ud * uu;
+    d.dinv[i].fixed_view_mut::<K, K>(0, 0).copy_from(&dinv);
+    d.ia[p] += ia_a;
+    d.of[p] += Force::from_v6(&pa);
     Ok(())
 }
 

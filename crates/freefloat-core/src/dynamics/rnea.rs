@@ -1,6 +1,6 @@
 use super::{fext_of, gravity_acceleration};
 use crate::data::Data;
-use crate::kinematics::{forward_kinematics, joint_velocity};
+use crate::kinematics::{forward_kinematics, joint_bias, joint_velocity};
 use crate::model::Model;
 use crate::spatial::Motion;
 
@@ -11,8 +11,8 @@ pub fn rnea(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64], fext: Opti
     forward_kinematics(m, d, q);
     let ag = gravity_acceleration(m);
     for i in 0..m.nbodies() {
-        let vj = joint_velocity(m, i, v);
-        let aj = joint_velocity(m, i, a);
+        let vj = joint_velocity(m, d, i, v);
+        let aj = joint_velocity(m, d, i, a) + joint_bias(m, d, i, v);
         let (vp, ap) = match m.parents[i] {
             Some(p) => (d.li_mi[i].inv_act_motion(&d.v[p]), d.li_mi[i].inv_act_motion(&d.a[p])),
             None => (Motion::ZERO, d.li_mi[i].inv_act_motion(&ag)),
@@ -24,7 +24,7 @@ pub fn rnea(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64], fext: Opti
         d.f[i] = inr.mul_motion(&d.a[i]) + vi.cross_force(&inr.mul_motion(&vi)) - fext_of(fext, i);
     }
     for i in (0..m.nbodies()).rev() {
-        let s = &m.subspaces[i];
+        let s = &d.s[i];
         let f6 = d.f[i].to_v6();
         for c in 0..m.nvs[i] {
             d.tau[m.idx_v[i] + c] = s.column(c).dot(&f6);

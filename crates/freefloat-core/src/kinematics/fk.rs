@@ -1,13 +1,19 @@
 use crate::data::Data;
-use crate::model::Model;
-use crate::spatial::Motion;
+use crate::model::{universal_bias, universal_first_axis, JointType, Model};
+use crate::spatial::{Motion, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
+/// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
 /// `q` must already be checked (see `Model::checked_q`).
 pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) {
     for i in 0..m.nbodies() {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
-        d.li_mi[i] = m.placements[i].compose(&m.joint_types[i].transform(&m.axes[i], qi));
+        let jt = m.joint_types[i];
+        d.li_mi[i] = m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi));
+        if jt == JointType::Universal {
+            let s1 = universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]);
+            d.s[i].fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
+        }
         d.o_mi[i] = match m.parents[i] {
             Some(p) => d.o_mi[p].compose(&d.li_mi[i]),
             None => d.li_mi[i],
@@ -15,10 +21,10 @@ pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) {
     }
 }
 
-/// Joint twist `S q̇` of body i, child frame.
+/// Joint twist `S q̇` of body i, child frame (the subspace of the last `forward_kinematics`).
 #[inline]
-pub fn joint_velocity(m: &Model, i: usize, qd: &[f64]) -> Motion {
-    let s = &m.subspaces[i];
+pub fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
+    let s = &d.s[i];
     let k0 = m.idx_v[i];
     let mut out = [0.0; 6];
     for c in 0..m.nvs[i] {
@@ -30,11 +36,23 @@ pub fn joint_velocity(m: &Model, i: usize, qd: &[f64]) -> Motion {
     Motion::from_slice(&out)
 }
 
+/// Joint bias acceleration `Ṡ q̇` of body i, child frame: zero but for a universal joint (RBDA
+/// eq. 3.41 `c_J`), after `forward_kinematics`.
+#[inline]
+pub fn joint_bias(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
+    if m.joint_types[i] != JointType::Universal {
+        return Motion::ZERO;
+    }
+    let k = m.idx_v[i];
+    let s1 = V3::new(d.s[i][(3, 0)], d.s[i][(4, 0)], d.s[i][(5, 0)]);
+    Motion::new(V3::zeros(), universal_bias(&s1, &m.axes2[i], qd[k], qd[k + 1]))
+}
+
 /// Placements and body twists (body frame).
 pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
     forward_kinematics(m, d, q);
     for i in 0..m.nbodies() {
-        let vj = joint_velocity(m, i, v);
+        let vj = joint_velocity(m, d, i, v);
         d.v[i] = match m.parents[i] {
             Some(p) => d.li_mi[i].inv_act_motion(&d.v[p]) + vj,
             None => vj,
@@ -48,8 +66,8 @@ pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
 pub fn forward_accelerations(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64]) {
     forward_kinematics(m, d, q);
     for i in 0..m.nbodies() {
-        let vj = joint_velocity(m, i, v);
-        let aj = joint_velocity(m, i, a);
+        let vj = joint_velocity(m, d, i, v);
+        let aj = joint_velocity(m, d, i, a) + joint_bias(m, d, i, v);
         let (vp, ap) = match m.parents[i] {
             Some(p) => (d.li_mi[i].inv_act_motion(&d.v[p]), d.li_mi[i].inv_act_motion(&d.a[p])),
             None => (Motion::ZERO, Motion::ZERO),

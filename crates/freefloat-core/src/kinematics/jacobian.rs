@@ -51,7 +51,7 @@ fn jacobian_from_data(m: &Model, d: &Data, body: usize, placement: &Se3, referen
     // Only the joints on the path to the base move the frame.
     while let Some(i) = j {
         for c in 0..m.nvs[i] {
-            let s = Motion::from_v6(&m.subspaces[i].column(c).into_owned());
+            let s = Motion::from_v6(&d.s[i].column(c).into_owned());
             let local = o_mf.inv_act_motion(&d.o_mi[i].act_motion(&s));
             let tw = match reference {
                 Reference::Local => local,

@@ -6,7 +6,9 @@ mod jacobian;
 mod momentum;
 
 pub use com::center_of_mass;
-pub use fk::{classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities, joint_velocity};
+pub use fk::{
+    classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities, joint_bias, joint_velocity,
+};
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};
 pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,

@@ -49,7 +49,7 @@ pub fn world_composite_inertias(m: &Model, d: &mut Data) {
 pub fn world_motion_subspaces(m: &Model, d: &mut Data) {
     for i in 0..m.nbodies() {
         for c in 0..m.nvs[i] {
-            let s = d.o_mi[i].act_motion(&Motion::from_v6(&m.subspaces[i].column(c).into_owned()));
+            let s = d.o_mi[i].act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
             d.os[i].set_column(c, &s.to_v6());
         }
     }

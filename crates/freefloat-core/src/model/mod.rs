@@ -7,7 +7,7 @@ mod physics;
 pub mod urdf;
 pub mod yaml;
 
-pub use joint::{JointLimits, JointType};
+pub use joint::{universal_bias, universal_first_axis, JointLimits, JointType};
 pub use physics::{check_finite_nonnegative_mass, check_physical};
 
 use crate::error::{FfError, Result};
@@ -29,6 +29,8 @@ pub struct BodySpec {
     pub joint_name: String,
     pub joint_type: JointType,
     pub axis: V3,
+    /// Second axis of a universal joint (in the intermediate frame); ignored by other joints.
+    pub axis2: V3,
     pub placement: Se3,
     pub inertia: Inertia,
     pub limits: JointLimits,
@@ -46,8 +48,10 @@ pub struct Model {
     /// Parent body of each body; `None` for the base (body 0). Always `parents[i] < i`.
     pub parents: Vec<Option<usize>>,
     pub joint_types: Vec<JointType>,
-    /// Joint axis in the joint frame (unit; meaningful for revolute/prismatic only).
+    /// Joint axis in the joint frame (unit; meaningful for revolute/prismatic/cylindrical only).
     pub axes: Vec<V3>,
+    /// Second axis of a universal joint (unit, not parallel to `axes[i]`); z elsewhere, unused.
+    pub axes2: Vec<V3>,
     /// Rest placement of each joint frame in its parent body frame (the base: in the inertial frame).
     pub placements: Vec<Se3>,
     pub inertias: Vec<Inertia>,
@@ -65,7 +69,8 @@ pub struct Model {
     pub nvs: Vec<usize>,
     pub nq: usize,
     pub nv: usize,
-    /// Motion subspace of each joint (constant in the child frame).
+    /// Motion subspace of each joint in the child frame at q = 0 (constant for every joint but the
+    /// universal one, whose current subspace is `Data::s`).
     pub subspaces: Vec<M6>,
     pub children: Vec<Vec<usize>>,
 }
@@ -91,6 +96,7 @@ impl ModelBuilder {
             parents: vec![None],
             joint_types: vec![base_joint],
             axes: vec![V3::z()],
+            axes2: vec![V3::z()],
             placements: vec![Se3::identity()],
             inertias: vec![base_inertia],
             limits: vec![JointLimits::default()],
@@ -138,7 +144,7 @@ impl ModelBuilder {
             )));
         }
         let mut axis = b.axis;
-        if matches!(b.joint_type, JointType::Revolute | JointType::Prismatic) {
+        if b.joint_type.has_axis() {
             let n = axis.norm();
             if !(n > 1e-12) || !n.is_finite() {
                 return Err(FfError::Model(format!(
@@ -149,11 +155,34 @@ impl ModelBuilder {
             }
             axis /= n;
         }
+        let mut axis2 = V3::z();
+        if b.joint_type == JointType::Universal {
+            let n = b.axis2.norm();
+            if !(n > 1e-12) || !n.is_finite() {
+                return Err(FfError::Model(format!(
+                    "joint '{}': second axis {:?} has zero length",
+                    b.joint_name,
+                    b.axis2.as_slice()
+                )));
+            }
+            axis2 = b.axis2 / n;
+            // A Cardan joint: orthogonal axes (parallel ones would leave S rank-deficient; the dual-quaternion
+            // formulation's joint frame is built from the two axes and needs them orthogonal)
+            if axis.dot(&axis2).abs() > 1e-9 {
+                return Err(FfError::Model(format!(
+                    "joint '{}': universal joint axes {:?} and {:?} must be orthogonal",
+                    b.joint_name,
+                    axis.as_slice(),
+                    axis2.as_slice()
+                )));
+            }
+        }
         m.body_names.push(b.name);
         m.joint_names.push(b.joint_name);
         m.parents.push(Some(b.parent));
         m.joint_types.push(b.joint_type);
         m.axes.push(axis);
+        m.axes2.push(axis2);
         m.placements.push(b.placement);
         m.inertias.push(b.inertia);
         m.limits.push(b.limits);
@@ -221,7 +250,7 @@ impl Model {
             self.idx_v.push(nv);
             self.nqs.push(jt.nq());
             self.nvs.push(jt.nv());
-            self.subspaces.push(jt.subspace(&self.axes[i]));
+            self.subspaces.push(jt.subspace(&self.axes[i], &self.axes2[i]));
             nq += jt.nq();
             nv += jt.nv();
         }

@@ -118,6 +118,7 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonph
             joint_name: j.name.clone(),
             joint_type: j.kind,
             axis: j.axis,
+            axis2: V3::z(), // URDF has no universal joint
             placement: j.placement,
             inertia: child.inertia,
             limits: j.limits,

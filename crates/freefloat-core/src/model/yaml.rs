@@ -40,6 +40,8 @@ struct JointYaml {
     #[serde(rename = "type")]
     kind: String,
     axis: Option<[f64; 3]>,
+    /// Second axis of a universal joint (required there, rejected elsewhere).
+    axis2: Option<[f64; 3]>,
     limits: Option<LimitsYaml>,
 }
 
@@ -190,7 +192,7 @@ impl Loader<'_> {
                 self.err_at(
                     &body.name,
                     format!(
-                        "body '{}': unknown joint type '{}' (expected revolute, prismatic, fixed or spherical)",
+                        "body '{}': unknown joint type '{}' (expected revolute, prismatic, fixed, spherical, cylindrical or universal)",
                         body.name, joint.kind
                     ),
                 )
@@ -219,6 +221,25 @@ impl Loader<'_> {
                 }
                 axis = V3::z();
             }
+            let axis2 = match (jt, joint.axis2) {
+                (JointType::Universal, Some(a)) => V3::from(a),
+                (JointType::Universal, None) => {
+                    return Err(self.err_at(
+                        &body.name,
+                        format!(
+                            "body '{}': a universal joint needs `axis2`, the second rotation axis (e.g. axis: [1, 0, 0], axis2: [0, 1, 0])",
+                            body.name
+                        ),
+                    ))
+                }
+                (_, Some(_)) => {
+                    return Err(self.err_at(
+                        &body.name,
+                        format!("body '{}': `axis2` is only meaningful for a universal joint, not {}", body.name, jt.name()),
+                    ))
+                }
+                (_, None) => V3::z(),
+            };
             let l = joint.limits.as_ref();
             let ang_lim = |x: Option<f64>| if jt == JointType::Revolute { x.map(ang) } else { x };
             let limits = JointLimits {
@@ -240,6 +261,7 @@ impl Loader<'_> {
                 joint_name: joint.name.clone().unwrap_or_else(|| format!("{}_joint", body.name)),
                 joint_type: jt,
                 axis,
+                axis2,
                 placement,
                 inertia: self.inertia(body)?,
                 limits,
