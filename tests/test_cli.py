@@ -103,6 +103,7 @@ def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
     assert (tmp_path / "fig4.png").stat().st_size > 10_000
     r2 = run("identify", "minimal", "seed001_dual_arm", "--trajectory", str(tmp_path / "trajectory.json"),
              "--out", str(tmp_path / "id"))
+    assert "simulating seed001_dual_arm along" in r2.stdout
     ident = json.loads((tmp_path / "id" / "results.json").read_text())
     assert ident["median_rel_error_pct"] < 1.0 and "bias compensation" in ident["solver"]
     bad = run("excite", "seed001_dual_arm", "--out", str(tmp_path / "bad"), ok=False)  # Table 2 is non-physical

@@ -9,7 +9,6 @@ import pytest
 import freefloat as ff
 from freefloat import excitation as exc
 from freefloat import trajectories as tr
-from freefloat.estimation import absolute_columns
 
 
 @pytest.fixture(scope="module")
