@@ -104,9 +104,9 @@ def test_prediction_starts_with_zero_momentum_and_follows_fourier(consistent_rob
     qm, _, _ = fourier.evaluate(np.array([7.0 - h]))
     np.testing.assert_allclose((qp - qm)[0] / (2 * h), qd[1], atol=1e-7)
     assert fourier.duration == pytest.approx(40.0)
-    from freefloat.validation import _drive
+    from freefloat.simulation import simulate_driven
 
-    traj = _drive(m, fourier, m.joints_tagged("arm_"), m.joints_tagged("wheel"), 1.0, 5e-3, 1, False)
+    traj = simulate_driven(m, fourier, m.joints_tagged("arm_"), 5e-3, held=m.joints_tagged("wheel"), t_final=1.0)
     assert np.abs(traj.momentum).max() < 1e-9 * m.total_mass
 
 

@@ -289,7 +289,9 @@ def demo_cmd(out, t_final):
                "with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)")
     telem, _ = idf.trajectory_data(m, designed, joints, progress=True)
     plain = idf.identify_minimal(m, telem).errors(m)
-    res = idf.identify_minimal(m, telem, rate_noise=(50e-6, 80e-6, 50e-6))
+    from .telemetry import SIGMA_ANG, SIGMA_JOINT, SIGMA_LIN
+
+    res = idf.identify_minimal(m, telem, rate_noise=(SIGMA_LIN, SIGMA_ANG, SIGMA_JOINT))
     e = res.errors(m)
     click.echo(f"  {len(res.names)} minimal parameters, condition number {res.fit.condition_number:.4g}; relative error "
                f"median {e['median_rel_error_pct']:.3g} %, max {e['max_rel_error_pct']:.3g} % (seed 001 Case 1: 2.08 %, 174 %)")
@@ -430,18 +432,15 @@ def identify_minimal_cmd(model, data, n_sim, traj_file, method, known, h0, weigh
     if n_sim is not None:
         click.echo(f"simulating {n_sim} excitation intervals of {m.name} with the paper's rate noise ...")
         data, _ = idf.excitation_data(m, n_intervals=n_sim, progress=True)
-        if out:
-            Path(out).mkdir(parents=True, exist_ok=True)
-            data.to_parquet(Path(out) / "telemetry.parquet")
     if traj_file is not None:
         from .excitation import load_trajectory
 
         trajectory, joints = load_trajectory(traj_file)
         click.echo(f"simulating {m.name} along {traj_file} ({trajectory.duration:g} s) with the paper's rate noise ...")
         data, _ = idf.trajectory_data(m, trajectory, joints, progress=True)
-        if out:
-            Path(out).mkdir(parents=True, exist_ok=True)
-            data.to_parquet(Path(out) / "telemetry.parquet")
+    if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results
+        Path(out).mkdir(parents=True, exist_ok=True)
+        data.to_parquet(Path(out) / "telemetry.parquet")
     res = idf.identify_minimal(m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig)
     click.echo(res.table(truth=m if truth else None))
     summary = res.to_dict(truth=m if truth else None)

@@ -145,19 +145,34 @@ def representative_parameters(mp, phi, prior=None) -> np.ndarray:
     return P
 
 
+def _pseudo_to_standard_map() -> np.ndarray:
+    """T (10 × 16) with P = T vec(J) for a symmetric pseudo-inertia J (vec in either order: J is symmetric):
+    m = J₃₃, h = J_{i3}, and I = tr(Σ) 1 − Σ with Σ the upper-left block."""
+    T = np.zeros((10, 16))
+    e = lambda r, c: 4 * r + c  # noqa: E731 - index of J[r, c] in vec(J)
+    T[0, e(3, 3)] = 1.0
+    for k in range(3):
+        T[1 + k, e(k, 3)] = 1.0
+    for row, (a, b) in ((4, (1, 2)), (6, (0, 2)), (9, (0, 1))):  # Ixx = Σyy + Σzz, ...
+        T[row, e(a, a)] = T[row, e(b, b)] = 1.0
+    for row, (a, b) in ((5, (0, 1)), (7, (0, 2)), (8, (1, 2))):  # Ixy = −Σxy, ...
+        T[row, e(a, b)] = -1.0
+    return T
+
+
+#: standard parameters from a pseudo-inertia, the one linear map used for both cvxpy variables and numbers
+PSEUDO_TO_STANDARD = _pseudo_to_standard_map()
+
+
 def _standard_from_pseudo(J):
-    """cvxpy expression: J -> [m, h, Ixx, Ixy, Iyy, Ixz, Iyz, Izz] with I = tr(Σ) 1 − Σ."""
+    """cvxpy expression J (symmetric 4×4 variable) -> its 10 standard parameters."""
     import cvxpy as cp
 
-    tr = J[0, 0] + J[1, 1] + J[2, 2]
-    return cp.hstack([J[3, 3], J[0, 3], J[1, 3], J[2, 3],
-                      tr - J[0, 0], -J[0, 1], tr - J[1, 1], -J[0, 2], -J[1, 2], tr - J[2, 2]])
+    return PSEUDO_TO_STANDARD @ cp.vec(J, order="C")
 
 
 def _standard_from_pseudo_np(J) -> np.ndarray:
-    tr = np.trace(J[:3, :3])
-    return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3],
-                     tr - J[0, 0], -J[0, 1], tr - J[1, 1], -J[0, 2], -J[1, 2], tr - J[2, 2]])
+    return PSEUDO_TO_STANDARD @ np.asarray(J, dtype=float).ravel()
 
 
 def _whitening(phi, covariance) -> np.ndarray:

@@ -222,7 +222,8 @@ def component_variances(mp, q, v, h, phi, chunk: int = 4096) -> np.ndarray:
     ss = np.zeros(6)
     for k in range(0, len(q), chunk):
         qs, vs = q[k:k + chunk], v[k:k + chunk]
-        r = h[k:k + chunk] - mp.regressor(qs, vs) @ phi - mp.known_momentum(qs, vs)
+        K, h_known = mp.regressor_and_known_momentum(qs, vs)
+        r = h[k:k + chunk] - K @ phi - h_known
         ss += np.sum(r * r, axis=0)
     return ss / max(len(q), 1)
 
@@ -307,17 +308,9 @@ def trajectory_data(model, trajectory, joints, dt: float = 1e-3, record_every: i
     momentum model when the trajectory starts moving), the other joints rest.  With `noise`, seed 001's rate
     noise and pose rebuild (Appendix C).  Returns (telemetry, trajectory)."""
     from . import telemetry as tm
-    from .algorithms import centroidal_momentum_matrix
-    from .simulation import simulate
+    from .simulation import simulate_driven
 
-    presc = trajectory.prescription(model, joints)
-    q0, v0, _ = presc(0.0)
-    if np.any(v0[6:] != 0.0):  # zero total momentum: A_b v_b = −A_j q̇_j
-        A = centroidal_momentum_matrix(model, q0)
-        v0[:6] = np.linalg.solve(A[:, :6], -A[:, 6:] @ v0[6:])
-    duration = trajectory.duration
-    traj = simulate(model, q0, v0, duration, dt, prescribed=joints, prescription=presc,
-                    record_every=record_every, progress=progress)
+    traj = simulate_driven(model, trajectory, joints, dt, record_every=record_every, progress=progress)
     telem = tm.from_trajectory(traj)
     if noise:
         telem = tm.add_noise(telem, model, np.random.default_rng(seed))

@@ -83,6 +83,12 @@ class MinimalParameters:
         cols = _body_columns(self.known)
         return K[..., cols] @ P[self.known].ravel()
 
+    def regressor_and_known_momentum(self, q, v, P=None):
+        """(`regressor(q, v)`, `known_momentum(q, v, P)`) from one build of the momentum regressor."""
+        P = self.model.parameters() if P is None else np.asarray(P, dtype=float)
+        K = self._full_regressor(q, v)
+        return K[..., self._unknown_cols()[self.columns]], K[..., _body_columns(self.known)] @ P[self.known].ravel()
+
     def _full_regressor(self, q, v):
         return momentum_regressor(self.model, q, v)
 

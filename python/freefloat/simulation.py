@@ -195,6 +195,23 @@ def simulate(
     return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
 
 
+def simulate_driven(model: Model, trajectory, joints, dt: float, *, held=(), t_final: float | None = None,
+                    record_every: int = 1, progress=False) -> Trajectory:
+    """Simulate `model` while the named `joints` follow a joint `trajectory` (an object with `prescription`
+    and `duration`, e.g. from `freefloat.trajectories`) and the joints in `held` stay at their neutral angle; the
+    base floats with zero total momentum, its initial twist solved from the momentum model,
+    A_b v_b = −A_j q̇_j (seed 001, digest A.10). t_final: default the trajectory's duration."""
+    from .algorithms import centroidal_momentum_matrix
+
+    presc = trajectory.prescription(model, joints)  # entries it does not drive: neutral angle, at rest
+    q0, v0, _ = presc(0.0)
+    A = centroidal_momentum_matrix(model, q0)
+    v0[:6] = np.linalg.solve(A[:, :6], -A[:, 6:] @ v0[6:])
+    t_final = trajectory.duration if t_final is None else t_final
+    return simulate(model, q0, v0, t_final, dt, prescribed=list(joints) + list(held), prescription=presc,
+                    record_every=record_every, progress=progress)
+
+
 def _bar_callback(bar):
     """Progress callback that advances a tqdm bar counting per mille."""
     def cb(frac):

@@ -24,14 +24,15 @@ import numpy as np
 
 from ._core import InputError
 from ._rotations import quat_to_matrix
-from .simulation import simulate
+from .telemetry import SIGMA_ANG, SIGMA_LIN
+from .simulation import simulate_driven
 from .trajectories import Fourier
 
 #: seed 001 Table 6 (digest B.9): RMS prediction errors of base twist [m/s, rad/s] and arm torques [N·m]
 PAPER_TABLE6_TWIST = (1.7e-4, 1.6e-4, 0.6e-4, 2.1e-4, 1.8e-4, 3.5e-4)
 PAPER_TABLE6_TORQUE = (0.2961, 0.1665, 0.0778, 0.0922, 0.0368, 0.0262)
 #: the paper's noise references for Table 6: rate noise (Sec. VI.C) and the torque-sensor sigma of its ref. [33]
-NOISE_LIN, NOISE_ANG, NOISE_TORQUE = 50e-6, 80e-6, 0.3808
+NOISE_LIN, NOISE_ANG, NOISE_TORQUE = SIGMA_LIN, SIGMA_ANG, 0.3808
 TWIST_NAMES = ["v0x", "v0y", "v0z", "w0x", "w0y", "w0z"]
 
 
@@ -171,26 +172,11 @@ def predict(true_model, identified_model, joints=None, trajectory=None, dt: floa
         trajectory = default_fourier(true_model.neutral()[iq])
     if trajectory.n != len(joints):
         raise InputError(f"predict: the trajectory drives {trajectory.n} joints, {len(joints)} are named")
-    duration = getattr(trajectory, "duration", None)
-    runs = [_drive(mod, trajectory, joints, locked, duration, dt, record_every, progress)
+    runs = [simulate_driven(mod, trajectory, joints, dt, held=locked, record_every=record_every, progress=progress)
             for mod in (true_model, identified_model)]
     iv = [true_model.idx_v[true_model.joint_names.index(j)] for j in joints]
     (t, tw_t, tau_t), (_, tw_p, tau_p) = ((r.t, _world_twist(r), r.tau[:, iv]) for r in runs)
     return PredictionResult(t=t, twist_true=tw_t, twist_pred=tw_p, tau_true=tau_t, tau_pred=tau_p, joints=joints)
-
-
-def _drive(model, trajectory, joints, locked, duration, dt, record_every, progress):
-    """Simulate `model` with `joints` following `trajectory`, `locked` joints still, base floating, h = 0."""
-    from . import centroidal_momentum_matrix
-
-    # Entries of joints the trajectory does not drive are the neutral angle with zero rate and acceleration,
-    # which is exactly what the locked joints must follow.
-    presc = trajectory.prescription(model, joints)
-    q0, v0, _ = presc(0.0)
-    A = centroidal_momentum_matrix(model, q0)
-    v0[:6] = np.linalg.solve(A[:, :6], -A[:, 6:] @ v0[6:])  # zero total momentum (seed 001 A.10)
-    return simulate(model, q0, v0, duration, dt, prescribed=list(joints) + list(locked), prescription=presc,
-                    record_every=record_every, progress=progress)
 
 
 def _world_twist(traj) -> np.ndarray:
