@@ -173,12 +173,13 @@ def test_bad_input(guess):
 
 
 def test_the_shipped_designed_trajectory():
-    """scenarios/seed001_exciting_trajectory.json (written by `freefloat excite seed001_dual_arm --guess
+    """The shipped designed trajectory (freefloat/data/trajectories/, written by `freefloat excite seed001_dual_arm --guess
     seed001_dual_arm_offset`): within the limits on a fine grid, and on the TRUE robot it excites every minimal
     parameter (noise-free data recovers them)."""
-    from pathlib import Path
+    from freefloat import data
 
-    traj, joints = exc.load_trajectory(Path(__file__).parents[1] / "scenarios" / "seed001_exciting_trajectory.json")
+    with data.path("trajectories", "seed001_exciting_trajectory") as p:
+        traj, joints = exc.load_trajectory(p)
     L = exc.Limits.seed001()
     t = np.linspace(0, traj.duration, 100 * traj.n_intervals + 1)
     q, qd, qdd = traj.evaluate(t)

@@ -22,8 +22,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def yaml_truth(model_name):
-    """(m, b', I'_c) of base and target straight from models/<name>.yaml."""
-    d = yaml.safe_load((ROOT / "models" / f"{model_name}.yaml").read_text())
+    """(m, b', I'_c) of base and target straight from the built-in model's YAML text."""
+    d = yaml.safe_load(ff.models.source(model_name))
     out = {}
     for b in d["bodies"]:
         if b["name"] in ("base", "target"):
@@ -268,7 +268,7 @@ def test_modified_rls_bad_samples_raise_clear_errors():
 
 
 def test_target_must_be_welded_to_the_end_effector():
-    text = (ROOT / "models" / "seed000_2d_medium.yaml").read_text()
+    text = ff.models.source("seed000_2d_medium")
     loose = ff.Model.from_yaml_string(text.replace("joint: {name: grasp, type: fixed}",
                                                    "joint: {name: grasp, type: revolute, axis: [0, 0, 1]}"))
     with pytest.raises(ff.InputError, match="welded"):

@@ -34,14 +34,6 @@ def torque_options(m: Model, torques: str, amplitude: float) -> dict:
     return {"torques": table, "hold": "zoh"}
 
 
-def _scenario(name: str) -> Path:
-    """A file shipped in the repository's scenarios/ directory (next to the package source)."""
-    p = Path(__file__).resolve().parents[2] / "scenarios" / name
-    if not p.exists():
-        raise click.ClickException(f"scenario file {p} not found (the demo runs from a source checkout)")
-    return p
-
-
 def load_model(spec: str, base: str = "free") -> Model:
     """A built-in name, or a path to a YAML or URDF file."""
     p = Path(spec)
@@ -245,7 +237,7 @@ def demo_cmd(out, t_final):
     1. Simulation: the robot floats freely while its six arm joints follow a smooth prescribed manoeuvre
        (hybrid dynamics: the base responds, the joint torques needed are recorded); prints and plots how
        well momentum and energy are conserved.
-    2. Identification: the exciting trajectory designed by `freefloat excite` (scenarios/) with the paper's
+    2. Identification: the exciting trajectory designed by `freefloat excite` (shipped in the package) with the paper's
        rate noise, then the 52 minimal parameters from the momentum model; prints the paper's error
        figures and plots every parameter's error.
     3. Validation by prediction (seed 001 Sec. VI.D): true and identified robots along a Fourier trajectory."""
@@ -284,7 +276,10 @@ def demo_cmd(out, t_final):
 
     from .excitation import load_trajectory
 
-    designed, joints = load_trajectory(_scenario("seed001_exciting_trajectory.json"))
+    from . import data
+
+    with data.path("trajectories", "seed001_exciting_trajectory") as p:
+        designed, joints = load_trajectory(p)
     click.echo(f"\nidentification: the designed exciting trajectory ({designed.n_intervals} intervals, `freefloat excite`) "
                "with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)")
     telem, _ = idf.trajectory_data(m, designed, joints, progress=True)
@@ -630,7 +625,7 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
 def scenarios_cmd():
     """List the built-in post-capture scenarios (seed 000), one per line with what it reproduces.
 
-    A scenario file (YAML, in the repository's scenarios/ directory) names the robot, the captured target, the
+    A scenario file (YAML; the built-in ones ship inside the package) names the robot, the captured target, the
     controller gains, the initial velocities and the identification settings. Run one with
     `freefloat identify postcapture NAME --out DIR`."""
     from . import postcapture as pc

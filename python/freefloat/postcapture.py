@@ -3,7 +3,7 @@
 on standard parameters), results, tables beside the paper's, figures.
 
     import freefloat.postcapture as pc
-    sc = pc.load_scenario("seed000_2d_medium")        # scenarios/seed000_2d_medium.yaml
+    sc = pc.load_scenario("seed000_2d_medium")        # built-in (freefloat/data/scenarios/) or a file path
     res = pc.run(sc)                                    # simulate + identify (4 estimators)
     print(res.table()); res.save("out/")
 
@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from . import _core
+from . import _core, data
 from . import algorithms as alg
 from . import models
 from . import online
@@ -28,7 +28,6 @@ from . import postcapture_equations as eq
 from ._core import InputError
 from ._rotations import quat_to_matrix
 
-SCENARIO_DIR = Path(__file__).resolve().parents[2] / "scenarios"
 METHODS = ("momentum", "force")
 SOLVERS = ("modified_rls", "standard_rls")
 # Noise study levels (the paper has no noise): white, per sample. Velocities [m/s, rad/s] and accelerations
@@ -74,27 +73,29 @@ class Scenario:
 
 
 def list_scenarios() -> list[tuple[str, str]]:
-    """Built-in scenarios (name, description) from the top-level scenarios/ directory."""
+    """Built-in scenarios (name, description), shipped inside the package (`freefloat.data`)."""
     out = []
-    for p in sorted(SCENARIO_DIR.glob("*.yaml")):
-        d = yaml.safe_load(p.read_text())
-        out.append((p.stem, str(d.get("description", "")).strip()))
+    for name in data.names("scenarios"):
+        d = yaml.safe_load(data.read_text("scenarios", name))
+        out.append((name, str(d.get("description", "")).strip()))
     return out
 
 
 def load_scenario(spec: str | Path) -> Scenario:
     """A scenario by built-in name or file path."""
     p = Path(spec)
-    if not p.suffix:
-        p = SCENARIO_DIR / f"{spec}.yaml"
-    if not p.exists():
-        names = ", ".join(n for n, _ in list_scenarios())
+    if not p.suffix and data.exists("scenarios", str(spec)):
+        text, source = data.read_text("scenarios", str(spec)), f"built-in scenario '{spec}'"
+    elif p.suffix and p.is_file():
+        text, source = p.read_text(), str(p)
+    else:
+        names = ", ".join(data.names("scenarios"))
         raise InputError(f"scenario '{spec}' not found (built-in scenarios: {names})")
-    d = yaml.safe_load(p.read_text())
+    d = yaml.safe_load(text)
     try:
-        return _parse(d, str(p))
+        return _parse(d, source)
     except KeyError as e:
-        raise InputError(f"{p}: missing key {e}") from None
+        raise InputError(f"{source}: missing key {e}") from None
 
 
 def _parse(d: dict, source: str) -> Scenario:
