@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """freefloat vs Pinocchio / Crocoddyl on the same robot, timed in one run.
 
-The robot is the built-in `seed001_dual_arm` (free base + two 3R arms + three reaction wheels; nq = 16,
+The robot is the built-in `naveen_dual_arm` (free base + two 3R arms + three reaction wheels; nq = 16,
 nv = 15). Pinocchio gets it through freefloat's URDF export (`Model.to_urdf`), loaded with
 `pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())` and zero gravity. The export writes the
 unlimited revolute joints as URDF `continuous`, which Pinocchio turns into unbounded revolute joints with
@@ -45,7 +45,7 @@ from pathlib import Path
 
 import numpy as np
 
-MODEL = "seed001_dual_arm"
+MODEL = "naveen_dual_arm"
 
 # Scenario of the simulation comparison (same as crates/freefloat-core/benches/dynamics.rs).
 AMP = np.array([20.0, 15.0, 8.0, 20.0, 12.0, 10.0])  # N·m

@@ -82,7 +82,7 @@ def main():
     n, reps = (200, 3) if args.quick else (2000, 7)
     rng = np.random.default_rng(1)
     rows = []
-    robots = [ff.models.load("thesis_ch5_single_arm"), ff.models.load("thesis_ch7_two_arm")]
+    robots = [ff.models.load("valverde_ch5_single_arm"), ff.models.load("valverde_ch7_two_arm")]
     robots += [ff.Model.from_yaml_string(random_tree_yaml(k, k)) for k in (5, 10, 20, 40, 60)]
     for m in robots:
         t, err = bench(m, n, reps, rng)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Exciting-trajectory design objective (seed 001, eq. 32): freefloat vs a Pinocchio + numpy peer.
 
-Problem: guessed robot seed001_dual_arm_offset, `ExcitationDesign` defaults: all 256 direction combinations
+Problem: guessed robot naveen_dual_arm_offset, `ExcitationDesign` defaults: all 256 direction combinations
 (one 1-s cycloidal interval each, six arm joints with design seeds, three wheels on fixed seeds), seeds
 x = d.feasible_start(d.all_directions).  One evaluation of eq. 32, C = κ(G_m) + w·N_l N_m / Σh², needs
   * the joint path on a grid of 10 points per interval (2,561 points),
@@ -60,9 +60,9 @@ import numpy as np
 
 import freefloat as ff
 from freefloat import excitation as exc
-from freefloat.estimation import absolute_columns
+from freefloat.identification.estimation import absolute_columns
 
-MODEL = "seed001_dual_arm_offset"
+MODEL = "naveen_dual_arm_offset"
 #: the issue's targets: one evaluation of eq. 32 over 256 intervals, and the whole three-step design
 TARGETS = {"ff_objective_s": 5e-3, "design_s": 60.0}
 AGREE_RTOL = 1e-6       # κ, mean square, objective (κ from GᵀG: both sides square the condition number)

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Minimal-parameter identification from momentum (seed 001, eqs. 26-27): freefloat vs a vectorised numpy peer.
 
-Problem: seed001_dual_arm, 67 intervals x 1 s at 1 kHz = 67,000 samples -> a 402,000 x 52 minimal regressor
+Problem: naveen_dual_arm, 67 intervals x 1 s at 1 kHz = 67,000 samples -> a 402,000 x 52 minimal regressor
 (wheels known, closed-form minimal parameters).  The states come from a simulation (ff.simulate, RK4, dt = 1 ms,
 every step recorded) with a prescribed smooth multi-sine on the six arm joints and the three wheels; the
 measured momentum is the simulated momentum plus Gaussian noise (sigma 0.1 on every component).
@@ -44,7 +44,7 @@ import numpy as np
 import freefloat as ff
 from freefloat import estimation as est
 
-MODEL = "seed001_dual_arm"
+MODEL = "naveen_dual_arm"
 DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]
 NOISE = 0.1
 TARGETS = {"regressor": 10.0, "end_to_end": 5.0}

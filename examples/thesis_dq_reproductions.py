@@ -11,8 +11,8 @@ What is and is not reproduced (honestly):
   so the trajectory is the thesis' motion; the thesis' *dual-quaternion state* integration (8B twists + base DQ,
   with its own constraint drift) is not re-implemented. The condition number of the system matrix S (6.17)
   (Figs. 5.5, 7.x) is evaluated at every recorded configuration (`ff.dq.condition_number`).
-* Masses, inertias and geometry are the documented choices in crates/freefloat-core/models/thesis_ch5_single_arm.yaml and
-  crates/freefloat-core/models/thesis_ch7_two_arm.yaml (the thesis gives none). Spherical-joint inputs use the digest's recommended
+* Masses, inertias and geometry are the documented choices in crates/freefloat-core/models/valverde_ch5_single_arm.yaml and
+  crates/freefloat-core/models/valverde_ch7_two_arm.yaml (the thesis gives none). Spherical-joint inputs use the digest's recommended
   mapping (phi -> tau_x, theta -> tau_y, psi -> tau_z).
 * Input windows are open intervals as printed; the discontinuous (5.142) set and the window ends make the
   torques jump, and the adaptive integrator steps across the jumps without event location.
@@ -92,9 +92,9 @@ def run(m, torques, t_final, dt_out, name, out: Path):
 
 
 def plot(traj, com, r, cond, path, title):
-    from freefloat.plots import _plt
+    from freefloat.viz import pyplot
 
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(2, 4, figsize=(18, 7), sharex=True)
     t = traj.t
     ax[0, 0].plot(t, np.linalg.norm(com - com[0], axis=1))
@@ -134,8 +134,8 @@ def main():
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    m5 = ff.models.load("thesis_ch5_single_arm")
-    m7 = ff.models.load("thesis_ch7_two_arm")
+    m5 = ff.models.load("valverde_ch5_single_arm")
+    m7 = ff.models.load("valverde_ch7_two_arm")
     t5, t7 = (8.0, 6.0) if args.quick else (70.0, 20.0)
     res = [run(m5, ch5_torques(m5, True), t5, 0.05, "ch5_smooth_5.141", out),
            run(m5, ch5_torques(m5, False), t5, 0.05, "ch5_discontinuous_5.142", out),

@@ -87,7 +87,7 @@ def test_missing_files(tmp_path):
 
 
 def test_wrong_sizes_and_nan():
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     q, v = m.neutral(), np.zeros(m.nv)
     with pytest.raises(ff.InputError, match=r"`q`.*\(13\) or \(T, 13\)"):
         ff.aba(m, q[:-1], v, v)
@@ -110,7 +110,7 @@ def test_wrong_sizes_and_nan():
 
 
 def test_quaternion_policy():
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     q = m.neutral()
     q2 = q.copy()
     q2[3:7] = [0.1, 0.2, 0.3, 0.9]
@@ -125,7 +125,7 @@ def test_quaternion_policy():
 
 
 def test_unknown_frame_and_reference():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     with pytest.raises(ff.InputError, match="'hand' is neither a body nor a frame"):
         ff.frame_jacobian(m, m.neutral(), "hand")
     with pytest.raises(ff.InputError, match="'local' or 'world'"):
@@ -135,7 +135,7 @@ def test_unknown_frame_and_reference():
 
 
 def test_with_parameters_checks():
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     with pytest.raises(ff.InputError, match=r"\(8, 10\)"):
         m.with_parameters(np.zeros((3, 10)))
     P = m.parameters()
@@ -145,7 +145,7 @@ def test_with_parameters_checks():
 
 
 def test_simulation_bad_input_and_callback_errors():
-    m = ff.models.load("thesis_ch5_single_arm")
+    m = ff.models.load("valverde_ch5_single_arm")
     q, v = m.neutral(), np.zeros(m.nv)
     with pytest.raises(ff.InputError, match="t_final"):
         ff.simulate(m, q, v, -1.0, 1e-3)

@@ -25,13 +25,13 @@ def test_every_command_has_help(cmd):
 
 def test_models_lists_builtins():
     r = run("models")
-    assert "seed001_dual_arm" in r.stdout and "thesis_ch7_two_arm" in r.stdout
-    assert "name: seed000_3d" in run("models", "--show", "seed000_3d").stdout
+    assert "naveen_dual_arm" in r.stdout and "valverde_ch7_two_arm" in r.stdout
+    assert "name: zhang2020_3d" in run("models", "--show", "zhang2020_3d").stdout
 
 
 def test_simulate_writes_parquet_json_and_figure(tmp_path):
     out = tmp_path / "run.parquet"
-    r = run("simulate", "thesis_ch5_single_arm", "--t-final", "1", "--out", str(out))
+    r = run("simulate", "valverde_ch5_single_arm", "--t-final", "1", "--out", str(out))
     assert "momentum drift" in r.stdout
     res = json.loads(out.with_suffix(".results.json").read_text())
     assert res["samples"] == 101 and res["momentum_drift_angular_rel"] < 1e-9
@@ -55,56 +55,56 @@ def test_bad_model_gives_one_clear_line(tmp_path):
 
 
 def test_params_minimal_prints_and_writes_table4(tmp_path):
-    r = run("params", "minimal", "seed001_dual_arm", "--method", "closed-form", "--out", str(tmp_path))
+    r = run("params", "minimal", "naveen_dual_arm", "--method", "closed-form", "--out", str(tmp_path))
     assert "52 minimal parameters" in r.stdout and "0.09*L4.m" in r.stdout
     res = json.loads((tmp_path / "results.json").read_text())
     assert res["rank"] == 52 and len(res["names"]) == len(res["expressions"]) == len(res["values"]) == 52
     assert abs(res["values"][3] - (-96.63)) < 1e-9 and res["known_bodies"] == ["wheel_x", "wheel_y", "wheel_z"]
-    r = run("params", "minimal", "seed001_dual_arm", "--known", "")
+    r = run("params", "minimal", "naveen_dual_arm", "--known", "")
     assert "73 minimal parameters" in r.stdout
 
 
 def test_params_minimal_closed_form_refuses_prismatic():
-    r = run("params", "minimal", "thesis_ch7_two_arm", "--method", "closed-form", ok=False)
+    r = run("params", "minimal", "valverde_ch7_two_arm", "--method", "closed-form", ok=False)
     assert r.returncode == 2 and 'method="numeric"' in r.stderr and "Traceback" not in r.stderr
 
 
 def test_identify_minimal_from_a_simulation_and_from_a_file(tmp_path):
-    r = run("identify", "minimal", "seed001_dual_arm", "--simulate", "16", "--out", str(tmp_path))
+    r = run("identify", "minimal", "naveen_dual_arm", "--simulate", "16", "--out", str(tmp_path))
     assert "eqs. 38-39" in r.stdout
     res = json.loads((tmp_path / "results.json").read_text())
     assert len(res["estimate"]) == 52 and res["median_rel_error_pct"] < 1.0
-    r2 = run("identify", "minimal", "seed001_dual_arm", "--data", str(tmp_path / "telemetry.parquet"))
+    r2 = run("identify", "minimal", "naveen_dual_arm", "--data", str(tmp_path / "telemetry.parquet"))
     assert "52 minimal parameters" in r2.stdout
-    bad = run("identify", "minimal", "seed001_dual_arm", ok=False)
+    bad = run("identify", "minimal", "naveen_dual_arm", ok=False)
     assert bad.returncode == 2 and "exactly one of --data" in bad.stderr
 
 
 def test_identify_minimal_full_urdf_and_weights(tmp_path):
-    r = run("identify", "minimal", "seed001_dual_arm_consistent", "--simulate", "16", "--weights", "auto", "--full",
-            "--prior", "seed001_dual_arm_offset", "--out", str(tmp_path))
+    r = run("identify", "minimal", "naveen_dual_arm_consistent", "--simulate", "16", "--weights", "auto", "--full",
+            "--prior", "naveen_dual_arm_offset", "--out", str(tmp_path))
     assert "physically consistent" in r.stdout
     res = json.loads((tmp_path / "results.json").read_text())
     assert res["consistent"]["max_rel_deviation"] < 1e-5
     # The URDF written back loads without allow_nonphysical and has the identified momentum model.
     m = ff.Model.from_urdf(tmp_path / "identified.urdf")
-    truth = ff.models.load("seed001_dual_arm_consistent")
+    truth = ff.models.load("naveen_dual_arm_consistent")
     mp = ff.minimal_parameters(truth, "closed-form")
     np.testing.assert_allclose(mp.from_standard(m.parameters()), res["estimate"], rtol=1e-4)
-    bad = run("identify", "minimal", "seed001_dual_arm", "--simulate", "16", "--weights", "1,2", ok=False)
+    bad = run("identify", "minimal", "naveen_dual_arm", "--simulate", "16", "--weights", "1,2", ok=False)
     assert bad.returncode == 2 and "--weights" in bad.stderr
 
 
 def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
-    r = run("excite", "seed001_dual_arm", "--guess", "seed001_dual_arm_offset", "--maxiter", "3", "--out", str(tmp_path))
+    r = run("excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--maxiter", "3", "--out", str(tmp_path))
     assert "pruning kept" in r.stdout and "Table 3" in r.stdout
     res = json.loads((tmp_path / "results.json").read_text())
     assert 0 < res["n_kept"] < 256 and len(res["kept_intervals"]) == res["n_kept"]
     assert (tmp_path / "fig4.png").stat().st_size > 10_000
-    r2 = run("identify", "minimal", "seed001_dual_arm", "--trajectory", str(tmp_path / "trajectory.json"),
+    r2 = run("identify", "minimal", "naveen_dual_arm", "--trajectory", str(tmp_path / "trajectory.json"),
              "--out", str(tmp_path / "id"))
-    assert "simulating seed001_dual_arm along" in r2.stdout
+    assert "simulating naveen_dual_arm along" in r2.stdout
     ident = json.loads((tmp_path / "id" / "results.json").read_text())
     assert ident["median_rel_error_pct"] < 1.0 and "bias compensation" in ident["solver"]
-    bad = run("excite", "seed001_dual_arm", "--out", str(tmp_path / "bad"), ok=False)  # Table 2 is non-physical
+    bad = run("excite", "naveen_dual_arm", "--out", str(tmp_path / "bad"), ok=False)  # Table 2 is non-physical
     assert bad.returncode != 0 and "non-physical" in bad.stderr and "Traceback" not in bad.stderr

@@ -5,22 +5,22 @@ import numpy as np
 import pytest
 
 import freefloat as ff
-from freefloat import identify as idf
+from freefloat.identification import identify as idf
 from freefloat import telemetry as tm
 from freefloat import trajectories as tr
 from freefloat._rotations import quat_to_matrix
-from freefloat.consistent import consistent_parameters, is_consistent, pseudo_inertia
-from freefloat.validation import default_fourier, predict
+from freefloat.identification.consistent import consistent_parameters, is_consistent, pseudo_inertia
+from freefloat.identification.validation import default_fourier, predict
 
 
 @pytest.fixture(scope="module")
 def consistent_robot():
-    return ff.models.load("seed001_dual_arm_consistent")
+    return ff.models.load("naveen_dual_arm_consistent")
 
 
 @pytest.fixture(scope="module")
 def prior():
-    return ff.models.load("seed001_dual_arm_offset")
+    return ff.models.load("naveen_dual_arm_offset")
 
 
 def _params(m, c, I_c):
@@ -62,7 +62,7 @@ def test_consistent_parameters_reproduce_exact_minimal_parameters(consistent_rob
 def test_verbatim_table2_has_no_consistent_representative(prior):
     # seed 001's Table 2 links are not physically consistent; no consistent robot has the same minimal
     # parameters: the nearest one misses some of them by several percent (L4.Izz, L6.Izz, L6.Ixy).
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     mp = ff.minimal_parameters(m, "closed-form")
     c = consistent_parameters(mp, mp.from_standard(m.parameters()), prior=prior)
     assert c.max_rel_deviation > 0.02
@@ -125,7 +125,7 @@ def test_noisy_identification_predicts_far_below_the_noise_floor(consistent_robo
 @pytest.fixture(scope="module")
 def thrust_run():
     """Seed 001 robot with base thrusters firing while the arms and wheels move (16 intervals, all 52 excited)."""
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     arm, wh = m.joints_tagged("arm_"), m.joints_tagged("wheel")
     start, rng_ = tr.with_wheels(np.deg2rad(idf.TABLE3_START_DEG), idf.TABLE3_RANGE_RAD)
     cyc = tr.Cycloidal(start, rng_, tr.direction_combinations(9)[::16])
@@ -196,7 +196,7 @@ def test_bias_compensation_removes_the_errors_in_variables_bias():
     # Least squares on noisy rates shrinks the estimate (about -0.05 % common mode with the paper's noise,
     # standard deviations ~10x too small). With the known rate noise the bias is removed and the reported
     # standard deviations match the actual errors (z-scores of order one).
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     telem, _ = idf.excitation_data(m, n_intervals=48, seed=5)
     truth = ff.minimal_parameters(m, "closed-form").from_standard(m.parameters())
     ls = ff.identify_minimal(m, telem)
@@ -216,7 +216,7 @@ def test_bias_compensation_removes_the_errors_in_variables_bias():
 def test_bias_compensation_refuses_a_noise_dominated_direction():
     # The first 20 direction combinations (not spread over the 256) leave one combination barely excited
     # (condition number ~4e5): compensating there would amplify noise, so the plain estimate comes back.
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     telem, _ = idf.excitation_data(m, n_intervals=20, spread=False, seed=0)
     plain = ff.identify_minimal(m, telem)
     with pytest.warns(UserWarning, match="least-excited direction"):

@@ -341,7 +341,7 @@ def test_reactions_along_a_trajectory_and_cli(tmp_path):
     import subprocess
     import sys
 
-    m = ff.models.load("thesis_ch5_single_arm")
+    m = ff.models.load("valverde_ch5_single_arm")
     tau = np.zeros(m.nv)
     tau[6:] = [0.5, -0.3, 0.2]
     table = np.tile(tau, (1001, 1))  # constant joint torques sampled every dt
@@ -355,7 +355,7 @@ def test_reactions_along_a_trajectory_and_cli(tmp_path):
         a = axes[i] / np.linalg.norm(axes[i])
         assert np.abs(r.reaction[:, i, 3:] @ a).max() < 1e-9
         np.testing.assert_allclose(r.wrench[:, i, 3:] @ a, traj.tau[:, m.idx_v[i]], atol=1e-9)
-    out = subprocess.run([sys.executable, "-m", "freefloat", "reactions", "thesis_ch5_single_arm", "--t-final", "0.2",
+    out = subprocess.run([sys.executable, "-m", "freefloat", "reactions", "valverde_ch5_single_arm", "--t-final", "0.2",
                           "--record-every", "20", "--out", str(tmp_path)], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert "peak" in out.stdout and (tmp_path / "reactions.png").exists()
@@ -364,7 +364,7 @@ def test_reactions_along_a_trajectory_and_cli(tmp_path):
 
 
 def test_simulate_with_the_dq_formulation():
-    m = ff.models.load("thesis_ch7_two_arm")
+    m = ff.models.load("valverde_ch7_two_arm")
     rng = np.random.default_rng(2)
     v0 = 0.1 * rng.normal(size=m.nv)
     tau = np.tile(0.05 * rng.normal(size=m.nv), (501, 1))

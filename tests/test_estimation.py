@@ -1,5 +1,5 @@
 """Least-squares identification from momentum (python/freefloat/estimation.py, engine crate `estimation`):
-seed001_dual_arm driven by a prescribed multi-sine on the six arm joints and three wheels; exact recovery from
+naveen_dual_arm driven by a prescribed multi-sine on the six arm joints and three wheels; exact recovery from
 noise-free momentum, consistent standard deviations under noise, agreement with numpy.linalg.lstsq on the
 explicitly built minimal regressor (eq. 26), rank deficiency reported, and the error figures (eqs. 38-39)."""
 
@@ -26,7 +26,7 @@ def run(m, joints=DRIVEN, t_final=6.0, seed=1):
 
 @pytest.fixture(scope="module")
 def case():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     mp = ff.minimal_parameters(m, method="closed-form")  # wheels are known (tagged)
     return m, mp, run(m), mp.from_standard(m.parameters())
 

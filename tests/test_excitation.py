@@ -13,7 +13,7 @@ from freefloat import trajectories as tr
 
 @pytest.fixture(scope="module")
 def guess():
-    return ff.models.load("seed001_dual_arm_offset")
+    return ff.models.load("naveen_dual_arm_offset")
 
 
 @pytest.fixture(scope="module")
@@ -165,27 +165,27 @@ def test_bad_input(guess):
     with pytest.raises(ff.InputError, match="no feasible position range"):
         exc.ExcitationDesign(guess, limits=exc.Limits(np.ones(6), np.zeros(6), np.ones(6), np.ones(6)))
     with pytest.raises(ff.InputError, match="non-physical"):
-        exc.ExcitationDesign(ff.models.load("seed001_dual_arm"))
+        exc.ExcitationDesign(ff.models.load("naveen_dual_arm"))
     with pytest.raises(ff.InputError, match="no arm joints"):
-        exc.ExcitationDesign(ff.models.load("seed000_3d"))
+        exc.ExcitationDesign(ff.models.load("zhang2020_3d"))
     with pytest.raises(ff.InputError, match="not a 1-DoF joint"):
         exc.ExcitationDesign(guess, arm=["nope"])
 
 
 def test_the_shipped_designed_trajectory():
-    """The shipped designed trajectory (freefloat/data/trajectories/, written by `freefloat excite seed001_dual_arm --guess
-    seed001_dual_arm_offset`): within the limits on a fine grid, and on the TRUE robot it excites every minimal
+    """The shipped designed trajectory (freefloat/data/trajectories/, written by `freefloat excite naveen_dual_arm --guess
+    naveen_dual_arm_offset`): within the limits on a fine grid, and on the TRUE robot it excites every minimal
     parameter (noise-free data recovers them)."""
     from freefloat import data
 
-    with data.path("trajectories", "seed001_exciting_trajectory") as p:
+    with data.path("trajectories", "naveen_exciting_trajectory") as p:
         traj, joints = exc.load_trajectory(p)
     L = exc.Limits.seed001()
     t = np.linspace(0, traj.duration, 100 * traj.n_intervals + 1)
     q, qd, qdd = traj.evaluate(t)
     assert np.all(q[:, :6] >= L.q_min - 1e-9) and np.all(q[:, :6] <= L.q_max + 1e-9)
     assert np.all(np.abs(qd[:, :6]) <= L.qd_max + 1e-9) and np.all(np.abs(qdd[:, :6]) <= L.qdd_max + 1e-9)
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     telem, _ = ff.identify.trajectory_data(m, traj, joints, dt=2e-3, noise=False)
     res = ff.identify_minimal(m, telem)
     np.testing.assert_allclose(res.estimate, res.truth_values(m), rtol=1e-7)

@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 import freefloat as ff
-from freefloat import identify as idf
+from freefloat.identification import identify as idf
 
 
 @pytest.fixture(scope="module")
 def robot():
-    return ff.models.load("seed001_dual_arm")
+    return ff.models.load("naveen_dual_arm")
 
 
 @pytest.fixture(scope="module")
@@ -67,4 +67,4 @@ def test_bad_data_is_rejected(robot):
         telem, _ = idf.excitation_data(robot, n_intervals=1, noise=False)
         ff.identify_minimal(robot, telem, h0=[0, 0])
     with pytest.raises(ff.InputError, match="seed 001 robot"):
-        idf.excitation_data(ff.models.load("seed000_3d"), n_intervals=2)
+        idf.excitation_data(ff.models.load("zhang2020_3d"), n_intervals=2)

@@ -6,7 +6,7 @@ import pytest
 import freefloat as ff
 
 
-@pytest.mark.parametrize("name,frame", [("seed001_dual_arm", "ee_A"), ("seed000_3d", "ee"), ("seed000_2d_medium", "ee")])
+@pytest.mark.parametrize("name,frame", [("naveen_dual_arm", "ee_A"), ("zhang2020_3d", "ee"), ("zhang2020_2d_medium", "ee")])
 def test_generalized_jacobian_predicts_end_effector_twist(name, frame):
     m = ff.models.load(name)
     rng = np.random.default_rng(3)
@@ -30,7 +30,7 @@ def test_generalized_jacobian_predicts_end_effector_twist(name, frame):
     np.testing.assert_allclose(Jg @ qd + off, twist, rtol=1e-10, atol=1e-10)
 
 
-@pytest.mark.parametrize("name", ["seed000_3d", "seed001_dual_arm_consistent"])
+@pytest.mark.parametrize("name", ["zhang2020_3d", "naveen_dual_arm_consistent"])
 def test_body_velocities_and_accelerations_match_pinocchio(tmp_path, name):
     pin = pytest.importorskip("pinocchio")
     m = ff.models.load(name)

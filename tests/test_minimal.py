@@ -23,7 +23,7 @@ TABLE4_ATOL = 5e-4 + 1e-9
 
 @pytest.fixture(scope="module")
 def dual_arm():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     return m, ff.minimal_parameters(m, method="numeric"), ff.minimal_parameters(m, method="closed-form")
 
 
@@ -101,7 +101,7 @@ def test_known_wheels_move_to_the_right_hand_side(dual_arm):
 
 
 def test_wheels_unknown_numeric_counts_their_columns():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     mp = ff.minimal_parameters(m, known=[])
     assert mp.known == [] and len(mp.unknown) == 10
     # each wheel on a revolute joint adds 7 (same count as a link); its spin inertia about its own axis
@@ -110,7 +110,7 @@ def test_wheels_unknown_numeric_counts_their_columns():
 
 
 def test_numeric_other_joint_types():
-    m = ff.models.load("thesis_ch7_two_arm")  # revolute, prismatic and spherical joints
+    m = ff.models.load("valverde_ch7_two_arm")  # revolute, prismatic and spherical joints
     _check_numeric_reproduces_momentum(m, seed=2)
     with pytest.raises(ValueError, match='method="numeric"'):
         ff.minimal_parameters(m, method="closed-form")
@@ -136,20 +136,20 @@ def _check_numeric_reproduces_momentum(m, seed):
 
 
 def test_numeric_is_deterministic():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     a, b = ff.minimal_parameters(m), ff.minimal_parameters(m)
     assert a.names == b.names and np.array_equal(a.matrix, b.matrix)
 
 
 def test_closed_form_rejects_non_dh_placement():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     # wheel_x spins about base x (joint axis not z): closed form must refuse once the wheels are unknown
     with pytest.raises(ValueError, match='method="numeric"'):
         ff.minimal_parameters(m, method="closed-form", known=[])
 
 
 def test_bad_arguments():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     with pytest.raises(ValueError, match="method"):
         ff.minimal_parameters(m, method="magic")
     with pytest.raises(ValueError, match="not a body"):

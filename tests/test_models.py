@@ -5,8 +5,8 @@ import pytest
 
 import freefloat as ff
 
-REQUIRED = ["seed001_dual_arm", "seed000_2d_small", "seed000_2d_medium", "seed000_2d_large", "seed000_3d",
-            "thesis_ch5_single_arm", "thesis_ch7_two_arm"]
+REQUIRED = ["naveen_dual_arm", "zhang2020_2d_small", "zhang2020_2d_medium", "zhang2020_2d_large", "zhang2020_3d",
+            "valverde_ch5_single_arm", "valverde_ch7_two_arm"]
 
 
 def test_builtin_names_and_loading():
@@ -30,7 +30,7 @@ def test_seed001_standard_parameters_match_digest_table():
         "L5": [2.725, 9.015, 21.455, 2.1125, 1.4625, 0.4825, 35, 15.75, 1.75, 1.75],
         "L6": [34.59, 60.4, 60.37, 27.1, -1.98, 21.27, 60, 36.0, -30.0, -21.0],
     }
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     P = m.parameters()
     for name, (xx, yy, zz, xy, yz, zx, mass, mx, my, mz) in digest.items():
         ours = P[m.body_index(name)]
@@ -39,7 +39,7 @@ def test_seed001_standard_parameters_match_digest_table():
 
 def test_seed001_geometry_at_zero():
     # Digest §B.3: J1 at [0.7,0.3,0.9] (+z0), J2 at [1.7,0.3,0.9] (axis -y), J3 at [2.7,0.3,0.9], J4 at [-0.3,0.3,0.9].
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     fk = ff.forward_kinematics(m, m.neutral())
     pos = {n: fk[m.body_index(n), :3] for n in ("L1", "L2", "L3", "L4")}
     np.testing.assert_allclose(pos["L1"], [0.7, 0.3, 0.9], atol=1e-12)
@@ -51,14 +51,14 @@ def test_seed001_geometry_at_zero():
 
 
 def test_seed001_table2_is_not_physical_without_the_opt_out():
-    text = ff.models.source("seed001_dual_arm").replace("allow_nonphysical: true", "allow_nonphysical: false")
+    text = ff.models.source("naveen_dual_arm").replace("allow_nonphysical: true", "allow_nonphysical: false")
     with pytest.raises(ff.ModelError, match=r"L1.*triangle"):
         ff.Model.from_yaml_string(text)
 
 
 def test_thesis_ch5_end_effector_hint():
     # thesis ch. 8 hint: with theta2 = 5 deg, theta3 = -10 deg the end effector is at [6.727, 0, 5] m.
-    m = ff.models.load("thesis_ch5_single_arm")
+    m = ff.models.load("valverde_ch5_single_arm")
     q = m.neutral()
     joints = [j for j, t in zip(m.joint_names, m.joint_types) if t == "revolute"]
     q[m.idx_q[m.joint_names.index(joints[1])]] = np.deg2rad(5)
@@ -79,7 +79,7 @@ def test_mdh_equals_explicit_placement():
     np.testing.assert_allclose(a.placements[1], T, atol=1e-14)
 
 
-@pytest.mark.parametrize("name", ["seed001_dual_arm_consistent", "seed000_3d", "seed000_2d_medium", "thesis_ch5_single_arm"])
+@pytest.mark.parametrize("name", ["naveen_dual_arm_consistent", "zhang2020_3d", "zhang2020_2d_medium", "valverde_ch5_single_arm"])
 def test_urdf_round_trip_preserves_dynamics(tmp_path, name):
     m = ff.models.load(name)
     path = tmp_path / f"{name}.urdf"
@@ -98,13 +98,13 @@ def test_urdf_round_trip_preserves_dynamics(tmp_path, name):
 def test_urdf_of_nonphysical_model_is_rejected_on_load(tmp_path):
     # URDF has no way to carry allow_nonphysical: reloading the verbatim Table 2 robot must fail loudly.
     path = tmp_path / "verbatim.urdf"
-    ff.models.load("seed001_dual_arm").to_urdf(path)
+    ff.models.load("naveen_dual_arm").to_urdf(path)
     with pytest.raises(ff.ModelError, match=r"line \d+.*'L1'.*triangle"):
         ff.Model.from_urdf(path)
 
 
 def test_with_parameters_round_trip_and_gravity():
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     P = m.parameters()
     P2 = P.copy()
     P2[-1, 0] *= 2  # heavier target

@@ -15,7 +15,7 @@ from click.testing import CliRunner
 import freefloat as ff
 from freefloat import _core
 from freefloat import postcapture as pc
-from freefloat import postcapture_equations as eq
+from freefloat.postcapture import equations as eq
 from freefloat.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,12 +34,12 @@ def yaml_truth(model_name):
 
 @pytest.fixture(scope="module")
 def medium():
-    return pc.run("seed000_2d_medium")
+    return pc.run("zhang2020_2d_medium")
 
 
 @pytest.fixture(scope="module")
 def spatial():
-    return pc.run("seed000_3d")
+    return pc.run("zhang2020_3d")
 
 
 # -- closed forms against their definitions --------------------------------------------------------------
@@ -99,7 +99,7 @@ def test_closed_forms_match_definitions():
 
 # -- simulation ------------------------------------------------------------------------------------------
 def test_simulation_obeys_eq_39_and_the_momentum_balance():
-    sc = pc.load_scenario("seed000_2d_medium")
+    sc = pc.load_scenario("zhang2020_2d_medium")
     sc.duration = 20.0
     m = ff.models.load(sc.model)
     sim = pc.simulate(sc, m)
@@ -122,7 +122,7 @@ def test_simulation_obeys_eq_39_and_the_momentum_balance():
 
 # -- identification --------------------------------------------------------------------------------------
 def test_truth_vector_is_the_model_file(medium):
-    tr = yaml_truth("seed000_2d_medium")
+    tr = yaml_truth("zhang2020_2d_medium")
     (m1, b1, I1), (mn, bn, In) = tr["base"], tr["target"]
     np.testing.assert_allclose(medium.truth, [m1, b1[0], b1[1], I1[2, 2], mn, bn[0], bn[1], In[2, 2]], rtol=1e-12)
     # and Table 2 / the paper's results (digest §9)
@@ -162,7 +162,7 @@ def test_standard_form_is_at_least_as_accurate(medium, spatial):
 
 def test_noise_free_3d(spatial):
     names = spatial.names
-    tr = yaml_truth("seed000_3d")
+    tr = yaml_truth("zhang2020_3d")
     assert spatial.truth[names.index("mn")] == tr["target"][0]
     for method in pc.METHODS:
         for solver in pc.SOLVERS:
@@ -181,7 +181,7 @@ def test_mass_and_com_do_not_depend_on_the_solver(medium):
 
 def test_velocity_sweep_reproduces_the_papers_trend():
     """Figs. 6-9: momentum-based I'_n error grows with the initial base velocity, force-based does not."""
-    sc = pc.load_scenario("seed000_2d_sweep")
+    sc = pc.load_scenario("zhang2020_2d_sweep")
     sw = pc.sweep(sc, velocities=[[0, 10], [200, 200]])
     j = sw["names"].index("In")
     mom = np.asarray(sw["errors"]["momentum/modified_rls"])[:, j]
@@ -191,7 +191,7 @@ def test_velocity_sweep_reproduces_the_papers_trend():
 
 
 def test_noise_degrades_gracefully():
-    sc = pc.load_scenario("seed000_2d_medium")
+    sc = pc.load_scenario("zhang2020_2d_medium")
     sc.noise = dict(pc.DEFAULT_NOISE)
     res = pc.run(sc, seed=1)
     for method in pc.METHODS:
@@ -202,7 +202,7 @@ def test_noise_degrades_gracefully():
 
 # -- command line ----------------------------------------------------------------------------------------
 def test_cli_identify_postcapture(tmp_path):
-    r = CliRunner().invoke(main, ["identify", "postcapture", "seed000_2d_small", "--out", str(tmp_path)])
+    r = CliRunner().invoke(main, ["identify", "postcapture", "zhang2020_2d_small", "--out", str(tmp_path)])
     assert r.exit_code == 0, r.output
     assert "momentum-based" in r.output and "paper force" in r.output
     data = json.loads((tmp_path / "results.json").read_text())
@@ -212,7 +212,7 @@ def test_cli_identify_postcapture(tmp_path):
     assert entry["paper"] == [5.2, 13.4]  # Table 4
     assert (tmp_path / "momentum_estimates.png").exists() and (tmp_path / "force_estimates.png").exists()
     r = CliRunner().invoke(main, ["scenarios"])
-    assert r.exit_code == 0 and "seed000_3d" in r.output
+    assert r.exit_code == 0 and "zhang2020_3d" in r.output
 
 
 # -- bad input -------------------------------------------------------------------------------------------
@@ -268,7 +268,7 @@ def test_modified_rls_bad_samples_raise_clear_errors():
 
 
 def test_target_must_be_welded_to_the_end_effector():
-    text = ff.models.source("seed000_2d_medium")
+    text = ff.models.source("zhang2020_2d_medium")
     loose = ff.Model.from_yaml_string(text.replace("joint: {name: grasp, type: fixed}",
                                                    "joint: {name: grasp, type: revolute, axis: [0, 0, 1]}"))
     with pytest.raises(ff.InputError, match="welded"):
@@ -278,11 +278,11 @@ def test_target_must_be_welded_to_the_end_effector():
 
 
 def test_simulation_bad_input():
-    sc = pc.load_scenario("seed000_2d_medium")
+    sc = pc.load_scenario("zhang2020_2d_medium")
     sc.excitation["amp"] = [0.02]
     with pytest.raises(ff.InputError, match="excitation_amp"):
         pc.simulate(sc)
-    sc = pc.load_scenario("seed000_2d_medium")
+    sc = pc.load_scenario("zhang2020_2d_medium")
     sc.v0[0] = np.nan
     with pytest.raises(ff.InputError, match="v0"):
         pc.simulate(sc)
@@ -291,14 +291,14 @@ def test_simulation_bad_input():
 def test_projection_and_forgetting_options():
     """The projection leaves consistent (here: the true) parameters alone and repairs a non-physical set;
     a forgetting factor close to 1 still converges on noise-free data."""
-    truth = np.array(ff.models.load("seed000_2d_medium").parameters())[4]
+    truth = np.array(ff.models.load("zhang2020_2d_medium").parameters())[4]
     np.testing.assert_allclose(eq.project_consistent(truth), truth, rtol=1e-9)
     bad = truth.copy()
     bad[4] = -1.0  # Ixx < 0: violates positivity
     fixed = eq.project_consistent(bad)
     m, b, Ic = eq.from_standard(fixed[None])
     assert m[0] > 0 and np.linalg.eigvalsh(Ic[0]).min() >= -1e-9
-    sc = pc.load_scenario("seed000_2d_medium")
+    sc = pc.load_scenario("zhang2020_2d_medium")
     sc.forgetting, sc.project = 0.9999, True
     res = pc.run(sc)
     assert res.rel_error("momentum", "standard_rls").max() < 1e-3
@@ -307,7 +307,7 @@ def test_projection_and_forgetting_options():
 def test_measurement_options():
     """Central differences of the sampled velocities approximate the exact accelerations (to the O(h²) error of a
     0.1 s step) and drop the two end samples; an unknown mode is an InputError."""
-    sc = pc.load_scenario("seed000_2d_medium")
+    sc = pc.load_scenario("zhang2020_2d_medium")
     sc.duration = 10.0
     m = ff.models.load(sc.model)
     sim = pc.simulate(sc, m)

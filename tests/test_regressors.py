@@ -19,7 +19,7 @@ GRAVITY = np.array([0.3, -1.2, -9.81])
 
 
 def test_regressors_reproduce_momentum_and_rnea():
-    m = ff.models.load("seed001_dual_arm").with_gravity(GRAVITY)
+    m = ff.models.load("naveen_dual_arm").with_gravity(GRAVITY)
     rng = np.random.default_rng(5)
     q = m.random_configuration(rng)
     v, a = rng.normal(size=m.nv), rng.normal(size=m.nv)
@@ -31,7 +31,7 @@ def test_regressors_reproduce_momentum_and_rnea():
 
 
 def test_stacked_equals_loop():
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     rng = np.random.default_rng(6)
     T = 4
     q = np.array([m.random_configuration(rng) for _ in range(T)])
@@ -46,7 +46,7 @@ def test_stacked_equals_loop():
 
 
 def test_bad_input_names_the_argument():
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     q, v = m.neutral(), np.zeros(m.nv)
     with pytest.raises(ff.InputError, match=r"`v`.*\(12\) or \(T, 12\)"):
         ff.momentum_regressor(m, q, v[:-1])
@@ -158,12 +158,12 @@ def compare(m, side, rng, n_states=3):
 
 @needs_pin
 @pytest.mark.parametrize("gravity", [np.zeros(3), GRAVITY], ids=["zero_g", "g"])
-@pytest.mark.parametrize("name", ["seed001_dual_arm_consistent", "seed000_3d"])
+@pytest.mark.parametrize("name", ["naveen_dual_arm_consistent", "zhang2020_3d"])
 def test_builtin_robots_match_pinocchio(tmp_path, name, gravity):
     m = ff.models.load(name).with_gravity(gravity)
     side = PinSide.from_urdf(m, tmp_path / "robot.urdf")
     merged = sum(1 for t in m.joint_types if t == "fixed")
-    assert side.model.njoints - 1 == m.nbodies - merged  # seed000_3d's target is merged into link6 by Pinocchio
+    assert side.model.njoints - 1 == m.nbodies - merged  # zhang2020_3d's target is merged into link6 by Pinocchio
     compare(m, side, np.random.default_rng(12))
 
 

@@ -9,7 +9,7 @@ import freefloat as ff
 
 @pytest.fixture(scope="module")
 def robot():
-    return ff.models.load("seed001_dual_arm")
+    return ff.models.load("naveen_dual_arm")
 
 
 def state(m, seed=0):
@@ -55,7 +55,7 @@ def test_internal_torques_conserve_momentum_and_energy(robot):
 
 def test_thruster_wrench_changes_momentum_by_its_impulse():
     # Linear momentum obeys dp/dt = R(t) F for a base-frame force F; check the integral over the run.
-    m = ff.models.load("seed000_3d")
+    m = ff.models.load("zhang2020_3d")
     q, v = m.neutral(), np.zeros(m.nv)
     v[3:6] = [0.05, -0.02, 0.03]
     F = np.array([3.0, -1.0, 2.0])

@@ -11,7 +11,7 @@ from freefloat._core import InputError
 
 @pytest.fixture(scope="module")
 def robot():
-    return ff.models.load("seed001_dual_arm")
+    return ff.models.load("naveen_dual_arm")
 
 
 @pytest.fixture(scope="module")
@@ -147,7 +147,7 @@ def test_noise_leaks_into_reconstructed_poses(robot, true_telemetry):
 
 
 def test_integrate_poses_constant_rotation():
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     # Constant body angular velocity about z for 1 s: exact quaternion (0, 0, sin(w/2), cos(w/2)).
     t = np.linspace(0, 1, 101)
     v = np.zeros((101, m.nv))

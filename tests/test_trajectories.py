@@ -16,7 +16,7 @@ TABLE3_RANGE = np.array([0.524, 2.51, 2.51, 2.513, 2.036, 2.5])
 
 @pytest.fixture(scope="module")
 def robot():
-    return ff.models.load("seed001_dual_arm")
+    return ff.models.load("naveen_dual_arm")
 
 
 def test_direction_combinations_count_unique_and_fixed():

@@ -1,14 +1,18 @@
 """freefloat: model, simulate, excite, identify and control free-floating space robots.
 
     import freefloat as ff
-    m = ff.models.load("seed001_dual_arm")
+    m = ff.models.load("naveen_dual_arm")
     q, v = m.neutral(), np.zeros(m.nv)
     ff.momentum(m, q, v); ff.aba(m, q, v, tau)
     traj = ff.simulate(m, q, v, t_final=10.0, dt=1e-3)
 
-Conventions are in docs/architecture.md; every number is computed by the Rust engine."""
+The package follows the pipeline a user walks (docs/architecture.md): the core (`model`, `models`, `algorithms`,
+`trajectories`, `simulation`), `io` (telemetry and trajectory files, shipped data), `identification` (minimal
+parameters, excitation design, least squares, consistent parameters, validation, online estimators),
+`postcapture` (Zhang, Yue, Yuan 2020), `dq` (Valverde 2018's dual quaternions and reaction wrenches), `control`,
+`viz` (plotting helpers) and `cli` (the `freefloat` command). Every number is computed by the Rust engine."""
 
-from . import dq, estimation, excitation, models, online, reactions, telemetry, trajectories
+from . import constants, control, dq, identification, io, models, trajectories, viz
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
@@ -29,20 +33,32 @@ from .algorithms import (
     momentum_regressor,
     rnea,
 )
-from .minimal import MinimalParameters, minimal_parameters
+from .dq import reactions
+from .identification import (
+    IdentificationResult,
+    MinimalParameters,
+    estimation,
+    excitation,
+    identify,
+    identify_minimal,
+    minimal,
+    minimal_parameters,
+    online,
+)
+from .io import Telemetry, telemetry
 from .model import Model
 from .simulation import Trajectory, simulate
-from .telemetry import Telemetry
-from .identify import IdentificationResult, identify_minimal
 
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "Trajectory", "models", "dq", "online", "reactions", "simulate", "telemetry", "trajectories", "excitation", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
+    "Model", "Trajectory", "models", "dq", "online", "reactions", "simulate", "telemetry", "trajectories",
+    "excitation", "Telemetry", "estimation", "identify_minimal", "IdentificationResult",
     "aba", "rnea", "crba", "hybrid_dynamics", "dq_dynamics",
-    "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
-    "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
+    "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian",
+    "generalized_jacobian", "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
     "momentum_regressor", "dynamics_regressor",
     "minimal_parameters", "MinimalParameters",
     "ModelError", "InputError", "NumericalError",
+    "constants", "control", "identification", "identify", "io", "minimal", "viz",
 ]

@@ -12,12 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._core import InputError
-
-#: Reaction-wheel seeds predetermined by seed 001 Sec. VI.A.2 (digest B.1): start 0 rad, range 3π rad
-#: per 1-s interval, i.e. a peak rate of 2·3π/1 = 6π rad/s (18.8496 kg·m²/s for the 1 kg·m² wheel).
-WHEEL_START = 0.0
-WHEEL_RANGE = 3.0 * np.pi
-
+from .constants import WHEEL_RANGE, WHEEL_START
 
 def direction_combinations(n: int, fixed: int = 0, fastest: str = "last") -> np.ndarray:
     """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (seed 001 V.B:

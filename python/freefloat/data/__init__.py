@@ -1,65 +1,12 @@
-"""Files shipped inside the package: built-in post-capture scenarios and designed trajectories.
-
-They are found with `importlib.resources`, so they work the same from a wheel, a normal install and an editable
-install of a source checkout. Built-in robots are not here: they are embedded in the engine (`ff.models`).
+"""Files shipped inside the package: built-in post-capture scenarios (`scenarios/*.yaml`) and designed joint
+trajectories (`trajectories/*.json`). This package only anchors them for `importlib.resources`; the functions to
+list and read them live in `freefloat.io.data` and are re-exported here.
 
     from freefloat import data
-    data.names("scenarios")                         # ['seed000_2d_large', ...]
-    data.read_text("scenarios", "seed000_2d_medium")  # the YAML text
-    with data.path("trajectories", "seed001_exciting_trajectory") as p: ...
+    data.names("scenarios")                             # ['zhang2020_2d_large', ...]
+    data.read_text("scenarios", "zhang2020_2d_medium")  # the YAML text
 """
 
-from __future__ import annotations
+from ..io.data import ALIASES, KINDS, exists, names, path, read_text, resolve
 
-import contextlib
-from importlib import resources
-from pathlib import Path
-from typing import Iterator
-
-from .._core import InputError
-
-#: kind -> file suffix of the shipped files
-KINDS = {"scenarios": ".yaml", "trajectories": ".json"}
-
-
-def _folder(kind: str):
-    if kind not in KINDS:
-        raise InputError(f"unknown data kind '{kind}' (one of: {', '.join(KINDS)})")
-    return resources.files(__name__).joinpath(kind)
-
-
-def names(kind: str) -> list[str]:
-    """Names (file stems) of the shipped files of one kind, sorted."""
-    folder = _folder(kind)
-    suffix = KINDS[kind]
-    return sorted(p.name[: -len(suffix)] for p in folder.iterdir() if p.name.endswith(suffix))
-
-
-def _entry(kind: str, name: str):
-    suffix = KINDS.get(kind, "")
-    f = _folder(kind).joinpath(name if name.endswith(suffix) else name + suffix)
-    if not f.is_file():
-        raise InputError(f"no built-in {kind[:-1]} '{name}' (built-in: {', '.join(names(kind))})")
-    return f
-
-
-def exists(kind: str, name: str) -> bool:
-    """Whether a shipped file of that kind and name exists."""
-    try:
-        _entry(kind, name)
-        return True
-    except InputError:
-        return False
-
-
-def read_text(kind: str, name: str) -> str:
-    """The text of a shipped file."""
-    return _entry(kind, name).read_text(encoding="utf-8")
-
-
-@contextlib.contextmanager
-def path(kind: str, name: str) -> Iterator[Path]:
-    """A real file-system path to a shipped file for the duration of the `with` block (extracted to a
-    temporary file only if the package is imported from an archive)."""
-    with resources.as_file(_entry(kind, name)) as p:
-        yield Path(p)
+__all__ = ["ALIASES", "KINDS", "exists", "names", "path", "read_text", "resolve"]

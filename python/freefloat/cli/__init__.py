@@ -1,0 +1,48 @@
+"""Command line: `freefloat --help` lists the commands; each has its own `--help`.
+
+One module per command group, each a thin layer over the library: `models`, `simulate`, `reactions`, `demo`,
+`params`, `identify` (+ `postcapture` for `identify postcapture` and `scenarios`), `excite`. A new command goes
+in its own module and is registered below.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import click
+
+from .. import _core
+from . import demo, excite, identify, models, params, postcapture, reactions, simulate
+
+
+class FriendlyGroup(click.Group):
+    """Turn the engine's errors into one clear line instead of a traceback."""
+
+    def invoke(self, ctx):
+        try:
+            return super().invoke(ctx)
+        except (_core.ModelError, _core.InputError, _core.NumericalError, FileNotFoundError) as e:
+            click.echo(f"error: {e}", err=True)
+            sys.exit(2)
+
+
+@click.group(cls=FriendlyGroup, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="freefloat")
+def main():
+    """freefloat: model, simulate and identify free-floating space robots.
+
+    Start with `freefloat demo`, list robots with `freefloat models`, and simulate one with
+    `freefloat simulate naveen_dual_arm --out run.parquet`."""
+
+
+main.add_command(models.models_cmd)
+main.add_command(simulate.simulate_cmd)
+main.add_command(reactions.reactions_cmd)
+main.add_command(demo.demo_cmd)
+main.add_command(params.params_group)
+main.add_command(identify.identify_group)
+identify.identify_group.add_command(postcapture.identify_postcapture_cmd)
+main.add_command(excite.excite_cmd)
+main.add_command(postcapture.scenarios_cmd)
+
+__all__ = ["main"]

@@ -1,0 +1,127 @@
+"""`freefloat identify`: the group, and `identify minimal` (minimal parameters from telemetry, optionally a full
+consistent set and validation by prediction). `identify postcapture` is in `cli.postcapture`."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import click
+import numpy as np
+
+from ._common import load_model, parse_vector
+
+
+@click.group("identify", context_settings={"help_option_names": ["-h", "--help"]})
+def identify_group():
+    """Identify inertial parameters from measured (or simulated) motion.
+
+    `freefloat identify minimal MODEL --data FILE` estimates the minimal parameters (the combinations the
+    momentum model can see; `freefloat params minimal MODEL` lists them) from telemetry of a free-floating
+    robot."""
+
+
+@identify_group.command("minimal")
+@click.argument("model")
+@click.option("--data", type=click.Path(), help="Telemetry file (.parquet or .csv) with columns t, q.<label>, v.<label> "
+                                                  "(labels as in a `freefloat simulate` output) and optionally momentum.px ... momentum.Lz "
+                                                  "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).")
+@click.option("--simulate", "n_sim", type=int, help="Instead of --data: simulate N one-second excitation intervals of the "
+                                                     "seed 001 robot (cycloids from the paper's Table 3 seeds) with the paper's rate noise.")
+@click.option("--trajectory", "traj_file", type=click.Path(exists=True, dir_okay=False),
+              help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
+                   "`freefloat excite`) with the paper's rate noise, and identify from that.")
+@click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="closed-form", show_default=True,
+              help="Minimal-parameter set: seed 001's closed form (revolute trees in modified-DH frames) or numeric (any robot).")
+@click.option("--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel').")
+@click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns (default: those, else zero).")
+@click.option("--weights", help="Weighted least squares: 'auto' (two steps: each momentum component weighted by the inverse "
+                                "of its residual variance) or six inverse variances for px,py,pz,Lx,Ly,Lz (default: unweighted).")
+@click.option("--rate-noise", help="Standard deviations of the white noise on the measured rates, 'base linear, base "
+                                   "angular, joint' (e.g. 50e-6,80e-6,50e-6, or 'paper' for those): removes the "
+                                   "errors-in-variables bias of least squares (with --simulate, 'paper' is the default).")
+@click.option("--full/--no-full", default=False, show_default=True,
+              help="Also compute a full, physically consistent set of standard parameters that reproduces the identified "
+                   "minimal ones (a convex program) and write it as OUT/identified.urdf.")
+@click.option("--prior", help="With --full/--validate: the model (built-in name or file) whose parameters choose the "
+                              "parts the data cannot see (default: MODEL itself; for seed001 try naveen_dual_arm_offset).")
+@click.option("--validate/--no-validate", default=False, show_default=True,
+              help="Predict base twist and joint torques of the true (MODEL) and identified robots along the paper's "
+                   "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to seed 001 Table 6. Implies --full.")
+@click.option("--truth/--no-truth", default=True, show_default=True,
+              help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).")
+@click.option("--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf).")
+def identify_minimal_cmd(model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, out):
+    """Estimate the minimal inertial parameters of MODEL from motion data.
+
+    The robot floats freely, so its total momentum is conserved (zero when released at rest) or changes by the
+    recorded external impulses (wrench.* columns): the momentum model then relates the measured base and joint
+    motion to the unknown parameters linearly. Bodies with known parameters (reaction wheels) supply the scale.
+    Prints the estimate with standard deviations (and the true value and relative error with --truth) and the
+    paper's error figures; --full gives a complete URDF back, --validate checks it by prediction.
+
+    Example: freefloat identify minimal naveen_dual_arm_consistent --simulate 64 --validate
+    --prior naveen_dual_arm_offset --out ident/"""
+    from ..identification import identify as idf
+
+    m = load_model(model)
+    if sum(x is not None for x in (data, n_sim, traj_file)) != 1:
+        raise click.UsageError("give exactly one of --data FILE, --simulate N and --trajectory FILE")
+    known_list = None if known is None else [k for k in known.split(",") if k]
+    h = None if h0 is None else parse_vector(h0, 6, "--h0", np.zeros(6))
+    w = None if weights is None else ("auto" if weights.strip() == "auto" else parse_vector(weights, 6, "--weights", None))
+    if rate_noise is None and (n_sim is not None or traj_file is not None) and w is None:
+        rate_noise = "paper"  # the simulated data carries the paper's noise, so its levels are known
+    if rate_noise is not None and rate_noise.strip() == "paper":
+        from ..constants import SIGMA_ANG, SIGMA_JOINT, SIGMA_LIN
+
+        rate_noise = f"{SIGMA_LIN},{SIGMA_ANG},{SIGMA_JOINT}"
+    sig = None if rate_noise is None else parse_vector(rate_noise, 3, "--rate-noise", None)
+    if n_sim is not None:
+        click.echo(f"simulating {n_sim} excitation intervals of {m.name} with the paper's rate noise ...")
+        data, _ = idf.excitation_data(m, n_intervals=n_sim, progress=True)
+    if traj_file is not None:
+        from ..io.trajectory_files import load_trajectory
+
+        trajectory, joints = load_trajectory(traj_file)
+        click.echo(f"simulating {m.name} along {traj_file} ({trajectory.duration:g} s) with the paper's rate noise ...")
+        data, _ = idf.trajectory_data(m, trajectory, joints, progress=True)
+    if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results
+        Path(out).mkdir(parents=True, exist_ok=True)
+        data.to_parquet(Path(out) / "telemetry.parquet")
+    res = idf.identify_minimal(m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig)
+    click.echo(res.table(truth=m if truth else None))
+    summary = res.to_dict(truth=m if truth else None)
+    if out:
+        res.save(out, truth=m if truth else None)
+        click.echo(f"wrote {out}/results.json" + (f" and {out}/minimal_parameters.png" if truth else ""))
+    if full or validate:
+        summary.update(_full_and_validate(m, res, prior, validate, out))
+        if out:
+            Path(out, "results.json").write_text(json.dumps(summary, indent=2))
+
+
+def _full_and_validate(m, res, prior, validate, out) -> dict:
+    """--full / --validate of `identify minimal`: consistent standard parameters, URDF, Table 6 prediction."""
+    from ..identification.validation import identified_model, predict
+
+    prior_model = None if prior is None else load_model(prior)
+    click.echo("\nphysically consistent standard parameters (convex program) ...")
+    ident, c, how = identified_model(m, res, prior_model)
+    click.echo(f"  reproduces the identified minimal parameters to {c.max_rel_deviation:.3g} relative "
+               f"(whitened misfit {c.misfit:.3g}); smallest pseudo-inertia eigenvalue {c.min_eigenvalue.min():.3g}; "
+               f"solver {c.solver}")
+    extra = {"consistent": {"parameters": c.parameters.tolist(), "max_rel_deviation": c.max_rel_deviation,
+                            "misfit": c.misfit, "solver": c.solver}}
+    if out:
+        c.model(m).to_urdf(Path(out) / "identified.urdf")
+        click.echo(f"  wrote {out}/identified.urdf")
+    if validate:
+        click.echo(f"prediction along the Fourier trajectory of Sec. VI.D (40 s, both robots); identified robot: {how} ...")
+        pred = predict(m, ident, progress=True)
+        click.echo(pred.table())
+        extra["prediction"] = pred.to_dict() | {"identified_robot": how}
+        if out:
+            pred.save(out)
+            click.echo(f"  wrote {out}/prediction.json and {out}/prediction_errors.png")
+    return extra

@@ -1,0 +1,69 @@
+"""Figures of the post-capture reproduction (Zhang, Yue, Yuan 2020): estimate histories (Figs. 4-5 style) and
+the initial-velocity sweep (Figs. 6-9 style)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..viz import pyplot
+from .estimators import METHODS, SOLVERS
+from .results import SOLVER_TITLES, PostcaptureResult, _is_product
+
+
+def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
+    """Figs. 4-5 style: estimate / truth versus time, one figure per method (both solvers)."""
+    plt = pyplot()
+    paths = []
+    for method in METHODS:
+        if (method, "modified_rls") not in res.histories:
+            continue
+        show = [j for j, n in enumerate(res.names) if not _is_product(n)]
+        ncol = 4
+        nrow = int(np.ceil(len(show) / ncol))
+        fig, axes = plt.subplots(nrow, ncol, figsize=(3.2 * ncol, 2.4 * nrow), constrained_layout=True, squeeze=False)
+        for ax, j in zip(axes.ravel(), show):
+            for solver, style in zip(SOLVERS, ("-", "--")):
+                t, h = res.histories[(method, solver)]
+                tr = res.truth[j]
+                y = h[:, j] / tr if tr != 0 else h[:, j]
+                ax.plot(t, y, style, label=SOLVER_TITLES[solver])
+            ax.set_title(res.names[j] + (" / truth" if res.truth[j] != 0 else " (truth 0)"))
+            if res.truth[j] != 0:
+                ax.set_ylim(0.9, 1.1)
+            ax.grid(alpha=0.3)
+        for ax in axes[-1]:
+            ax.set_xlabel("t [s]")
+        for ax in axes.ravel()[len(show):]:
+            ax.axis("off")
+        axes[0, 0].legend(fontsize=7)
+        fig.suptitle(f"{res.scenario.name}: {method}-based identification (estimate / truth)")
+        p = out / f"{method}_estimates.png"
+        fig.savefig(p, dpi=110)
+        plt.close(fig)
+        paths.append(p)
+    return paths
+
+
+def plot_sweep(sw: dict, out: Path, params=("In", "I1", "mn", "bnx")) -> Path:
+    """Figs. 6-9 style: relative error vs |initial base velocity|, one panel per parameter."""
+    plt = pyplot()
+    names = sw["names"]
+    speed = np.linalg.norm(np.asarray(sw["velocities"]), axis=1)
+    order = np.argsort(speed, kind="stable")
+    fig, axes = plt.subplots(1, len(params), figsize=(4 * len(params), 3.4), constrained_layout=True)
+    for ax, p in zip(axes, params):
+        j = names.index(p)
+        for key, errs in sw["errors"].items():
+            e = np.asarray(errs)[:, j] * 100
+            ax.semilogy(speed[order], np.maximum(e[order], 1e-12), "o", label=key, ms=4, alpha=0.8)
+        ax.set_xlabel("|v_base(0)| [m/s]")
+        ax.set_ylabel("relative error [%]")
+        ax.set_title(p)
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7)
+    p = Path(out) / "velocity_sweep.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    return p

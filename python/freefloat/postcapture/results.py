@@ -1,0 +1,135 @@
+"""Results of a post-capture identification: histories, final errors, transit times, the table beside the
+paper's values, results.json; the tables of the velocity sweep and the noise study."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .estimators import METHODS, SOLVERS
+from .scenario import Scenario
+
+SOLVER_TITLES = {"modified_rls": "paper (modified RLS)", "standard_rls": "standard params (RLS)"}
+
+
+def transit_times(t, hist, truth, tol, zero_abs=1e-8):
+    """Per parameter: (first time within tolerance, time after which it stays within). Relative
+    tolerance; for a zero true value the paper's absolute 1e-8 (Table 6 note)."""
+    out = []
+    for j in range(hist.shape[1]):
+        err = np.abs(hist[:, j] - truth[j])
+        ok = err <= (tol * abs(truth[j]) if truth[j] != 0 else zero_abs)
+        first = float(t[np.argmax(ok)]) if ok.any() else None
+        bad = np.nonzero(~ok)[0]
+        stays = None if not ok[-1] else (float(t[0]) if len(bad) == 0 else float(t[bad[-1] + 1]))
+        out.append((first, stays))
+    return out
+
+
+@dataclass
+class PostcaptureResult:
+    scenario: Scenario
+    names: list
+    truth: np.ndarray
+    histories: dict          # (method, solver) -> (t (N,), params (N, P))
+    timings: dict
+    residuals: dict = field(default_factory=dict)
+
+    def final(self, method, solver):
+        return self.histories[(method, solver)][1][-1]
+
+    def rel_error(self, method, solver):
+        tr = self.truth
+        est = self.final(method, solver)
+        return np.where(tr != 0, np.abs(est - tr) / np.where(tr != 0, np.abs(tr), 1), np.abs(est - tr))
+
+    def transits(self, method, solver):
+        t, h = self.histories[(method, solver)]
+        return transit_times(t, h, self.truth, self.scenario.tolerance)
+
+    def to_dict(self) -> dict:
+        out = {"scenario": self.scenario.name, "model": self.scenario.model, "tolerance": self.scenario.tolerance,
+               "P0": self.scenario.P0, "forgetting": self.scenario.forgetting, "projected": self.scenario.project,
+               "duration": self.scenario.duration, "timings_s": self.timings, "equation_residuals_at_truth": self.residuals,
+               "noise": self.scenario.noise, "measurement": self.scenario.measurement, "methods": {}}
+        for (method, solver), (t, h) in self.histories.items():
+            tt = self.transits(method, solver)
+            err = self.rel_error(method, solver)
+            out["methods"].setdefault(method, {})[solver] = {
+                n: {"truth": float(self.truth[j]), "estimate": float(h[-1, j]),
+                    "error": float(err[j]), "error_kind": "relative" if self.truth[j] != 0 else "absolute",
+                    "transit_time": tt[j][1], "first_within": tt[j][0],
+                    "paper": self.scenario.paper.get(method, {}).get(n)}
+                for j, n in enumerate(self.names)}
+        return out
+
+    def table(self) -> str:
+        """Our final estimates (transit time to the scenario's tolerance, 'stays' reading) beside the paper's."""
+        tol = self.scenario.tolerance
+        lines = [f"{self.scenario.name}: final estimates at t = {self.scenario.duration:g} s, "
+                 f"(transit time to {tol * 100:g} %, after which the estimate stays within)"]
+        for method in METHODS:
+            if (method, "modified_rls") not in self.histories:
+                continue
+            paper = self.scenario.paper.get(method, {})
+            hdr = f"{'param':>6} {'truth':>12} | {'paper ' + method:>22} | " + " | ".join(
+                f"{SOLVER_TITLES[s]:>30}" for s in SOLVERS)
+            lines += ["", f"{method}-based", hdr, "-" * len(hdr)]
+            tr = {s: self.transits(method, s) for s in SOLVERS}
+            err = {s: self.rel_error(method, s) for s in SOLVERS}
+            for j, n in enumerate(self.names):
+                if n not in paper and paper and _is_product(n):
+                    continue
+                p = paper.get(n)
+                ptxt = "" if p is None or p[0] is None else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (-)"))
+                cells = []
+                for s in SOLVERS:
+                    e = self.final(method, s)[j]
+                    tt = tr[s][j][1]
+                    cells.append(f"{e:>13.6g} ({'-' if tt is None else f'{tt:.1f}'} s, {err[s][j]:.1e})")
+                lines.append(f"{n:>6} {self.truth[j]:>12.6g} | {ptxt:>22} | " + " | ".join(f"{c:>30}" for c in cells))
+        lines.append("")
+        lines.append("(error in brackets: relative, absolute for a zero true value; '-' = not within tolerance at the end)")
+        return "\n".join(lines)
+
+    def save(self, out) -> Path:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "results.json").write_text(json.dumps(self.to_dict(), indent=1))
+        (out / "table.txt").write_text(self.table() + "\n")
+        from .plots import plot_histories
+
+        plot_histories(self, out)
+        return out / "results.json"
+
+
+def _is_product(n):
+    return n[-2:] in ("xy", "xz", "yz") and n[0] == "I"
+
+
+def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx"), paper: dict | None = None) -> str:
+    names = sw["names"]
+    cols = [names.index(p) for p in params]
+    lines = ["relative error (%) at the end of the run vs initial base velocity [m/s]",
+             f"{'velocity':>14} {'method/solver':>26} " + " ".join(f"{p:>10}" for p in params)]
+    for k, v in enumerate(sw["velocities"]):
+        for key, errs in sw["errors"].items():
+            lines.append(f"{str([round(x, 1) for x in v]):>14} {key:>26} " + " ".join(f"{100 * errs[k][c]:>10.4f}" for c in cols))
+    if paper:
+        lines.append("paper (text of Sec. V-A-3): momentum-based I'n " + ", ".join(
+            f"{p['error_percent']} % at {p['velocity']}" for p in paper.get("momentum_In", []))
+            + f"; force-based: {paper.get('force_In', '')}")
+    return "\n".join(lines)
+
+
+def noise_table(ns: dict) -> str:
+    names = ns["names"]
+    lines = ["median relative error (%) at the end of the run; noise = DEFAULT_NOISE × scale"]
+    lines.append(f"{'scale':>6} {'method/solver':>24} " + " ".join(f"{n:>9}" for n in names))
+    for lv in ns["levels"]:
+        for key, e in lv["median_error"].items():
+            lines.append(f"{lv['scale']:>6g} {key:>24} " + " ".join(f"{100 * x:>9.4f}" for x in e))
+    return "\n".join(lines)
