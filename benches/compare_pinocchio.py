@@ -417,7 +417,7 @@ def make_croc(pm, dt, poly_two):
 
 def sim_crocoddyl(pm, q0, v0, t_final, dt, poly_two=False):
     """One C++ RK4 step per Python call. Default control parametrization: u held over the step, set
-    to the torque at mid-step (as in the Pinocchio baseline digest). poly_two: quadratic control
+    to the torque at mid-step (as in our earlier Pinocchio baseline). poly_two: quadratic control
     through (t, t+dt/2, t+dt), i.e. the exact stage torques, the same forcing as the other runs."""
     iam = make_croc(pm, dt, poly_two)
     d = iam.createData()
@@ -481,7 +481,7 @@ def sim_crocoddyl_rollout_prebuilt(pm, q0, v0, t_final, dt, chunk=1000):
 
 def sim_crocoddyl_rollout(pm, q0, v0, t_final, dt, chunk=1000):
     """Crocoddyl's own C++ loop: ShootingProblem.rollout with PolyTwoRK control (the exact stage
-    torques, as the ff table run). A 10 000-node problem takes about 9 GB (research digest), so the
+    torques, as the ff table run). A 10 000-node problem takes about 9 GB (measured), so the
     horizon is rolled out in chunks of `chunk` nodes, each starting where the previous ended; the
     per-step work is the same. Controls are built inside the timing, as freefloat's torque table is."""
     import crocoddyl

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Cost per evaluation of the dual-quaternion formulation (`ff.dq_dynamics`, seed 003 ch. 6) against the
+"""Cost per evaluation of the dual-quaternion formulation (`ff.dq_dynamics`, Valverde 2018 ch. 6) against the
 engine's ABA, and ABA + one RNEA pass (what the recursive engine needs to give the same joint wrenches).
 
 Each call is timed on a stacked batch of N random states (one Rust loop, GIL released), divided by N, so

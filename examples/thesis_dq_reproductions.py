@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Dissertation seed 003: the chapter 5 single-arm runs (smooth (5.141) and discontinuous (5.142) inputs, 70 s)
+"""Dissertation Valverde 2018: the chapter 5 single-arm runs (smooth (5.141) and discontinuous (5.142) inputs, 70 s)
 and the chapter 7 two-arm, 11-body run ((7.16) inputs, 20 s), with the quantities of Figs. 5.3-5.11 and 7.4-7.9:
 centre-of-mass drift, linear and angular momentum, kinetic energy against the work done, and joint reaction
 wrenches (the dual-quaternion formulation, `ff.reactions.along`).
@@ -12,7 +12,7 @@ What is and is not reproduced (honestly):
   with its own constraint drift) is not re-implemented. The condition number of the system matrix S (6.17)
   (Figs. 5.5, 7.x) is evaluated at every recorded configuration (`ff.dq.condition_number`).
 * Masses, inertias and geometry are the documented choices in crates/freefloat-core/models/valverde_ch5_single_arm.yaml and
-  crates/freefloat-core/models/valverde_ch7_two_arm.yaml (the thesis gives none). Spherical-joint inputs use the digest's recommended
+  crates/freefloat-core/models/valverde_ch7_two_arm.yaml (the thesis gives none). Spherical-joint inputs use our
   mapping (phi -> tau_x, theta -> tau_y, psi -> tau_z).
 * Input windows are open intervals as printed; the discontinuous (5.142) set and the window ends make the
   torques jump, and the adaptive integrator steps across the jumps without event location.

@@ -27,8 +27,15 @@ URDF = """<?xml version="1.0"?>
 
 
 def test_good_files_load():
-    ff.Model.from_yaml_string(GOOD_YAML)
-    ff.Model.from_urdf_string(URDF)
+    """The reference files the bad-input tests mutate load to the robot they describe."""
+    m = ff.Model.from_yaml_string(GOOD_YAML)
+    assert (m.name, m.body_names, m.joint_types, m.nq, m.nv) == ("t", ["base", "arm"], ["free", "revolute"], 8, 7)
+    # [m, m c, I about the body origin]: the CoM inertia (0.01, 0.1, 0.1) moved by 0.5 m along x (parallel axes)
+    np.testing.assert_allclose(m.parameters()[1], [1, 0.5, 0, 0, 0.01, 0, 0.35, 0, 0, 0.35], rtol=0, atol=1e-15)
+    u = ff.Model.from_urdf_string(URDF)
+    assert (u.name, u.body_names, u.joint_names, u.joint_types) == ("r", ["base", "arm"], ["root_joint", "j1"], ["free", "revolute"])
+    assert u.total_mass == 11.0
+    np.testing.assert_allclose(u.parameters()[1], [1, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1], rtol=0, atol=1e-15)
 
 
 def test_yaml_syntax_error_has_line():

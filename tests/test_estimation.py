@@ -116,19 +116,3 @@ def test_bad_arguments_are_named(case):
         est.least_squares(m, tr.q, tr.v, tr.momentum, mp, weights=[1.0, 1.0, 1.0, 1.0, 1.0, -1.0])
     with pytest.raises(ff.InputError, match="method"):
         est.least_squares(m, tr.q, tr.v, tr.momentum, mp, method="svd")
-
-
-def test_benchmark_script_quick_runs_and_agrees(tmp_path):
-    """benches/identify_vs_numpy.py keeps working (smoke run; speed is reported, not asserted)."""
-    import json
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    script = Path(__file__).resolve().parents[1] / "benches" / "identify_vs_numpy.py"
-    r = subprocess.run([sys.executable, str(script), "--quick", "--repeats", "1", "--out", str(tmp_path)],
-                       capture_output=True, text=True, timeout=600)
-    assert r.returncode == 0, r.stderr[-2000:]
-    res = json.loads((tmp_path / "identify_vs_numpy.json").read_text())
-    assert res["agreement"]["estimate_max_rel"] < 1e-9 and res["agreement"]["regressor_max_rel"] < 1e-12
-    assert all(v > 0 for v in res["ratios"].values())

@@ -1,4 +1,4 @@
-"""Exciting-trajectory design (seed 001 Sec. V): the Rust objective against independent computations, the
+"""Exciting-trajectory design (Naveen et al. Sec. V): the Rust objective against independent computations, the
 constraints, Algorithm 1, trajectory files and bad input."""
 
 import json
@@ -180,7 +180,7 @@ def test_the_shipped_designed_trajectory():
 
     with data.path("trajectories", "naveen_exciting_trajectory") as p:
         traj, joints = exc.load_trajectory(p)
-    L = exc.Limits.seed001()
+    L = exc.Limits.naveen()
     t = np.linspace(0, traj.duration, 100 * traj.n_intervals + 1)
     q, qd, qdd = traj.evaluate(t)
     assert np.all(q[:, :6] >= L.q_min - 1e-9) and np.all(q[:, :6] <= L.q_max + 1e-9)
@@ -193,7 +193,7 @@ def test_the_shipped_designed_trajectory():
 
 def test_a_design_that_cannot_excite_everything_is_reported(guess):
     # only J1 designed, every other arm joint and the wheels are still: most parameters stay unexcited
-    d = exc.ExcitationDesign(guess, arm=["J1"], wheels=[], limits=exc.Limits.seed001(1))
+    d = exc.ExcitationDesign(guess, arm=["J1"], wheels=[], limits=exc.Limits.naveen(1))
     with pytest.raises(ff.NumericalError, match="does not excite every minimal parameter"):
         d.design(maxiter=2, progress=False)
 

@@ -1,4 +1,4 @@
-"""The identification pipeline of seed 001: simulated excitation, telemetry, minimal-parameter estimate."""
+"""The identification pipeline of Naveen et al.: simulated excitation, telemetry, minimal-parameter estimate."""
 
 import json
 
@@ -66,5 +66,5 @@ def test_bad_data_is_rejected(robot):
     with pytest.raises(ff.InputError, match="h0"):
         telem, _ = idf.excitation_data(robot, n_intervals=1, noise=False)
         ff.identify_minimal(robot, telem, h0=[0, 0])
-    with pytest.raises(ff.InputError, match="seed 001 robot"):
+    with pytest.raises(ff.InputError, match="Naveen et al. robot"):
         idf.excitation_data(ff.models.load("zhang2020_3d"), n_intervals=2)

@@ -1,4 +1,4 @@
-"""Minimal parameters of the momentum model (python/freefloat/minimal.py): seed 001's closed form against its
+"""Minimal parameters of the momentum model (python/freefloat/minimal.py): Naveen et al.'s closed form against its
 Table 4, the numeric (QR) method against the closed form, and the numeric method on other joint types."""
 
 import freefloat as ff
@@ -7,7 +7,7 @@ import pytest
 import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 import scipy.linalg
 
-# Seed 001, Table 4 "True" column (digest §B.7), phi_m(1..52) in the paper's order.  Printed to 3 decimals, so
+# Naveen et al., Table 4 "True" column, phi_m(1..52) in the paper's order.  Printed to 3 decimals, so
 # the tolerance is half a unit of the last digit (5e-4, e.g. 2.1125 printed 2.112) plus float slack.
 TABLE4_TRUE = [
     2130.560, 2078.560, 1555.700, -96.630, -269.450, -148.890, 2265.000, 440.500, 679.500, 1033.000,
@@ -48,7 +48,7 @@ def test_closed_form_reproduces_table4(dual_arm):
 def test_closed_form_expressions_match_appendix_a(dual_arm):
     _, _, mpc = dual_arm
     ex = mpc.expressions()
-    # phi_m(4) with the corrected +0.09 (printed 0.9: digest F.3) and phi_m(11), phi_m(16) of Appendix A
+    # phi_m(4) with the corrected +0.09 (printed 0.9; docs/architecture.md, minimal parameters) and phi_m(11), phi_m(16) of Appendix A
     assert ex[3] == "base.Ixy - 0.21*L1.m - 0.21*L2.m - 0.21*L3.m + 0.09*L4.m + 0.09*L5.m + 0.09*L6.m"
     assert ex[10] == "L1.Ixx - L1.Iyy - L2.m + L2.Iyy + L3.Iyy"
     assert ex[15] == "L1.mcx + L2.m + L3.m"
@@ -79,7 +79,7 @@ def test_deleted_directions_are_exact_combinations(dual_arm):
     G = unknown_regressor(m, mpn, Q, V).reshape(-1, 70)
     for mp in (mpn, mpc):
         N = scipy.linalg.null_space(mp.matrix)
-        assert N.shape == (70, 18)  # 3 per revolute joint (seed 001, eqs. 18-20)
+        assert N.shape == (70, 18)  # 3 per revolute joint (Naveen et al., eqs. 18-20)
         assert np.abs(G @ N).max() <= 1e-12 * np.abs(G).max()
 
 

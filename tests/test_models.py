@@ -1,4 +1,4 @@
-"""Built-in robots and model files: contents checked against numbers printed in the seeds/digests."""
+"""Built-in robots and model files: contents checked against numbers printed in the published works (docs/models.md)."""
 
 import numpy as np
 import pytest
@@ -18,10 +18,10 @@ def test_builtin_names_and_loading():
         assert m.nq == len(m.neutral()) and m.nbodies == len(m.body_names)
 
 
-def test_seed001_standard_parameters_match_digest_table():
-    # research/seed001_minimal_params.md §B.2, derived standard parameters about each link origin,
+def test_naveen_standard_parameters_match_table2():
+    # Naveen, Shah, Misra Table 2 as standard parameters about each link origin (docs/models.md),
     # order [Ixx Iyy Izz Ixy Iyz Izx m mx my mz] (L2 y-CoM corrected to -0.04).
-    digest = {
+    table2 = {
         "base": [1700.0, 1600.0, 1460.0, -84.48, -199.55, -114.29, 2000, 400.0, 600.0, 800.0],
         "L1": [3.47, 20.135, 38.635, 0.4, 3.825, 6.0, 50, 30.0, 2.5, -3.5],
         "L2": [1.314, 8.18, 25.134, 1.25, 1.67, 2.3, 40, 16.0, -1.6, -2.0],
@@ -32,13 +32,13 @@ def test_seed001_standard_parameters_match_digest_table():
     }
     m = ff.models.load("naveen_dual_arm")
     P = m.parameters()
-    for name, (xx, yy, zz, xy, yz, zx, mass, mx, my, mz) in digest.items():
+    for name, (xx, yy, zz, xy, yz, zx, mass, mx, my, mz) in table2.items():
         ours = P[m.body_index(name)]
         np.testing.assert_allclose(ours, [mass, mx, my, mz, xx, xy, yy, zx, yz, zz], rtol=0, atol=1e-9, err_msg=name)
 
 
-def test_seed001_geometry_at_zero():
-    # Digest §B.3: J1 at [0.7,0.3,0.9] (+z0), J2 at [1.7,0.3,0.9] (axis -y), J3 at [2.7,0.3,0.9], J4 at [-0.3,0.3,0.9].
+def test_naveen_geometry_at_zero():
+    # Geometry reconstructed from Appendix A (docs/models.md): J1 at [0.7,0.3,0.9] (+z0), J2 at [1.7,0.3,0.9] (axis -y), J3 at [2.7,0.3,0.9], J4 at [-0.3,0.3,0.9].
     m = ff.models.load("naveen_dual_arm")
     fk = ff.forward_kinematics(m, m.neutral())
     pos = {n: fk[m.body_index(n), :3] for n in ("L1", "L2", "L3", "L4")}
@@ -50,13 +50,13 @@ def test_seed001_geometry_at_zero():
     np.testing.assert_allclose(J[3:, m.idx_v[m.body_index("L2")]], [0, -1, 0], atol=1e-12)
 
 
-def test_seed001_table2_is_not_physical_without_the_opt_out():
+def test_naveen_table2_is_not_physical_without_the_opt_out():
     text = ff.models.source("naveen_dual_arm").replace("allow_nonphysical: true", "allow_nonphysical: false")
     with pytest.raises(ff.ModelError, match=r"L1.*triangle"):
         ff.Model.from_yaml_string(text)
 
 
-def test_thesis_ch5_end_effector_hint():
+def test_valverde_ch5_end_effector_hint():
     # thesis ch. 8 hint: with theta2 = 5 deg, theta3 = -10 deg the end effector is at [6.727, 0, 5] m.
     m = ff.models.load("valverde_ch5_single_arm")
     q = m.neutral()

@@ -1,4 +1,4 @@
-"""Seed 000 post-capture identification (issue 3): closed forms, simulation, both estimators, bad input.
+"""Zhang et al. 2020 post-capture identification (issue 3): closed forms, simulation, both estimators, bad input.
 
 Truth is read from the model YAML files themselves (mass, CoM offset, inertia about the CoM), not from
 the code under test; cross-checks use conservation laws, the closed-form attitude response of eq. (39),
@@ -90,7 +90,7 @@ def test_closed_forms_match_definitions():
     np.testing.assert_allclose(eq.G_block(p)[0] @ np.r_[m, m * b], m * cdd, rtol=1e-5)
     np.testing.assert_allclose(eq.S_block(p)[0] @ mJ, m * np.cross(c, cdd), rtol=1e-5)
     np.testing.assert_allclose(eq.Q_block(p)[0] @ eq.inertia_sharp(Ic), Iw @ b0 + np.cross(w, Iw @ w), rtol=1e-12)
-    # planar reduction (digest §4.2): the bx² and by² columns of H coincide, the bx·by column vanishes
+    # planar reduction: the bx² and by² columns of H coincide, the bx·by column vanishes
     pz = eq.PointMotion(np.array([[1.0, 2, 0]]), np.eye(3)[None], np.array([[0.3, -1, 0]]),
                         np.array([[0, 0, 0.4]]), np.zeros((1, 3)), np.zeros((1, 3)))
     H = eq.H_block(pz)[0]
@@ -125,7 +125,7 @@ def test_truth_vector_is_the_model_file(medium):
     tr = yaml_truth("zhang2020_2d_medium")
     (m1, b1, I1), (mn, bn, In) = tr["base"], tr["target"]
     np.testing.assert_allclose(medium.truth, [m1, b1[0], b1[1], I1[2, 2], mn, bn[0], bn[1], In[2, 2]], rtol=1e-12)
-    # and Table 2 / the paper's results (digest §9)
+    # and Table 2 / the paper's results
     np.testing.assert_allclose(medium.truth, [500, 0.1, -0.1, 83.61, 250, 0.25, 0.1, 10.41])
 
 

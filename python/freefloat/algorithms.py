@@ -58,7 +58,7 @@ def hybrid_dynamics(model, q, v, tau, ddq, prescribed, fext=None):
 
 def dq_dynamics(model, q, v, tau, fext=None, locked=None, formulation="dq"):
     """Forward dynamics and joint wrenches by the dual-quaternion Newton-Euler formulation
-    (dissertation seed 003, ch. 5-6): one linear system for every body's acceleration and every joint's
+    (Valverde 2018, ch. 5-6): one linear system for every body's acceleration and every joint's
     reaction, solved through the Schur complement (a symmetric positive-definite Delassus matrix).
 
     Returns (a, W): `a` (nv,) the generalized accelerations, equal to `aba(model, q, v, tau, fext)`;

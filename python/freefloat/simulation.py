@@ -163,7 +163,7 @@ def simulate(
       dynamics); the recorded tau then holds the forces these joints needed.
     progress: True for a progress bar, or a callable progress(fraction) returning False to abort.
     formulation: "aba" (the engine's articulated-body algorithm) or "dq" (the dual-quaternion Newton-Euler
-      system of seed 003 ch. 6, `dq_dynamics`: same motion to round-off, slower; free or fixed base with
+      system of Valverde 2018 ch. 6, `dq_dynamics`: same motion to round-off, slower; free or fixed base with
       revolute, prismatic, spherical, cylindrical, universal and fixed joints). With "dq" the recorded momentum and kinetic energy
       are the formulation's own (2.53)/(2.54)."""
     if not isinstance(model, Model):
@@ -200,7 +200,7 @@ def simulate_driven(model: Model, trajectory, joints, dt: float, *, held=(), t_f
     """Simulate `model` while the named `joints` follow a joint `trajectory` (an object with `prescription`
     and `duration`, e.g. from `freefloat.trajectories`) and the joints in `held` stay at their neutral angle; the
     base floats with zero total momentum, its initial twist solved from the momentum model,
-    A_b v_b = −A_j q̇_j (seed 001, digest A.10). t_final: default the trajectory's duration."""
+    A_b v_b = −A_j q̇_j (Naveen et al.). t_final: default the trajectory's duration."""
     from .algorithms import centroidal_momentum_matrix
 
     presc = trajectory.prescription(model, joints)  # entries it does not drive: neutral angle, at rest

@@ -1,10 +1,10 @@
-"""Joint trajectories of seed 001 (Naveen, Shah, Misra, "Momentum model-based minimal parameter
+"""Joint trajectories of Naveen et al. (Naveen, Shah, Misra, "Momentum model-based minimal parameter
 identification of a space robot"): the multi-interval cycloidal exciting trajectory (Section V.B–D,
 eqs. 28–31) and the Fourier trajectory used to evaluate the estimates (Section VI.D, eqs. 40–41).
 
 Both give joint angle, rate and acceleration as functions of time, vectorised over time, and a
 `prescription(model, joint_names)` that `freefloat.simulate(..., prescribed=..., prescription=...)`
-accepts. The reaction wheels of seed 001 are ordinary joints of the model, so they are driven like the
+accepts. The reaction wheels of Naveen et al. are ordinary joints of the model, so they are driven like the
 arm joints: `with_wheels` appends their predetermined seeds (start 0, range 3π per interval, Sec. VI.A.2)."""
 
 from __future__ import annotations
@@ -15,10 +15,10 @@ from ._core import InputError
 from .constants import WHEEL_RANGE, WHEEL_START
 
 def direction_combinations(n: int, fixed: int = 0, fastest: str = "last") -> np.ndarray:
-    """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (seed 001 V.B:
+    """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (Naveen et al. V.B:
     one joint keeps its direction, so there are 2^(n-1) combinations, 256 for 6 arm joints + 3 wheels).
 
-    The paper fixes neither the joint nor the order (digest F, "not specified"). Ordering chosen here:
+    The paper fixes neither the joint nor the order. Ordering chosen here:
     row k is the binary expansion of k over the free joints in column order, most significant bit
     first, with bit 0 -> +1 and bit 1 -> -1. So row 0 is all +1 and the last free joint alternates
     fastest (lexicographic order with + before -). With fastest="first" the bit order is reversed: the
@@ -43,7 +43,7 @@ def direction_combinations(n: int, fixed: int = 0, fastest: str = "last") -> np.
 
 def with_wheels(start, range_, n_wheels: int = 3):
     """Append `n_wheels` reaction wheels with the seed-001 predetermined seeds (start 0 rad, range 3π
-    rad per interval, Sec. VI.A.2 / digest B.1) to arm seeds `start`, `range_` (n,). Returns the
+    rad per interval, Sec. VI.A.2) to arm seeds `start`, `range_` (n,). Returns the
     (n + n_wheels,) pair to pass to `Cycloidal`, whose directions then need n + n_wheels columns
     (e.g. `direction_combinations(n + n_wheels)`)."""
     start = np.concatenate([np.atleast_1d(np.asarray(start, float)), np.full(n_wheels, WHEEL_START)])
@@ -115,7 +115,7 @@ class MultiSine(_JointTrajectory):
 
 
 class Cycloidal(_JointTrajectory):
-    """Multi-interval cycloidal joint trajectory of seed 001, eqs. 28–31.
+    """Multi-interval cycloidal joint trajectory of Naveen et al., eqs. 28–31.
 
     start (n,)      θ_js, angle at t = 0 (eq. 30, k = 1)
     range_ (n,)     θ_jd > 0, distance moved per interval
@@ -125,7 +125,7 @@ class Cycloidal(_JointTrajectory):
 
     Interval k (1-based) moves joint j from θ_ji^k to θ_jf^k = θ_ji^k + d_jk·θ_jd, with θ_ji^1 = θ_js and
     θ_ji^k = θ_jf^(k-1) (eqs. 30–31; the printed eq. 31 uses θ_jf^(k-1), which is the same thing for
-    k > 1 and must read θ_js for k = 1, digest F.8). Within the interval (τ = t − (k−1)T_p):
+    k > 1 and must read θ_js for k = 1). Within the interval (τ = t − (k−1)T_p):
         q  = θ_i + Δ/T_p [τ − T_p/(2π) sin(2πτ/T_p)]                          (28)
         q̇  = Δ/T_p [1 − cos(2πτ/T_p)]                                          (29)
         q̈  = Δ/T_p (2π/T_p) sin(2πτ/T_p)                                      (derivative of 29)
@@ -152,7 +152,7 @@ class Cycloidal(_JointTrajectory):
             raise InputError("Cycloidal: start and range_ must be finite")
         if np.any(self.range_ <= 0):
             j = int(np.argmax(self.range_ <= 0))
-            raise InputError(f"Cycloidal: range_ must be > 0 (seed 001 eq. 37); joint {j} has {self.range_[j]}")
+            raise InputError(f"Cycloidal: range_ must be > 0 (Naveen et al. eq. 37); joint {j} has {self.range_[j]}")
         if not np.all(np.isin(self.directions, (-1.0, 1.0))):
             raise InputError("Cycloidal: directions must be +1 or -1")
         if not (self.interval > 0 and np.isfinite(self.interval)):
@@ -168,7 +168,7 @@ class Cycloidal(_JointTrajectory):
         return self.n_intervals * self.interval
 
     def peak_rate(self) -> np.ndarray:
-        """max |q̇_j| = 2θ_jd/T_p (digest A', from eq. 29 at τ = T_p/2)."""
+        """max |q̇_j| = 2θ_jd/T_p."""
         return 2.0 * self.range_ / self.interval
 
     def peak_acceleration(self) -> np.ndarray:
@@ -195,7 +195,7 @@ class Cycloidal(_JointTrajectory):
 
 
 class Fourier(_JointTrajectory):
-    """Finite Fourier joint trajectory of seed 001 Sec. VI.D, eqs. 40–41:
+    """Finite Fourier joint trajectory of Naveen et al. Sec. VI.D, eqs. 40–41:
         q_j  = q_j0 + Σ_i a_ji sin(iω_f t) + b_ji cos(iω_f t)                  (40)
         q̇_j  = Σ_i iω_f (a_ji cos(iω_f t) − b_ji sin(iω_f t))                   (41)
         q̈_j  = −Σ_i (iω_f)² (a_ji sin(iω_f t) + b_ji cos(iω_f t))              (derivative of 41)

@@ -23,7 +23,7 @@ from ._common import load_model, torque_options
 @click.option("--record-every", type=int, default=10, show_default=True, help="Evaluate the wrenches every n-th step.")
 @click.option("--out", help="Directory: reactions.csv (every joint's wrench), results.json (peaks), reactions.png.")
 def reactions_cmd(model, base, t_final, dt, torques, amplitude, record_every, out):
-    """Joint reaction wrenches of MODEL along a simulated motion (dual-quaternion formulation, seed 003 ch. 6).
+    """Joint reaction wrenches of MODEL along a simulated motion (dual-quaternion formulation, Valverde 2018 ch. 6).
 
     The motion is simulated by the engine (RK4); at every recorded sample `ff.dq_dynamics` gives each
     joint's transmitted wrench from one linear system. The table lists, per joint, the peak reaction force

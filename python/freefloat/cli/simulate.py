@@ -26,7 +26,7 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
 @click.option("--v0", help="Initial velocity, nv comma-separated numbers (default: zero).")
 @click.option("--record-every", type=int, default=10, show_default=True, help="RK4: keep every n-th step.")
 @click.option("--formulation", type=click.Choice(["aba", "dq"]), default="aba", show_default=True,
-              help="Dynamics: the engine's ABA, or the dual-quaternion Newton-Euler system (seed 003 ch. 6).")
+              help="Dynamics: the engine's ABA, or the dual-quaternion Newton-Euler system (Valverde 2018 ch. 6).")
 @click.option("--out", help="FILE.parquet, or a directory (gets trajectory, results.json, figure).")
 def simulate_cmd(model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out):
     """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.

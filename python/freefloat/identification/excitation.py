@@ -1,4 +1,4 @@
-"""Exciting-trajectory design for minimal-parameter identification (seed 001, Sec. V and VI.B).
+"""Exciting-trajectory design for minimal-parameter identification (Naveen et al., Sec. V and VI.B).
 
 Three steps (the paper's Fig. 2), from nothing but the geometry and a rough guess of the inertias:
 
@@ -7,19 +7,19 @@ Three steps (the paper's Fig. 2), from nothing but the geometry and a rough gues
    C = κ(G_m) + w·N_l N_m / Σ h², subject to the linear joint-limit constraints of eqs. 33-37.
 2. Pruning (Algorithm 1): intervals are kept in order while they add significant singular values or lower the
    condition number, with up to u_max "free" acceptances in a row.  As printed the algorithm never updates its
-   reference rank and condition number; here both are updated on every acceptance (digest A', F.5).
+   reference rank and condition number; here both are updated on every acceptance.
 3. The seeds are re-optimised on the surviving combinations only.
 
 The base response the objective needs comes from the momentum model of the *guessed* robot, in Rust
 (`freefloat_core::excitation`), as does the objective itself; Python drives scipy's SLSQP, with finite-difference
-gradients whose 2n+1 evaluations go to Rust in one call (worker threads).  The reaction wheels follow seed 001's
+gradients whose 2n+1 evaluations go to Rust in one call (worker threads).  The reaction wheels follow Naveen et al.'s
 predetermined seeds (start 0, range 3π per interval) and are not design variables.
 
-Choices the paper leaves open (digest F), all arguments here:
+Choices the paper leaves open, all arguments here:
 - the last wheel keeps its direction, and the combinations are ordered so the first arm joint alternates fastest
   (`direction_combinations(..., fastest="first")`): the accumulated travel of arm joint j stays within 2^(j-1)
   ranges, so position limits do not force tiny ranges on every joint;
-- limits (`Limits.seed001`): ±270° positions; 1.6π rad/s and 1.6π² rad/s² for rates and accelerations, so
+- limits (`Limits.naveen`): ±270° positions; 1.6π rad/s and 1.6π² rad/s² for rates and accelerations, so
   eqs. 34-36 cap the range at 0.8π = 2.513 rad, the largest value in Table 3;
 - the signal term Σh² covers the base twist and the *arm* joint rates: the wheels follow fixed seeds, and their
   fast spin (up to 6π rad/s) would otherwise swamp it, leaving the ranges free to shrink — which costs accuracy
@@ -59,7 +59,7 @@ WEIGHT = 1000.0
 #: a condition number above this means some parameter combination is not excited (the Gram matrix the objective
 #: uses cannot resolve singular values below ~1e-8 of the largest)
 KAPPA_UNEXCITED = 1e8
-#: seed 001 results to print beside ours
+#: Naveen et al. results to print beside ours
 PAPER_KAPPA, PAPER_KEPT = 248.8, 67
 
 
@@ -73,9 +73,14 @@ class Limits:
     qdd_max: np.ndarray
 
     @classmethod
-    def seed001(cls, n: int = 6) -> "Limits":
-        """Our documented choice for the seed 001 arms (the paper gives none)."""
+    def naveen(cls, n: int = 6) -> "Limits":
+        """Our documented choice for the Naveen et al. arms (the paper gives none)."""
         return cls(np.full(n, -1.5 * np.pi), np.full(n, 1.5 * np.pi), np.full(n, 1.6 * np.pi), np.full(n, 1.6 * np.pi**2))
+
+    @classmethod
+    def seed001(cls, n: int = 6) -> "Limits":
+        """Earlier name of `naveen` (kept as an alias)."""
+        return cls.naveen(n)
 
     def range_max(self, interval: float) -> np.ndarray:
         """θ_jd^max of eq. 36: min of the rate bound (eq. 34) and the acceleration bound (eq. 35)."""
@@ -128,7 +133,7 @@ class DesignResult:
         n = d.n_arm
         s, r = self.step3.x[:n], self.step3.x[n:]
         head = f"{'seed':10s}" + "".join(f"{j:>10s}" for j in d.arm)
-        lines = ["optimal seed parameters (seed 001 Table 3 format)", head,
+        lines = ["optimal seed parameters (Naveen et al. Table 3 format)", head,
                  f"{'start deg':10s}" + "".join(f"{np.rad2deg(v):10.3f}" for v in s),
                  f"{'range rad':10s}" + "".join(f"{v:10.3f}" for v in r),
                  f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_START_DEG),
@@ -191,7 +196,7 @@ class ExcitationDesign:
             if j not in guess.joint_names or guess.nvs[guess.joint_names.index(j)] != 1:
                 raise InputError(f"ExcitationDesign: '{j}' is not a 1-DoF joint of '{guess.name}'")
         self.n_arm = len(self.arm)
-        self.limits = Limits.seed001(self.n_arm) if limits is None else limits
+        self.limits = Limits.naveen(self.n_arm) if limits is None else limits
         self.limits.check(self.n_arm)
         if grid % samples != 0 or samples < 1:
             raise InputError(f"ExcitationDesign: grid ({grid}) must be a multiple of samples ({samples})")

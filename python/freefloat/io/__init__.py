@@ -3,7 +3,7 @@ joint-trajectory files (JSON; `trajectory_files`) and the files shipped inside t
 Simulated trajectories read and write themselves (`Trajectory.to_parquet` / `Trajectory.from_parquet`).
 
 A new file reader goes here: a module that turns the file into a `Telemetry` (or a `Trajectory`) and names the
-file, column and row of anything wrong; `Telemetry.read` dispatches on the suffix.
+file, column and row of anything wrong; `Telemetry.from_file` dispatches on the suffix.
 """
 
 from . import data, results, telemetry, trajectory_files

@@ -1,5 +1,5 @@
-"""Seed 000's identification equations (Zhang, Yue, Yuan 2020; digest `seed000_one_step_identification.md`
-§4-§7), vectorised over samples (leading axis T).
+"""The identification equations of Zhang, Yue, Yuan 2020 (its §III-IV, as corrected in docs/postcapture.md),
+vectorised over samples (leading axis T).
 
 Two forms of the same physics, for the base (body 1, reference point = base sensor) and the target
 (body n, reference point = capture point), the arm links known:
@@ -7,7 +7,7 @@ Two forms of the same physics, for the base (body 1, reference point = base sens
 * the paper's form (eqs. 11-33): mass and first moment μ = [m_1, m_1 b'_1, m_n, m_n b'_n] from the
   linear rows, CoM inertias θ = [I'_1#; I'_n#] from the angular rows with the second-order term
   ψ D(μ) (`Φ θ = y + ψ D(μ)`, eqs. 34-35), solved by the modified RLS;
-* the standard form (digest §7): per body [m, m b', inertia about the reference point], exactly
+* the standard form: per body [m, m b', inertia about the reference point], exactly
   linear, taken from the engine's momentum and inverse-dynamics regressors.
 
 Everything here is plain numpy on the recorded motion; the engine supplies the kinematics and the
@@ -45,7 +45,7 @@ def sharp(v: np.ndarray) -> np.ndarray:
 
 def quad(u: np.ndarray) -> np.ndarray:
     """W(u) (…, 3, 6) with (|b|² 1 − b bᵀ) u = W(u) mono(b), mono(b) = [bx², bx by, bx bz, by², by bz, bz²]
-    (digest §4.2; replaces the garbled Appendix A)."""
+   ."""
     z = np.zeros_like(u[..., 0])
     a, b, c = u[..., 0], u[..., 1], u[..., 2]
     return np.stack([np.stack([z, -b, -c, a, z, a], -1), np.stack([b, -a, z, z, -c, b], -1),
@@ -83,7 +83,7 @@ class PointMotion:
     b: np.ndarray
 
     def shifted(self, origin: np.ndarray) -> "PointMotion":
-        """Positions relative to a moving origin (the force form's base-sensor point, digest §5);
+        """Positions relative to a moving origin (the force form's base-sensor point);
         velocities and accelerations stay absolute."""
         return PointMotion(self.r - origin, self.A, self.v, self.w, self.a, self.b)
 
@@ -104,7 +104,7 @@ def B_block(p: PointMotion) -> np.ndarray:
 
 
 def H_block(p: PointMotion) -> np.ndarray:
-    """(T, 3, 10): m c × ċ = H m J(b') (eq. 19; closed form of digest §4.2)."""
+    """(T, 3, 10): m c × ċ = H m J(b') (eq. 19; our closed form, docs/postcapture.md)."""
     rt, wt, vt = skew(p.r), skew(p.w), skew(p.v)
     wb = np.einsum("tji,tj->ti", p.A, p.w)  # A^T ω
     return np.concatenate([mv(rt, p.v)[..., None], mm(mm(rt, wt) - vt, p.A), mm(p.A, quad(wb))], -1)
@@ -123,7 +123,7 @@ def G_block(p: PointMotion) -> np.ndarray:
 
 
 def S_block(p: PointMotion) -> np.ndarray:
-    """(T, 3, 10): m c × c̈ = S m J(b') (eq. 31; digest §5 closed form, S = dH/dt)."""
+    """(T, 3, 10): m c × c̈ = S m J(b') (eq. 31)."""
     rt, wt, bt, at = skew(p.r), skew(p.w), skew(p.b), skew(p.a)
     wb = np.einsum("tji,tj->ti", p.A, p.w)
     bb = np.einsum("tji,tj->ti", p.A, p.b)
@@ -142,8 +142,8 @@ def Q_block(p: PointMotion) -> np.ndarray:
 # -- problem layout (3D or planar) ----------------------------------------------------------------------
 @dataclass(frozen=True)
 class Layout:
-    """Which rows and columns of the 3D equations a model uses. Planar (digest §4.2 'planar
-    reduction'): linear rows x, y; angular row z; μ per body [m, m bx, m by]; θ per body I_zz;
+    """Which rows and columns of the 3D equations a model uses. Planar (the 'planar
+    reduction' of docs/postcapture.md): linear rows x, y; angular row z; μ per body [m, m bx, m by]; θ per body I_zz;
     D per body [m, m bx, m by, m(bx² + by²)] (the bx² and by² columns of H and S are equal, the
     bx·by column vanishes)."""
 
@@ -203,7 +203,7 @@ def known_params(model, unknown: list[int]) -> np.ndarray:
 
 @dataclass
 class PaperRows:
-    """Seed 000's regression in the modified-RLS form (eqs. 34-35), one block per sample."""
+    """Zhang et al. 2020's regression in the modified-RLS form (eqs. 34-35), one block per sample."""
 
     t: np.ndarray
     A: np.ndarray
@@ -246,7 +246,7 @@ def paper_momentum_rows(model, meas: Measurements, base: int, target: int) -> Pa
 
 
 def paper_force_rows(model, meas: Measurements, base: int, target: int) -> PaperRows:
-    """Force form, eqs. (26)-(33), moments about the current base-sensor point (digest §5)."""
+    """Force form, eqs. (26)-(33), moments about the current base-sensor point."""
     L = Layout(model.joint_types[0] == "planar")
     p1 = point_motion(model, meas.q, meas.v, meas.ddq, base)
     pn = point_motion(model, meas.q, meas.v, meas.ddq, target)
@@ -273,7 +273,7 @@ def _base_wrench_3d(w: np.ndarray, planar: bool):
 
 
 def standard_momentum_rows(model, meas: Measurements, base: int, target: int) -> StandardRows:
-    """Digest §7 momentum form: the engine's momentum regressor columns of base and target (standard
+    """Standard-parameter momentum form (docs/postcapture.md): the engine's momentum regressor columns of base and target (standard
     parameters about the sensor / capture point), cumulative differences from t0."""
     L = Layout(model.joint_types[0] == "planar")
     K = np.asarray(alg.momentum_regressor(model, meas.q, meas.v))
@@ -286,7 +286,7 @@ def standard_momentum_rows(model, meas: Measurements, base: int, target: int) ->
 
 
 def standard_force_rows(model, meas: Measurements, base: int, target: int) -> StandardRows:
-    """Digest §7 Newton-Euler form: base rows of the engine's inverse-dynamics regressor (the total
+    """Standard-parameter Newton-Euler form (docs/postcapture.md): base rows of the engine's inverse-dynamics regressor (the total
     wrench at the base sensor, base frame) for the base and target columns."""
     L = Layout(model.joint_types[0] == "planar")
     nb = meas.base_wrench.shape[1]

@@ -73,7 +73,7 @@ def identify_modified(model, rows: eq.PaperRows, sc: Scenario, planar: bool) -> 
 
 def identify_standard(model, rows: eq.StandardRows, sc: Scenario, planar: bool, forgetting: float | None = None,
                       project: bool = False) -> np.ndarray:
-    """Ordinary RLS on the standard parameters (digest §7); returns (N, P) physical parameters."""
+    """Ordinary RLS on the standard parameters; returns (N, P) physical parameters."""
     L = eq.Layout(planar)
     x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in _guess(sc, planar)])
     est = online.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting if forgetting is None else forgetting)

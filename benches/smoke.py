@@ -1,0 +1,107 @@
+#!/usr/bin/env python3
+"""Smoke run of every benchmark for CI: each script with --quick into a temporary folder, then the agreement
+numbers it recorded are checked. Exits non-zero if a script fails (each one aborts itself when freefloat and
+its peer disagree) or a recorded number is out of bounds. Timings are not judged here (a loaded CI machine
+says nothing about speed); the full runs and their tables are in benches/results/.
+
+    python benches/smoke.py                 # all four
+    python benches/smoke.py identify dq     # a subset, by name
+
+Pinocchio and Crocoddyl (the `[test]` extra) are needed for compare_pinocchio and excitation_bench; without them
+those two are reported as skipped, not passed.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+
+def _check_compare_pinocchio(out: Path) -> list[str]:
+    res = json.loads((out / "compare_pinocchio.json").read_text())
+    bad = [f"agreement {k} = {v:.3g} > 1e-9" for k, v in res["agreement_max_rel_error"].items() if not v < 1e-9]
+    if not (out / "compare_pinocchio.md").read_text().startswith("# freefloat vs Pinocchio"):
+        bad.append("compare_pinocchio.md has no title")
+    return bad
+
+
+def _check_excitation(out: Path) -> list[str]:
+    res = json.loads((out / "excitation_bench.json").read_text())
+    agree, bad = res["agreement"], []
+    if res["agreement_passed"] is not True:
+        bad.append("agreement_passed is not true")
+    bad += [f"{k} = {agree[k]:.3g} > 1e-6" for k in ("condition_number_rel", "mean_square_rel", "objective_rel")
+            if not agree[k] <= 1e-6]
+    bad += [f"{k} = {agree[k]:.3g} > 1e-9" for k in ("regressor_max_rel", "batch_vs_sequential_max_rel")
+            if not agree[k] <= 1e-9]
+    if res["problem"]["intervals"] != 256 or res["problem"]["regressor_shape"] != [7680, 52]:
+        bad.append(f"unexpected problem size {res['problem']}")
+    d = res["design"]
+    if not (0 < d["kept_intervals"] <= 256 and d["condition_number"] >= 1.0):
+        bad.append(f"design result out of range: {d}")
+    return bad
+
+
+def _check_identify(out: Path) -> list[str]:
+    res = json.loads((out / "identify_vs_numpy.json").read_text())
+    a, bad = res["agreement"], []
+    if not a["estimate_max_rel"] < 1e-9:
+        bad.append(f"estimate_max_rel = {a['estimate_max_rel']:.3g} >= 1e-9")
+    if not a["regressor_max_rel"] < 1e-12:
+        bad.append(f"regressor_max_rel = {a['regressor_max_rel']:.3g} >= 1e-12")
+    return bad
+
+
+def _check_dq(out: Path) -> list[str]:
+    # the script aborts when dq_dynamics and aba disagree; check that it wrote its table
+    return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
+
+
+#: name -> (script, extra arguments, modules it needs, check of its output)
+BENCHES = {
+    "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
+    "excitation": ("excitation_bench.py", [], ("pinocchio", "scipy"), _check_excitation),
+    "identify": ("identify_vs_numpy.py", ["--repeats", "1"], (), _check_identify),
+    "dq": ("dq_dynamics.py", [], (), _check_dq),
+}
+
+
+def main(argv: list[str]) -> int:
+    names = argv or list(BENCHES)
+    unknown = [n for n in names if n not in BENCHES]
+    if unknown:
+        print(f"unknown benchmark(s) {unknown}; choose from {list(BENCHES)}", file=sys.stderr)
+        return 2
+    failed = []
+    for name in names:
+        script, extra, needs, check = BENCHES[name]
+        missing = [mod for mod in needs if importlib.util.find_spec(mod) is None]
+        if missing:
+            print(f"SKIP {script}: {', '.join(missing)} not installed")
+            continue
+        with tempfile.TemporaryDirectory() as tmp:
+            t0 = time.perf_counter()
+            r = subprocess.run([sys.executable, str(HERE / script), "--quick", "--out", tmp, *extra],
+                               capture_output=True, text=True)
+            wall = time.perf_counter() - t0
+            problems = [f"exit code {r.returncode}: {r.stderr.strip()[-1500:]}"] if r.returncode else check(Path(tmp))
+        if problems:
+            failed.append(name)
+            print(f"FAIL {script} ({wall:.0f} s):\n  " + "\n  ".join(problems))
+        else:
+            print(f"ok   {script} ({wall:.0f} s)")
+    if failed:
+        print(f"{len(failed)} benchmark smoke run(s) failed: {', '.join(failed)}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
