@@ -636,7 +636,7 @@ def make_report(env, args, agree, batch, single, sim, ratios, checks):
         if k.startswith("_"):
             continue
         L.append(f"| {k} | {r['median']:.4f} | {r['min']:.4f} | {r['us_per_step']:.1f} | {r['realtime_factor']:.0f} | "
-                 f"{r['drift_pin']['linear_abs']:.2e} | {r['drift_pin']['angular_abs']:.2e} | {r['final_q_diff_vs_ff']:.1e} |")
+                 f"{r['drift_pin']['linear_abs']:.2e} | {r['drift_pin']['angular_abs']:.2e} | " f"{r['final_q_diff_vs_ff']:.1e} |")
     L.append("")
     L.append("## Ratios (same run; > 1 means freefloat is faster)\n")
     L.append("| comparison | median ratio | min ratio | target | met? |")

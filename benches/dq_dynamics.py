@@ -32,8 +32,8 @@ def random_tree_yaml(n: int, seed: int) -> str:
         axis /= np.linalg.norm(axis)
         xyz = rng.uniform(-1, 1, size=3)
         lines += [f"  - name: b{i}", f"    parent: b{parent}",
-                  "    joint: {type: revolute, axis: [%s]}" % ", ".join(f"{a:.6f}" for a in axis),
-                  "    origin: {xyz: [%s], rpy: [0, 0, 0]}" % ", ".join(f"{a:.6f}" for a in xyz),
+                  "    joint: {type: revolute, axis: [" + ", ".join(f"{a:.6f}" for a in axis) + "]}",
+                  "    origin: {xyz: [" + ", ".join(f"{a:.6f}" for a in xyz) + "], rpy: [0, 0, 0]}",
                   "    inertial: {mass: 2, com: [0.2, 0.05, 0], inertia: [0.3, 0.4, 0.5]}"]
     return "\n".join(lines) + "\n"
 

@@ -358,9 +358,9 @@ def main():
     md = [
         "# Exciting-trajectory objective (Naveen et al. eq. 32): freefloat vs a Pinocchio + numpy peer", "",
         f"{MODEL}, {n_int} intervals x 1 s: {res['problem']['grid_points']:,} grid points for the base response, "
-        f"{res['problem']['sampled_points']:,} sampled points -> {6 * n_int * d.samples:,} x {d.n_min} minimal regressor; "
+        f"{res['problem']['sampled_points']:,} sampled points -> " f"{6 * n_int * d.samples:,} x {d.n_min} minimal regressor; "
         f"seeds `d.feasible_start(d.all_directions)`.",
-        f"At these seeds: C = {res['freefloat_at_x']['objective']:.6g}, κ = {res['freefloat_at_x']['condition_number']:.6g}, "
+        f"At these seeds: C = {res['freefloat_at_x']['objective']:.6g}, " f"κ = {res['freefloat_at_x']['condition_number']:.6g}, "
         f"mean square {res['freefloat_at_x']['mean_square']:.6g}.",
         f"Agreement (checked before timing): regressor {reg_err:.1e}, κ {agreement['condition_number_rel']:.1e}, "
         f"mean square {agreement['mean_square_rel']:.1e}, objective {agreement['objective_rel']:.1e} "
@@ -372,21 +372,21 @@ def main():
         "| what | median [ms] | min [ms] |", "|---|---|---|",
         f"| freefloat `d.evaluate(x)` | {ms(so['ff_evaluate'])} | {1e3 * so['ff_evaluate']['min']:.2f} |",
         f"| Pinocchio + numpy peer | {ms(so['peer_evaluate'])} | {1e3 * so['peer_evaluate']['min']:.2f} |",
-        f"| freefloat Rust call alone (path pre-evaluated) | {ms(so['ff_rust_call_only'])} | {1e3 * so['ff_rust_call_only']['min']:.2f} |",
-        f"| cycloid evaluation alone (in both of the first two rows) | {ms(so['cycloid_only'])} | {1e3 * so['cycloid_only']['min']:.2f} |",
+        f"| freefloat Rust call alone (path pre-evaluated) | {ms(so['ff_rust_call_only'])} | " f"{1e3 * so['ff_rust_call_only']['min']:.2f} |",
+        f"| cycloid evaluation alone (in both of the first two rows) | {ms(so['cycloid_only'])} | " f"{1e3 * so['cycloid_only']['min']:.2f} |",
         "",
-        f"Peer / freefloat: {ratios['peer_over_ff_evaluate']:.1f}x.  Target for freefloat: < {1e3 * TARGETS['ff_objective_s']:.0f} ms "
+        f"Peer / freefloat: {ratios['peer_over_ff_evaluate']:.1f}x.  " f"Target for freefloat: < {1e3 * TARGETS['ff_objective_s']:.0f} ms "
         f"({'met' if res['meets_targets']['ff_objective_s'] else 'NOT met'}).",
         "", "## One finite-difference gradient (13 evaluations)", "",
         "| what | median [ms] | min [ms] |", "|---|---|---|",
-        f"| one `d.evaluate(X)` call, X 13 x 12, {d.threads} worker threads | {ms(sg['batch_one_call'])} | {1e3 * sg['batch_one_call']['min']:.2f} |",
-        f"| 13 sequential `d.evaluate(x_i)` calls | {ms(sg['sequential_13_calls'])} | {1e3 * sg['sequential_13_calls']['min']:.2f} |",
+        f"| one `d.evaluate(X)` call, X 13 x 12, {d.threads} worker threads | " f"{ms(sg['batch_one_call'])} | " f"{1e3 * sg['batch_one_call']['min']:.2f} |",
+        f"| 13 sequential `d.evaluate(x_i)` calls | {ms(sg['sequential_13_calls'])} | " f"{1e3 * sg['sequential_13_calls']['min']:.2f} |",
         "", f"Sequential / batch: {ratios['sequential_over_batch']:.2f}x (with 2 cores the ceiling is 2x).",
         "", "## Full design (`d.design(progress=False)`)", "",
         f"maxiter {design_maxiter}{' (capped for --quick: not the real design time)' if args.quick else ''}; "
         f"{design_repeats} run(s): " + ", ".join(f"{v['seconds']:.1f} s" for v in designs) + f"; median {design_med:.1f} s"
         + (f" (target < {TARGETS['design_s']:.0f} s: {'met' if res['meets_targets']['design_s'] else 'NOT met'})." if not args.quick else "."),
-        f"Kept intervals {res['design']['kept_intervals']} of {n_int}, κ after step 3 {res['design']['condition_number']:.4g} "
+        f"Kept intervals {res['design']['kept_intervals']} of {n_int}, " f"κ after step 3 {res['design']['condition_number']:.4g} "
         f"(paper: {exc.PAPER_KEPT} kept, κ {exc.PAPER_KAPPA}); steps (last run): "
         + ", ".join(f"{k} {v:.1f} s" for k, v in designs[-1]["steps_s"].items()) + ".",
     ]

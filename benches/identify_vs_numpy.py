@@ -196,7 +196,7 @@ def main():
         "# Identification from momentum: freefloat vs a vectorised numpy peer", "",
         f"{MODEL}, {T:,} samples -> {6 * T:,} x {mp.n_min} minimal regressor; {res['states']}; noise sigma {NOISE}.",
         f"freefloat route: {r.method}; condition number {r.condition_number:.1f}; "
-        f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}; eqs. 38-39 errors: median {med:.3f} %, max {mx:.3f} %.",
+        f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}; " f"eqs. 38-39 errors: median {med:.3f} %, max {mx:.3f} %.",
         f"Median of {repeats} repeats, {res['threads']} hardware threads (freefloat uses them; numpy's BLAS may too).", "",
         "| what | freefloat [s] | numpy peer [s] | ratio | target |", "|---|---|---|---|---|",
     ]
@@ -207,7 +207,7 @@ def main():
         target = f">= {TARGETS[rk]:.0f}x" if rk in TARGETS else "-"
         npk = "np_end_to_end" if rk == "end_to_end" else "np_regressor"
         md.append(f"| {label} | {timings[key][0]:.4f} | {timings[npk][0]:.4f} | {ratios[rk]:.1f}x | {target} |")
-    md += ["", f"Against the issue's reference peer ({REFERENCE['regressor']} s build, {REFERENCE['end_to_end']} s build + solve "
+    md += ["", f"Against the issue's reference peer ({REFERENCE['regressor']} s build, " f"{REFERENCE['end_to_end']} s build + solve "
            f"for 67,000 samples; only meaningful for the full run): regressor {ratios_vs_reference['regressor']:.1f}x, "
            f"end to end {ratios_vs_reference['end_to_end']:.1f}x."]
     text = "\n".join(md) + "\n"

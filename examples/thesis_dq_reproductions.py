@@ -11,7 +11,8 @@ What is and is not reproduced (honestly):
   so the trajectory is the thesis' motion; the thesis' *dual-quaternion state* integration (8B twists + base DQ,
   with its own constraint drift) is not re-implemented. The condition number of the system matrix S (6.17)
   (Figs. 5.5, 7.x) is evaluated at every recorded configuration (`ff.dq.condition_number`).
-* Masses, inertias and geometry are the documented choices in crates/freefloat-core/models/valverde_ch5_single_arm.yaml and
+* Masses, inertias and geometry are the documented choices in
+  crates/freefloat-core/models/valverde_ch5_single_arm.yaml and
   crates/freefloat-core/models/valverde_ch7_two_arm.yaml (the thesis gives none). Spherical-joint inputs use our
   mapping (phi -> tau_x, theta -> tau_y, psi -> tau_z).
 * Input windows are open intervals as printed; the discontinuous (5.142) set and the window ends make the

@@ -841,7 +841,7 @@ class NamedLayout:
         if self.base != "fixed":
             jm = model.joints[1]
             self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(self.base_v.start, self.base_v.stop)
-        for name, t, qs, vs in moving:
+        for name, t, _qs, vs in moving:
             jm = model.joints[self.pin_joint[name]]
             assert jm.nv == JOINT_NV[t], f"{name}: nv {jm.nv} in Pinocchio vs {JOINT_NV[t]} ({t})"
             self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)

@@ -48,7 +48,8 @@ def test_closed_form_reproduces_table4(dual_arm):
 def test_closed_form_expressions_match_appendix_a(dual_arm):
     _, _, mpc = dual_arm
     ex = mpc.expressions()
-    # phi_m(4) with the corrected +0.09 (printed 0.9; docs/architecture.md, minimal parameters) and phi_m(11), phi_m(16) of Appendix A
+    # phi_m(4) with the corrected +0.09 (printed 0.9; docs/architecture.md, minimal parameters)
+    # and phi_m(11), phi_m(16) of Appendix A
     assert ex[3] == "base.Ixy - 0.21*L1.m - 0.21*L2.m - 0.21*L3.m + 0.09*L4.m + 0.09*L5.m + 0.09*L6.m"
     assert ex[10] == "L1.Ixx - L1.Iyy - L2.m + L2.Iyy + L3.Iyy"
     assert ex[15] == "L1.mcx + L2.m + L3.m"

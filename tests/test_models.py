@@ -38,7 +38,8 @@ def test_naveen_standard_parameters_match_table2():
 
 
 def test_naveen_geometry_at_zero():
-    # Geometry reconstructed from Appendix A (docs/models.md): J1 at [0.7,0.3,0.9] (+z0), J2 at [1.7,0.3,0.9] (axis -y), J3 at [2.7,0.3,0.9], J4 at [-0.3,0.3,0.9].
+    # Geometry reconstructed from Appendix A (docs/models.md): J1 at [0.7,0.3,0.9] (+z0), J2 at [1.7,0.3,0.9]
+    # (axis -y), J3 at [2.7,0.3,0.9], J4 at [-0.3,0.3,0.9].
     m = ff.models.load("naveen_dual_arm")
     fk = ff.forward_kinematics(m, m.neutral())
     pos = {n: fk[m.body_index(n), :3] for n in ("L1", "L2", "L3", "L4")}
@@ -68,7 +69,10 @@ def test_valverde_ch5_end_effector_hint():
 
 def test_mdh_equals_explicit_placement():
     # Craig's modified DH: Rx(alpha) Tx(a) Rz(theta) Tz(d).
-    common = "name: t\nbodies:\n  - name: b\n    inertial: {mass: 1, inertia: [1, 1, 1]}\n  - name: l\n    parent: b\n    joint: {type: revolute}\n"
+    common = (
+        "name: t\nbodies:\n  - name: b\n    inertial: {mass: 1, inertia: [1, 1, 1]}\n"
+        "  - name: l\n    parent: b\n    joint: {type: revolute}\n"
+    )
     a = ff.Model.from_yaml_string(common + "    mdh: {alpha: 0.4, a: 1.5, d: 0.3, theta: 0.2}\n    inertial: {mass: 1, inertia: [1, 1, 1]}\n")
     ca, sa, ct, st = np.cos(0.4), np.sin(0.4), np.cos(0.2), np.sin(0.2)
     Rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])

@@ -23,11 +23,12 @@ import zlib
 import numpy as np
 import pytest
 
+import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
+from random_trees import assert_close
+
 ff = pytest.importorskip("freefloat", reason="freefloat is not importable yet (the engine is not built)")
 pin = pytest.importorskip("pinocchio", reason="Pinocchio (PyPI `pin`) is needed as the oracle")
 
-import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
-from random_trees import assert_close
 
 RTOL = 1e-9
 ATOL = 1e-12

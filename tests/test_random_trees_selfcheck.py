@@ -10,11 +10,12 @@ from collections import Counter
 import numpy as np
 import pytest
 
+import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
+from random_trees import assert_close
+
 yaml = pytest.importorskip("yaml")
 pin = pytest.importorskip("pinocchio", reason="Pinocchio (PyPI `pin`) is needed for the oracle self-checks")
 
-import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
-from random_trees import assert_close
 
 SEEDS = rt.TREE_SEEDS
 N_STATES = 3
@@ -410,7 +411,7 @@ def test_urdf_rendering_matches_direct_model(seed):
     assert rt.urdf_total_mass(text) == pytest.approx(d.total_mass(), rel=1e-14)
     assert rt.pin_total_mass(model) == pytest.approx(d.total_mass(), rel=1e-13)
     names = [b.name for b in d.bodies]
-    for q, v, tau, a, fext in _states(d, seed):
+    for q, v, _tau, a, fext in _states(d, seed):
         qp = L.q_to_pin(q)
         pin.framesForwardKinematics(model, data, qp)
         for b, T in zip(d.bodies, d.body_placements(q)):

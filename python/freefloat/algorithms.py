@@ -69,7 +69,8 @@ def dq_dynamics(model, q, v, tau, fext=None, locked=None, formulation="dq"):
 
     `locked`: joint names held at zero acceleration (their `tau` entries are ignored; the torque they need
     is the actuated component of their row of `W`). Free or fixed base; revolute, prismatic, spherical,
-    cylindrical, universal and fixed joints (the decoupled formulation: all but universal); every moving body needs a positive mass and a positive-definite inertia.
+    cylindrical, universal and fixed joints (the decoupled formulation: all but universal); every moving body needs a
+    positive mass and a positive-definite inertia.
 
     `formulation="decoupled"` solves chapter 5's decoupled (3-vector) Newton-Euler system instead, with the
     same outputs (no `locked`); the two agree to round-off."""

@@ -69,7 +69,7 @@ class _JointTrajectory:
         iq, iv = [], []
         for name in names:
             if name not in model.joint_names:
-                raise InputError(f"prescription: '{name}' is not a joint of model '{model.name}' (joints: {', '.join(model.joint_names[1:])})")
+                raise InputError(f"prescription: '{name}' is not a joint of model '{model.name}' " f"(joints: {', '.join(model.joint_names[1:])})")
             b = model.joint_names.index(name)
             if model.nvs[b] != 1:
                 raise InputError(f"prescription: joint '{name}' has {model.nvs[b]} DoF; only 1-DoF joints can be prescribed here")
@@ -95,7 +95,7 @@ class MultiSine(_JointTrajectory):
     def __init__(self, amplitude, frequency, phase):
         self.amp, self.w, self.ph = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (amplitude, frequency, phase))
         if not (self.amp.shape == self.w.shape == self.ph.shape):
-            raise InputError(f"MultiSine: amplitude, frequency and phase must share a shape, got {self.amp.shape}, {self.w.shape}, {self.ph.shape}")
+            raise InputError(f"MultiSine: amplitude, frequency and phase must share a shape, " f"got {self.amp.shape}, {self.w.shape}, {self.ph.shape}")
         if np.any(self.w <= 0):
             raise InputError("MultiSine: frequencies must be positive")
         self.n = self.amp.shape[0]

@@ -72,7 +72,7 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
             bar.close()
         click.echo(f"Fourier baseline ({len(res.directions) * design.interval:g} s, {fstep.x.size} variables): "
                    f"κ = {fstep.condition_number:.4g}, C = {fstep.objective:.4g} "
-                   f"(cycloids, {2 * design.n_arm} variables: κ = {res.step3.condition_number:.4g}, C = {res.step3.objective:.4g})")
+                   f"(cycloids, {2 * design.n_arm} variables: " f"κ = {res.step3.condition_number:.4g}, C = {res.step3.objective:.4g})")
         exc.save_trajectory(Path(out) / "fourier_trajectory.json", ftraj, design.joints, g.name)
         summary["fourier"] = {"condition_number": fstep.condition_number, "objective": fstep.objective,
                               "variables": int(fstep.x.size), "iterations": fstep.iterations}

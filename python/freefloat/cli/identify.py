@@ -32,9 +32,11 @@ def identify_group():
               help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
                    "`freefloat excite`) with the paper's rate noise, and identify from that.")
 @click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="closed-form", show_default=True,
-              help="Minimal-parameter set: Naveen et al.'s closed form (revolute trees in modified-DH frames) or numeric (any robot).")
+              help="Minimal-parameter set: Naveen et al.'s closed form (revolute trees in modified-DH frames) "
+                   "or numeric (any robot).")
 @click.option("--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel').")
-@click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns (default: those, else zero).")
+@click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns "
+                              "(default: those, else zero).")
 @click.option("--weights", help="Weighted least squares: 'auto' (two steps: each momentum component weighted by the inverse "
                                 "of its residual variance) or six inverse variances for px,py,pz,Lx,Ly,Lz (default: unweighted).")
 @click.option("--rate-noise", help="Standard deviations of the white noise on the measured rates, 'base linear, base "

@@ -48,7 +48,7 @@ def minimal_cmd(model, method, known, out):
     click.echo(f"{m.name}: {mp.n_min} minimal parameters ({method}; rank {mp.rank} of {mp.matrix.shape[1]} "
                f"standard columns); known bodies: {', '.join(known_names) or 'none'}")
     w = max(len(n) for n in mp.names)
-    for k, (n, e, x) in enumerate(zip(mp.names, ex, values)):
+    for n, e, x in zip(mp.names, ex, values):
         click.echo(f"  {n:{w}s} = {x:14.6g}   = {e}")
     if out:
         d = Path(out)

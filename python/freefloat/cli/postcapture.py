@@ -20,7 +20,8 @@ import click
 @click.option("--project/--no-project", default=None,
               help="Report the standard-parameter estimate projected onto physically consistent parameters.")
 @click.option("--accelerations", type=click.Choice(["exact", "central_difference"]),
-              help="Accelerations for the force form: exact at the samples (default) or central differences of the sampled velocities.")
+              help="Accelerations for the force form: exact at the samples (default) "
+                   "or central differences of the sampled velocities.")
 @click.option("--impulses", type=click.Choice(["simpson", "trapezoid"]),
               help="Thrust impulses for the momentum form: Simpson on the 1 kHz thrust (default) or trapezoid on the samples.")
 def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses):

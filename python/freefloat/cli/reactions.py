@@ -35,7 +35,7 @@ def reactions_cmd(model, base, t_final, dt, torques, amplitude, record_every, ou
     traj = simulate(m, m.neutral(), np.zeros(m.nv), t_final, dt, record_every=record_every, progress=True, **kw)
     r = rx.along(m, traj)
     click.echo(f"{m.name}: {t_final} s, {len(r.t)} samples; dq vs ABA accelerations agree to {r.max_acceleration_mismatch:.1e}")
-    click.echo(f"  {'joint':24s} {'type':10s} {'peak |f| [N]':>14s} {'at t [s]':>9s} {'peak |tau| [N m]':>17s} {'at t [s]':>9s}")
+    click.echo(f"  {'joint':24s} {'type':10s} {'peak |f| [N]':>14s} {'at t [s]':>9s} " f"{'peak |tau| [N m]':>17s} {'at t [s]':>9s}")
     for pk in r.peaks()[1:] if m.parents[0] < 0 and m.joint_types[0] != "fixed" else r.peaks():
         click.echo(f"  {pk['joint']:24s} {pk['type']:10s} {pk['peak_force']:14.6g} {pk['t_peak_force']:9.3f} "
                    f"{pk['peak_torque']:17.6g} {pk['t_peak_torque']:9.3f}")

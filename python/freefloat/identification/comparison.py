@@ -50,7 +50,7 @@ def compare(true_model, result, seeds=(0,), rate_noise=PAPER_RATE_NOISE, progres
 
 
 def comparison_table(cmp: dict) -> str:
-    lines = [f"{'trajectory':40s} {'duration':>9s} {'κ(true)':>9s} {'LS median':>10s} {'LS max':>10s} {'BC median':>10s} {'BC max':>10s}"]
+    lines = [f"{'trajectory':40s} {'duration':>9s} {'κ(true)':>9s} {'LS median':>10s} {'LS max':>10s} " f"{'BC median':>10s} {'BC max':>10s}"]
     for name, r in cmp.items():
         lines.append(f"{name:40s} {r['duration_s']:8.0f}s {r.get('condition_number', float('nan')):9.4g} "
                      f"{r['ls_median_pct']:9.4g}% {r['ls_max_pct']:9.4g}% {r['bias_compensated_median_pct']:9.4g}% "

@@ -94,7 +94,7 @@ class Limits:
             setattr(self, name, a)
         bad = np.flatnonzero(self.q_max <= self.q_min)
         if bad.size:
-            raise InputError(f"Limits: joint {bad[0]} has no feasible position range (q_max {self.q_max[bad[0]]} <= q_min {self.q_min[bad[0]]}); widen it")
+            raise InputError(f"Limits: joint {bad[0]} has no feasible position range " f"(q_max {self.q_max[bad[0]]} <= q_min {self.q_min[bad[0]]}); widen it")
         bad = np.flatnonzero((self.qd_max <= 0) | (self.qdd_max <= 0))
         if bad.size:
             raise InputError(f"Limits: joint {bad[0]} has a non-positive rate or acceleration limit; no motion is feasible")
@@ -376,7 +376,7 @@ class ExcitationDesign:
         L = self.limits
         A, b = [], []
         for j in range(n):
-            def blk(rows):
+            def blk(rows, j=j):
                 M = np.zeros((grid, n * k))
                 M[:, j * k:(j + 1) * k] = rows
                 return M
@@ -390,7 +390,7 @@ class ExcitationDesign:
         c0[:, 0] = 0.5 * (L.q_min + L.q_max)
         for j in range(n):
             hs, hc = j % n_terms, (j + 1) % n_terms
-            amp = lambda h: min(0.5 * (L.q_max[j] - L.q_min[j]), L.qd_max[j] / ((h + 1) * w),
+            amp = lambda h, j=j: min(0.5 * (L.q_max[j] - L.q_min[j]), L.qd_max[j] / ((h + 1) * w),
                                 L.qdd_max[j] / ((h + 1) * w) ** 2) / 4
             c0[j, 1 + hs] = amp(hs)
             c0[j, 1 + n_terms + hc] = amp(hc)

@@ -182,7 +182,7 @@ def bias_compensated(mp, q, v, fit, sigma, stride: int = 10, chunk: int = 512):
     share = _noise_share(N_G, GtG)
     if share > MAX_NOISE_SHARE:
         what = "is numerically singular" if not np.isfinite(share) else f"is {share:.2g} rate noise by energy"
-        warnings.warn(f"rate_noise: the regressor's least-excited direction {what} (limit {MAX_NOISE_SHARE}); the first-order bias compensation would be unreliable there, so "
+        warnings.warn(f"rate_noise: the regressor's least-excited direction {what} (limit {MAX_NOISE_SHARE}); " f"the first-order bias compensation would be unreliable there, so "
                       "the plain least-squares estimate is returned. Excite the robot more (more or designed intervals).",
                       stacklevel=3)
         return replace(fit, method=fit.method + " (bias compensation skipped: noise-dominated direction)")
@@ -214,7 +214,7 @@ def _rate_sigmas(model, rate_noise) -> np.ndarray:
         return r
     if r.shape == (3,) and model.joint_types[0] == "free":
         return np.concatenate([np.full(3, r[0]), np.full(3, r[1]), np.full(model.nv - 6, r[2])])
-    raise InputError(f"argument `rate_noise`: expected {model.nv} standard deviations or (base linear, base angular, joint), got shape {r.shape}")
+    raise InputError(f"argument `rate_noise`: expected {model.nv} standard deviations or " f"(base linear, base angular, joint), got shape {r.shape}")
 
 
 def component_variances(mp, q, v, h, phi, chunk: int = 4096) -> np.ndarray:
@@ -236,7 +236,7 @@ def _read(model, data, h0):
         raise InputError(f"argument `data`: expected a Trajectory, a Telemetry or a file path, got {type(data).__name__}")
     q, v = np.asarray(data.q, dtype=float), np.asarray(data.v, dtype=float)
     if q.ndim != 2 or q.shape[1] != model.nq or v.shape != (len(q), model.nv):
-        raise InputError(f"argument `data`: q/v have shapes {q.shape}/{v.shape}, model '{model.name}' needs (T, {model.nq})/(T, {model.nv})")
+        raise InputError(f"argument `data`: q/v have shapes {q.shape}/{v.shape}, " f"model '{model.name}' needs (T, {model.nq})/(T, {model.nv})")
     h = getattr(data, "momentum", None)
     if h0 is not None:
         h0 = np.asarray(h0, dtype=float)
@@ -286,7 +286,7 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
 
     arm, wheels = model.joints_tagged("arm_"), model.joints_tagged("wheel")
     if len(arm) != 6 or len(wheels) != 3:
-        raise InputError(f"excitation_data needs the Naveen et al. robot (6 arm joints tagged arm_*, 3 wheels); '{model.name}' has {len(arm)} and {len(wheels)}")
+        raise InputError(f"excitation_data needs the Naveen et al. robot (6 arm joints tagged arm_*, 3 wheels); " f"'{model.name}' has {len(arm)} and {len(wheels)}")
     start, range_ = tr.with_wheels(np.deg2rad(TABLE3_START_DEG), TABLE3_RANGE_RAD)
     all_dirs = tr.direction_combinations(9)
     if not 1 <= n_intervals <= len(all_dirs):

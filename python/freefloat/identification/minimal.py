@@ -96,7 +96,7 @@ class MinimalParameters:
         return _body_columns(self.unknown)
 
     def __repr__(self) -> str:
-        return f"MinimalParameters({self.model.name!r}, method={self.method!r}, n_min={self.n_min}, unknown={len(self.unknown)} bodies)"
+        return f"MinimalParameters({self.model.name!r}, method={self.method!r}, " f"n_min={self.n_min}, unknown={len(self.unknown)} bodies)"
 
 
 def minimal_parameters(model, method: str = "numeric", known=None) -> MinimalParameters:

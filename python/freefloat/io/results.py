@@ -39,8 +39,8 @@ def summary_text(title: str, s: dict) -> str:
     return "\n".join([
         f"\n{title}",
         f"  simulated {s['t_final']:.3f} s in {s['wall_time_s']:.3f} s wall ({s['steps']} steps, {s['method']})",
-        f"  momentum drift   linear  {s['momentum_drift_linear_abs']:.3e} kg m/s   (relative {s['momentum_drift_linear_rel']:.2e})",
-        f"                   angular {s['momentum_drift_angular_abs']:.3e} kg m²/s  (relative {s['momentum_drift_angular_rel']:.2e})",
+        f"  momentum drift   linear  {s['momentum_drift_linear_abs']:.3e} kg m/s   " f"(relative {s['momentum_drift_linear_rel']:.2e})",
+        f"                   angular {s['momentum_drift_angular_abs']:.3e} kg m²/s  " f"(relative {s['momentum_drift_angular_rel']:.2e})",
         f"  kinetic energy   {s['kinetic_energy_initial']:.6g} J -> {s['kinetic_energy_final']:.6g} J",
         f"  |ΔE − work|      {s['energy_minus_work_abs']:.3e} J   (relative {s['energy_minus_work_rel']:.2e})",
     ])

@@ -273,8 +273,8 @@ def _base_wrench_3d(w: np.ndarray, planar: bool):
 
 
 def standard_momentum_rows(model, meas: Measurements, base: int, target: int) -> StandardRows:
-    """Standard-parameter momentum form (docs/postcapture.md): the engine's momentum regressor columns of base and target (standard
-    parameters about the sensor / capture point), cumulative differences from t0."""
+    """Standard-parameter momentum form (docs/postcapture.md): the engine's momentum regressor columns of
+    base and target (standard parameters about the sensor / capture point), cumulative differences from t0."""
     L = Layout(model.joint_types[0] == "planar")
     K = np.asarray(alg.momentum_regressor(model, meas.q, meas.v))
     known = K @ known_params(model, [base, target])
@@ -286,8 +286,8 @@ def standard_momentum_rows(model, meas: Measurements, base: int, target: int) ->
 
 
 def standard_force_rows(model, meas: Measurements, base: int, target: int) -> StandardRows:
-    """Standard-parameter Newton-Euler form (docs/postcapture.md): base rows of the engine's inverse-dynamics regressor (the total
-    wrench at the base sensor, base frame) for the base and target columns."""
+    """Standard-parameter Newton-Euler form (docs/postcapture.md): base rows of the engine's inverse-dynamics
+    regressor (the total wrench at the base sensor, base frame) for the base and target columns."""
     L = Layout(model.joint_types[0] == "planar")
     nb = meas.base_wrench.shape[1]
     Y = np.asarray(alg.dynamics_regressor(model, meas.q, meas.v, meas.ddq))[:, :nb]

@@ -55,7 +55,7 @@ class PostcaptureResult:
                "P0": self.scenario.P0, "forgetting": self.scenario.forgetting, "projected": self.scenario.project,
                "duration": self.scenario.duration, "timings_s": self.timings, "equation_residuals_at_truth": self.residuals,
                "noise": self.scenario.noise, "measurement": self.scenario.measurement, "methods": {}}
-        for (method, solver), (t, h) in self.histories.items():
+        for (method, solver), (_t, h) in self.histories.items():
             tt = self.transits(method, solver)
             err = self.rel_error(method, solver)
             out["methods"].setdefault(method, {})[solver] = {

@@ -56,7 +56,8 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         return cum[idx // 2]
 
     def trapezoid(f):
-        # only the sampled thrust (the alternative when the 1 kHz thrust is not recorded): trapezoid between the 10 Hz samples
+        # only the sampled thrust (the alternative when the 1 kHz thrust is not recorded):
+        # trapezoid between the 10 Hz samples
         fs = f[idx]
         return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * (fs[1:] + fs[:-1]) * sc.sample_period, 0)])
 
