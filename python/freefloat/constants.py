@@ -32,5 +32,8 @@ PAPER_RATE_NOISE = (SIGMA_LIN, SIGMA_ANG, SIGMA_JOINT)
 #: Algorithm 1 settings (Sec. VI.B)
 U_MAX, DELTA = 5, 1.0 / 300.0
 
+#: Sec. VI.B results printed beside ours: κ of the designed trajectory and the number of intervals kept
+PAPER_KAPPA, PAPER_KEPT = 248.8, 67
+
 #: torque-sensor noise of the paper's reference [33] [N·m], the yardstick of Table 6
 SIGMA_TORQUE = 0.3808

@@ -2,7 +2,7 @@
 tree-type free-floating robot), in pipeline order:
 
 - `minimal`: the minimal (identifiable) parameters — closed-form grouping and a numeric method for any tree;
-- `excitation` (+ `pruning`, `comparison`): design of exciting trajectories (cycloids, eq. 32, Algorithm 1);
+- `excitation` (+ `excitation_results`, `pruning`, `comparison`): design of exciting trajectories (cycloids, eq. 32, Algorithm 1);
 - `estimation`: streaming least squares in the engine, with covariance and rank checks;
 - `identify`: `identify_minimal` from telemetry (weighted, errors-in-variables bias compensation);
 - `consistent`: physically consistent standard parameters reproducing the minimal ones (a convex program);
@@ -13,11 +13,23 @@ A new estimator goes here: a function that takes a model and a `Telemetry` (or r
 object with `to_dict()` / `save(out)`, its arithmetic in the engine (`crates/freefloat-core/src/estimation/`).
 """
 
-from . import comparison, consistent, estimation, excitation, identify, minimal, online, pruning, validation
+from . import (
+    comparison,
+    consistent,
+    estimation,
+    excitation,
+    excitation_results,
+    identify,
+    minimal,
+    online,
+    pruning,
+    validation,
+)
 from .identify import IdentificationResult, identify_minimal
 from .minimal import MinimalParameters, minimal_parameters
 
 __all__ = [
-    "IdentificationResult", "MinimalParameters", "comparison", "consistent", "estimation", "excitation", "identify",
+    "IdentificationResult", "MinimalParameters", "comparison", "consistent", "estimation", "excitation",
+    "excitation_results", "identify",
     "identify_minimal", "minimal", "minimal_parameters", "online", "pruning", "validation",
 ]

@@ -31,24 +31,21 @@ Choices the paper leaves open, all arguments here:
 
 from __future__ import annotations
 
-import json
-from dataclasses import dataclass, field
-from pathlib import Path
-
 import numpy as np
 
 from .. import _core
 from .._core import InputError, NumericalError
-from ..constants import DELTA, PAPER_RATE_NOISE, TABLE3_RANGE_RAD, TABLE3_START_DEG, U_MAX, WHEEL_RANGE, WHEEL_START
+from ..constants import DELTA, PAPER_KAPPA, PAPER_KEPT, PAPER_RATE_NOISE, U_MAX, WHEEL_RANGE, WHEEL_START
 from ..io.trajectory_files import load_trajectory, save_trajectory
 from ..trajectories import Cycloidal, Fourier, direction_combinations
 from .comparison import compare, comparison_table
 from .estimation import absolute_columns
+from .excitation_results import DesignResult, Limits, StepResult
 from .minimal import minimal_parameters
 from .pruning import MIN_GAIN, PruneResult, plot_fig4, prune_intervals, significant
 
 __all__ = [
-    "DELTA", "KAPPA_UNEXCITED", "MIN_GAIN", "PAPER_RATE_NOISE", "U_MAX", "WEIGHT", "DesignResult", "ExcitationDesign",
+    "PAPER_KAPPA", "PAPER_KEPT", "DELTA", "KAPPA_UNEXCITED", "MIN_GAIN", "PAPER_RATE_NOISE", "U_MAX", "WEIGHT", "DesignResult", "ExcitationDesign",
     "Limits", "PruneResult", "StepResult", "compare", "comparison_table", "load_trajectory", "plot_fig4",
     "prune_intervals", "save_trajectory", "significant",
 ]
@@ -59,123 +56,6 @@ WEIGHT = 1000.0
 #: a condition number above this means some parameter combination is not excited (the Gram matrix the objective
 #: uses cannot resolve singular values below ~1e-8 of the largest)
 KAPPA_UNEXCITED = 1e8
-#: Naveen et al. results to print beside ours
-PAPER_KAPPA, PAPER_KEPT = 248.8, 67
-
-
-@dataclass
-class Limits:
-    """Joint limits of the arm joints (n,): positions [rad], |rate| [rad/s], |acceleration| [rad/s²]."""
-
-    q_min: np.ndarray
-    q_max: np.ndarray
-    qd_max: np.ndarray
-    qdd_max: np.ndarray
-
-    @classmethod
-    def naveen(cls, n: int = 6) -> "Limits":
-        """Our documented choice for the Naveen et al. arms (the paper gives none)."""
-        return cls(np.full(n, -1.5 * np.pi), np.full(n, 1.5 * np.pi), np.full(n, 1.6 * np.pi), np.full(n, 1.6 * np.pi**2))
-
-    @classmethod
-    def seed001(cls, n: int = 6) -> "Limits":
-        """Earlier name of `naveen` (kept as an alias)."""
-        return cls.naveen(n)
-
-    def range_max(self, interval: float) -> np.ndarray:
-        """θ_jd^max of eq. 36: min of the rate bound (eq. 34) and the acceleration bound (eq. 35)."""
-        return np.minimum(0.5 * interval * self.qd_max, interval**2 / (2 * np.pi) * self.qdd_max)
-
-    def check(self, n: int) -> None:
-        for name in ("q_min", "q_max", "qd_max", "qdd_max"):
-            a = np.asarray(getattr(self, name), dtype=float)
-            if a.shape != (n,) or not np.all(np.isfinite(a)):
-                raise InputError(f"Limits.{name}: expected {n} finite numbers, got shape {a.shape}")
-            setattr(self, name, a)
-        bad = np.flatnonzero(self.q_max <= self.q_min)
-        if bad.size:
-            raise InputError(f"Limits: joint {bad[0]} has no feasible position range " f"(q_max {self.q_max[bad[0]]} <= q_min {self.q_min[bad[0]]}); widen it")
-        bad = np.flatnonzero((self.qd_max <= 0) | (self.qdd_max <= 0))
-        if bad.size:
-            raise InputError(f"Limits: joint {bad[0]} has a non-positive rate or acceleration limit; no motion is feasible")
-
-
-@dataclass
-class StepResult:
-    """One SQP run: seeds x = [θ_s; θ_d], the objective's parts, and the optimiser's report."""
-
-    x: np.ndarray
-    objective: float
-    condition_number: float
-    mean_square: float
-    iterations: int
-    evaluations: int
-    message: str
-    significant: int = 0  # significant singular values (> σmax/300) of the regressor
-
-
-@dataclass
-class DesignResult:
-    design: "ExcitationDesign"
-    step1: StepResult
-    prune: PruneResult
-    step3: StepResult
-    directions: np.ndarray          # surviving direction combinations (K, n_arm + n_wheels)
-    timings: dict = field(default_factory=dict)
-
-    def trajectory(self) -> Cycloidal:
-        """The exciting trajectory (arm joints then wheels, in `design.joints` order)."""
-        return self.design.cycloid(self.step3.x, self.directions)
-
-    def table3(self) -> str:
-        """Seed parameters in the format of the paper's Table 3 (start in degrees, range in radians)."""
-        d = self.design
-        n = d.n_arm
-        s, r = self.step3.x[:n], self.step3.x[n:]
-        head = f"{'seed':10s}" + "".join(f"{j:>10s}" for j in d.arm)
-        lines = ["optimal seed parameters (Naveen et al. Table 3 format)", head,
-                 f"{'start deg':10s}" + "".join(f"{np.rad2deg(v):10.3f}" for v in s),
-                 f"{'range rad':10s}" + "".join(f"{v:10.3f}" for v in r),
-                 f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_START_DEG),
-                 f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_RANGE_RAD)]
-        return "\n".join(lines)
-
-    def summary(self) -> str:
-        k = len(self.prune.kept)
-        return (f"step 1: {self.design.n_intervals} intervals, κ = {self.step1.condition_number:.4g} "
-                f"({self.step1.iterations} SQP iterations)\n"
-                f"step 2: pruning kept {k} of {self.design.n_intervals} intervals (paper: {PAPER_KEPT} of 256)\n"
-                f"step 3: κ = {self.step3.condition_number:.4g} on the kept intervals (paper: {PAPER_KAPPA}); "
-                f"significant singular values {self.step3.significant} of {self.design.n_min}; "
-                f"duration {k * self.design.interval:g} s")
-
-    def to_dict(self) -> dict:
-        d = self.design
-        return {
-            "model": d.guess.name, "arm_joints": d.arm, "wheels": d.wheels, "interval": d.interval,
-            "step1": _step_dict(self.step1, d.n_arm), "step3": _step_dict(self.step3, d.n_arm),
-            "kept_intervals": self.prune.kept.tolist(), "n_kept": int(len(self.prune.kept)),
-            "n_candidates": d.n_intervals, "significant_singular_values": self.step3.significant,
-            "n_min": d.n_min, "paper": {"condition_number": PAPER_KAPPA, "kept": PAPER_KEPT},
-            "weight": d.weight, "limits": {k: np.asarray(v).tolist() for k, v in d.limits.__dict__.items()},
-            "timings_s": self.timings,
-        }
-
-    def save(self, directory) -> Path:
-        """DIR/trajectory.json (for `freefloat simulate/identify --trajectory`), results.json, fig4.png."""
-        out = Path(directory)
-        out.mkdir(parents=True, exist_ok=True)
-        save_trajectory(out / "trajectory.json", self.trajectory(), self.design.joints, self.design.guess.name)
-        (out / "results.json").write_text(json.dumps(self.to_dict(), indent=2))
-        plot_fig4(self.prune, out / "fig4.png")
-        return out
-
-
-def _step_dict(s: StepResult, n: int) -> dict:
-    return {"start_rad": s.x[:n].tolist(), "range_rad": s.x[n:].tolist(), "objective": s.objective,
-            "condition_number": s.condition_number, "mean_square": s.mean_square, "iterations": s.iterations,
-            "evaluations": s.evaluations, "message": s.message}
-
 
 class ExcitationDesign:
     """The design problem for a robot with guessed parameters `guess` (a Model).
