@@ -43,3 +43,21 @@ pub fn source(name: &str) -> Result<&'static str> {
 pub fn load(name: &str) -> Result<Model> {
     super::yaml::from_yaml_str(source(name)?, &format!("built-in model '{}'", resolve(name)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_alias_names_a_current_robot_and_loads_it() {
+        let current = names();
+        for (old, new) in ALIASES {
+            assert!(current.contains(new), "alias {old} -> {new}: no such built-in");
+            assert!(!current.contains(old), "alias {old} is also a current name");
+            assert_eq!(source(old).unwrap(), source(new).unwrap());
+            assert_eq!(resolve(old), *new);
+        }
+        assert_eq!(resolve("naveen_dual_arm"), "naveen_dual_arm");
+        assert!(source("no_such_robot").is_err());
+    }
+}
