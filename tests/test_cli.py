@@ -29,6 +29,7 @@ def test_models_lists_builtins():
     assert "name: zhang2020_3d" in run("models", "--show", "zhang2020_3d").stdout
 
 
+@pytest.mark.slow
 def test_simulate_writes_parquet_json_and_figure(tmp_path):
     out = tmp_path / "run.parquet"
     r = run("simulate", "valverde_ch5_single_arm", "--t-final", "1", "--out", str(out))
@@ -38,6 +39,7 @@ def test_simulate_writes_parquet_json_and_figure(tmp_path):
     assert out.exists() and out.with_suffix(".png").stat().st_size > 10_000
 
 
+@pytest.mark.slow
 def test_demo_runs(tmp_path):
     r = run("demo", "--t-final", "2", "--out", str(tmp_path))
     res = json.loads((tmp_path / "results.json").read_text())
@@ -54,6 +56,7 @@ def test_bad_model_gives_one_clear_line(tmp_path):
     assert r.returncode == 2 and "negative" in r.stderr and "Traceback" not in r.stderr
 
 
+@pytest.mark.slow
 def test_params_minimal_prints_and_writes_table4(tmp_path):
     r = run("params", "minimal", "naveen_dual_arm", "--method", "closed-form", "--out", str(tmp_path))
     assert "52 minimal parameters" in r.stdout and "0.09*L4.m" in r.stdout
@@ -69,6 +72,7 @@ def test_params_minimal_closed_form_refuses_prismatic():
     assert r.returncode == 2 and 'method="numeric"' in r.stderr and "Traceback" not in r.stderr
 
 
+@pytest.mark.slow
 def test_identify_minimal_from_a_simulation_and_from_a_file(tmp_path):
     r = run("identify", "minimal", "naveen_dual_arm", "--simulate", "16", "--out", str(tmp_path))
     assert "eqs. 38-39" in r.stdout
@@ -80,6 +84,7 @@ def test_identify_minimal_from_a_simulation_and_from_a_file(tmp_path):
     assert bad.returncode == 2 and "exactly one of --data" in bad.stderr
 
 
+@pytest.mark.slow
 def test_identify_minimal_full_urdf_and_weights(tmp_path):
     r = run("identify", "minimal", "naveen_dual_arm_consistent", "--simulate", "16", "--weights", "auto", "--full",
             "--prior", "naveen_dual_arm_offset", "--out", str(tmp_path))
@@ -95,6 +100,7 @@ def test_identify_minimal_full_urdf_and_weights(tmp_path):
     assert bad.returncode == 2 and "--weights" in bad.stderr
 
 
+@pytest.mark.slow
 def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
     r = run("excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--maxiter", "3", "--out", str(tmp_path))
     assert "pruning kept" in r.stdout and "Table 3" in r.stdout

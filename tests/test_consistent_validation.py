@@ -59,6 +59,7 @@ def test_consistent_parameters_reproduce_exact_minimal_parameters(consistent_rob
         np.testing.assert_allclose(ff.momentum(mi, q, v), h_true, rtol=0, atol=1e-5 * np.abs(h_true).max())
 
 
+@pytest.mark.slow
 def test_verbatim_table2_has_no_consistent_representative(prior):
     # Naveen et al.'s Table 2 links are not physically consistent; no consistent robot has the same minimal
     # parameters: the nearest one misses some of them by several percent (L4.Izz, L6.Izz, L6.Ixy).
@@ -77,6 +78,7 @@ def test_bad_inputs_to_consistent_parameters(consistent_robot):
         consistent_parameters(mp, np.ones(mp.n_min), covariance=-np.eye(mp.n_min))
 
 
+@pytest.mark.slow
 def test_prediction_of_the_same_robot_is_exact_and_of_a_representative_nearly(consistent_robot, prior):
     m = consistent_robot
     same = predict(m, m, dt=5e-3)
@@ -110,6 +112,7 @@ def test_prediction_starts_with_zero_momentum_and_follows_fourier(consistent_rob
     assert np.abs(traj.momentum).max() < 1e-9 * m.total_mass
 
 
+@pytest.mark.slow
 def test_noisy_identification_predicts_far_below_the_noise_floor(consistent_robot, prior):
     m = consistent_robot
     telem, _ = idf.excitation_data(m, n_intervals=24, seed=1)
@@ -146,6 +149,7 @@ def thrust_run():
     return m, traj, telem
 
 
+@pytest.mark.slow
 def test_integrated_wrench_is_the_engine_momentum(thrust_run):
     _, traj, telem = thrust_run
     H = telem.integrated_momentum()
@@ -153,6 +157,7 @@ def test_integrated_wrench_is_the_engine_momentum(thrust_run):
     np.testing.assert_allclose(H, traj.momentum, atol=1e-7 * np.abs(traj.momentum).max() * 100)
 
 
+@pytest.mark.slow
 def test_identification_with_external_impulses(thrust_run, tmp_path):
     m, _, telem = thrust_run
     truth = ff.minimal_parameters(m, "closed-form").from_standard(m.parameters())
@@ -167,6 +172,7 @@ def test_identification_with_external_impulses(thrust_run, tmp_path):
     np.testing.assert_allclose(ff.identify_minimal(m, path).estimate, res.estimate, rtol=1e-10)
 
 
+@pytest.mark.slow
 def test_partial_wrench_columns_are_named(thrust_run, tmp_path):
     m, _, telem = thrust_run
     cols = telem.columns()
@@ -180,6 +186,7 @@ def test_partial_wrench_columns_are_named(thrust_run, tmp_path):
         tm.Telemetry.from_file(path, m)
 
 
+@pytest.mark.slow
 def test_weighted_least_squares(consistent_robot):
     m = consistent_robot
     telem, _ = idf.excitation_data(m, n_intervals=16, seed=2)
@@ -192,6 +199,7 @@ def test_weighted_least_squares(consistent_robot):
         ff.identify_minimal(m, telem, weights="best")
 
 
+@pytest.mark.slow
 def test_bias_compensation_removes_the_errors_in_variables_bias():
     # Least squares on noisy rates shrinks the estimate (about -0.05 % common mode with the paper's noise,
     # standard deviations ~10x too small). With the known rate noise the bias is removed and the reported
@@ -213,6 +221,7 @@ def test_bias_compensation_removes_the_errors_in_variables_bias():
         ff.identify_minimal(m, telem, rate_noise=(1.0, 2.0))
 
 
+@pytest.mark.slow
 def test_bias_compensation_refuses_a_noise_dominated_direction():
     # The first 20 direction combinations (not spread over the 256) leave one combination barely excited
     # (condition number ~4e5): compensating there would amplify noise, so the plain estimate comes back.

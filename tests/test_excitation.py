@@ -139,6 +139,7 @@ def test_trajectory_file_round_trip(design, tmp_path):
         exc.load_trajectory(tmp_path / "bad.json")
 
 
+@pytest.mark.slow
 def test_a_short_design_is_feasible_and_excites_everything(guess):
     d = exc.ExcitationDesign(guess)
     res = d.design(maxiter=4, progress=False)
@@ -190,6 +191,7 @@ def test_bad_input(guess):
         exc.ExcitationDesign(guess, arm=["nope"])
 
 
+@pytest.mark.slow
 def test_the_shipped_designed_trajectory():
     """The shipped designed trajectory (freefloat/data/trajectories/, written by
     `freefloat excite naveen_dual_arm --guess

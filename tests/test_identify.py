@@ -20,6 +20,7 @@ def clean(robot):
     return idf.excitation_data(robot, n_intervals=16, noise=False)
 
 
+@pytest.mark.slow
 def test_noise_free_data_recovers_the_minimal_parameters(robot, clean):
     telem, traj = clean
     res = ff.identify_minimal(robot, telem)
@@ -30,6 +31,7 @@ def test_noise_free_data_recovers_the_minimal_parameters(robot, clean):
     assert np.abs(traj.momentum).max() < 1e-5
 
 
+@pytest.mark.slow
 def test_data_from_a_file_and_from_memory_agree(robot, clean, tmp_path):
     telem, _ = clean
     path = tmp_path / "telemetry.parquet"
@@ -39,6 +41,7 @@ def test_data_from_a_file_and_from_memory_agree(robot, clean, tmp_path):
     np.testing.assert_allclose(b.estimate, a.estimate, rtol=1e-12)
 
 
+@pytest.mark.slow
 def test_noisy_data_gives_small_errors_and_a_report(robot, clean, tmp_path):
     telem, _ = clean
     noisy = ff.telemetry.add_noise(telem, robot, np.random.default_rng(1))

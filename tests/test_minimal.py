@@ -110,6 +110,7 @@ def test_wheels_unknown_numeric_counts_their_columns():
     assert mp.rank == 52 + 3 * 7
 
 
+@pytest.mark.slow
 def test_numeric_other_joint_types():
     m = ff.models.load("valverde_ch7_two_arm")  # revolute, prismatic and spherical joints
     _check_numeric_reproduces_momentum(m, seed=2)

@@ -121,6 +121,7 @@ def test_simulation_obeys_eq_39_and_the_momentum_balance():
 
 
 # -- identification --------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_truth_vector_is_the_model_file(medium):
     tr = yaml_truth("zhang2020_2d_medium")
     (m1, b1, I1), (mn, bn, In) = tr["base"], tr["target"]
@@ -129,6 +130,7 @@ def test_truth_vector_is_the_model_file(medium):
     np.testing.assert_allclose(medium.truth, [500, 0.1, -0.1, 83.61, 250, 0.25, 0.1, 10.41])
 
 
+@pytest.mark.slow
 def test_identification_equations_hold_at_the_truth(medium, spatial):
     """Relative residuals at the model file's parameters: round-off plus the RK4 truncation of the
     simulated state (3D: 30 m/s, spinning wrist joints, hence the looser bound)."""
@@ -139,6 +141,7 @@ def test_identification_equations_hold_at_the_truth(medium, spatial):
             assert r["standard"] <= tol * r["standard_scale"], (res.scenario.name, method, r)
 
 
+@pytest.mark.slow
 def test_noise_free_2d_converges_to_the_model_file(medium):
     for method in pc.METHODS:
         for solver in pc.SOLVERS:
@@ -151,6 +154,7 @@ def test_noise_free_2d_converges_to_the_model_file(medium):
     assert np.argmax(tt) == medium.names.index("In")
 
 
+@pytest.mark.slow
 def test_standard_form_is_at_least_as_accurate(medium, spatial):
     """Issue 3: the linear standard-parameter RLS reaches the same or smaller error than the modified RLS."""
     for res in (medium, spatial):
@@ -160,6 +164,7 @@ def test_standard_form_is_at_least_as_accurate(medium, spatial):
             assert std.max() <= mod.max() * 1.01, (res.scenario.name, method, std.max(), mod.max())
 
 
+@pytest.mark.slow
 def test_noise_free_3d(spatial):
     names = spatial.names
     tr = yaml_truth("zhang2020_3d")
@@ -172,6 +177,7 @@ def test_noise_free_3d(spatial):
             assert abs(spatial.final(method, solver)[names.index("bnz")]) < 1e-8  # zero true value
 
 
+@pytest.mark.slow
 def test_mass_and_com_do_not_depend_on_the_solver(medium):
     """Both solvers see the same physics: m and b' agree to the accuracy of the estimates."""
     a = medium.final("momentum", "modified_rls")
@@ -179,6 +185,7 @@ def test_mass_and_com_do_not_depend_on_the_solver(medium):
     np.testing.assert_allclose(a, b, rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_velocity_sweep_reproduces_the_papers_trend():
     """Figs. 6-9: momentum-based I'_n error grows with the initial base velocity, force-based does not."""
     sc = pc.load_scenario("zhang2020_2d_sweep")
@@ -190,6 +197,7 @@ def test_velocity_sweep_reproduces_the_papers_trend():
     assert abs(frc[1] - frc[0]) < 0.3 * frc[0]
 
 
+@pytest.mark.slow
 def test_noise_degrades_gracefully():
     sc = pc.load_scenario("zhang2020_2d_medium")
     sc.noise = dict(pc.DEFAULT_NOISE)
@@ -201,6 +209,7 @@ def test_noise_degrades_gracefully():
 
 
 # -- command line ----------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_cli_identify_postcapture(tmp_path):
     r = CliRunner().invoke(main, ["identify", "postcapture", "zhang2020_2d_small", "--out", str(tmp_path)])
     assert r.exit_code == 0, r.output
@@ -288,6 +297,7 @@ def test_simulation_bad_input():
         pc.simulate(sc)
 
 
+@pytest.mark.slow
 def test_projection_and_forgetting_options():
     """The projection leaves consistent (here: the true) parameters alone and repairs a non-physical set;
     a forgetting factor close to 1 still converges on noise-free data."""

@@ -104,9 +104,9 @@ class PredictionResult:
         return out
 
     def plot(self, path) -> None:
-        from ..viz import pyplot as _plt
+        from ..viz import pyplot
 
-        plt = _plt()
+        plt = pyplot()
         fig, ax = plt.subplots(3, 1, figsize=(10, 9), sharex=True, constrained_layout=True)
         e_tw, e_tau = self.twist_true - self.twist_pred, self.tau_true - self.tau_pred
         for k in range(3):
