@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Exciting-trajectory design objective (Naveen et al., eq. 32): freefloat vs a Pinocchio + numpy peer.
+"""Exciting-trajectory design objective (Naveen, Shah, Misra, eq. 32): freefloat vs a Pinocchio + numpy peer.
 
 Problem: guessed robot naveen_dual_arm_offset, `ExcitationDesign` defaults: all 256 direction combinations
 (one 1-s cycloidal interval each, six arm joints with design seeds, three wheels on fixed seeds), seeds
@@ -110,7 +110,7 @@ class PinPeer:
         self.q_loc = pin.neutral(pm)
         others = np.setdiff1d(np.arange(7, pm.nq), self.iq)
         if others.size:
-            raise SystemExit("the peer assumes every non-base joint is driven (true for the Naveen et al. robots)")
+            raise SystemExit("the peer assumes every non-base joint is driven (true for the Naveen, Shah, Misra robots)")
         self.R0 = quat_to_matrix(q0[3:7] / np.linalg.norm(q0[3:7]))
         self.p0 = q0[:3].copy()
 
@@ -335,7 +335,7 @@ def main():
         "sequential_over_batch": sg["sequential_13_calls"]["median"] / sg["batch_one_call"]["median"],
     }
     res = {
-        "benchmark": "excitation objective (Naveen et al. eq. 32)", "model": MODEL, "quick": args.quick,
+        "benchmark": "excitation objective (Naveen, Shah, Misra eq. 32)", "model": MODEL, "quick": args.quick,
         "problem": {"intervals": n_int, "grid_points": int(n_int * d.grid + 1), "sampled_points": int(n_int * d.samples),
                     "regressor_shape": [6 * n_int * d.samples, int(d.n_min)], "weight": d.weight,
                     "seeds": x.tolist(), "threads": d.threads},
@@ -356,7 +356,7 @@ def main():
 
     ms = lambda s: f"{1e3 * s['median']:.2f}"
     md = [
-        "# Exciting-trajectory objective (Naveen et al. eq. 32): freefloat vs a Pinocchio + numpy peer", "",
+        "# Exciting-trajectory objective (Naveen, Shah, Misra eq. 32): freefloat vs a Pinocchio + numpy peer", "",
         f"{MODEL}, {n_int} intervals x 1 s: {res['problem']['grid_points']:,} grid points for the base response, "
         f"{res['problem']['sampled_points']:,} sampled points -> " f"{6 * n_int * d.samples:,} x {d.n_min} minimal regressor; "
         f"seeds `d.feasible_start(d.all_directions)`.",

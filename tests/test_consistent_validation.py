@@ -1,4 +1,4 @@
-"""Physically consistent full parameters from minimal ones, validation by prediction (Naveen et al. Sec. VI.D),
+"""Physically consistent full parameters from minimal ones, validation by prediction (Naveen, Shah, Misra Sec. VI.D),
 identification with external impulses, and weighted least squares."""
 
 import numpy as np
@@ -61,7 +61,7 @@ def test_consistent_parameters_reproduce_exact_minimal_parameters(consistent_rob
 
 @pytest.mark.slow
 def test_verbatim_table2_has_no_consistent_representative(prior):
-    # Naveen et al.'s Table 2 links are not physically consistent; no consistent robot has the same minimal
+    # Naveen, Shah, Misra's Table 2 links are not physically consistent; no consistent robot has the same minimal
     # parameters: the nearest one misses some of them by several percent (L4.Izz, L6.Izz, L6.Ixy).
     m = ff.models.load("naveen_dual_arm")
     mp = ff.minimal_parameters(m, "closed-form")
@@ -84,7 +84,7 @@ def test_prediction_of_the_same_robot_is_exact_and_of_a_representative_nearly(co
     same = predict(m, m, dt=5e-3)
     assert np.abs(same.rms_twist).max() == 0.0 and np.abs(same.rms_torque).max() == 0.0
     # A different full parameter set with the same minimal parameters predicts the same motion and torques
-    # (momentum AND dynamics depend only on the minimal parameters, Naveen et al. Sec. IV).
+    # (momentum AND dynamics depend only on the minimal parameters, Naveen, Shah, Misra Sec. IV).
     mp = ff.minimal_parameters(m, "closed-form")
     rep = consistent_parameters(mp, mp.from_standard(m.parameters()), prior=prior).model(m)
     p = predict(m, rep, dt=5e-3)
@@ -127,7 +127,7 @@ def test_noisy_identification_predicts_far_below_the_noise_floor(consistent_robo
 
 @pytest.fixture(scope="module")
 def thrust_run():
-    """Naveen et al. robot with base thrusters firing while the arms and wheels move (16 intervals, all 52 excited)."""
+    """Naveen, Shah, Misra robot with base thrusters firing while the arms and wheels move (16 intervals, all 52 excited)."""
     m = ff.models.load("naveen_dual_arm")
     arm, wh = m.joints_tagged("arm_"), m.joints_tagged("wheel")
     start, rng_ = tr.with_wheels(np.deg2rad(idf.TABLE3_START_DEG), idf.TABLE3_RANGE_RAD)

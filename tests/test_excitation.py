@@ -1,4 +1,4 @@
-"""Exciting-trajectory design (Naveen et al. Sec. V): the Rust objective against independent computations, the
+"""Exciting-trajectory design (Naveen, Shah, Misra Sec. V): the Rust objective against independent computations, the
 constraints, Algorithm 1, trajectory files and bad input."""
 
 import json

@@ -1,4 +1,4 @@
-"""The identification pipeline of Naveen et al.: simulated excitation, telemetry, minimal-parameter estimate."""
+"""The identification pipeline of Naveen, Shah, Misra: simulated excitation, telemetry, minimal-parameter estimate."""
 
 import json
 
@@ -69,5 +69,5 @@ def test_bad_data_is_rejected(robot):
     with pytest.raises(ff.InputError, match="h0"):
         telem, _ = idf.excitation_data(robot, n_intervals=1, noise=False)
         ff.identify_minimal(robot, telem, h0=[0, 0])
-    with pytest.raises(ff.InputError, match="Naveen et al. robot"):
+    with pytest.raises(ff.InputError, match="Naveen, Shah, Misra robot"):
         idf.excitation_data(ff.models.load("zhang2020_3d"), n_intervals=2)

@@ -1,4 +1,4 @@
-"""Minimal parameters of the momentum model (python/freefloat/minimal.py): Naveen et al.'s closed form against its
+"""Minimal parameters of the momentum model (python/freefloat/minimal.py): Naveen, Shah, Misra's closed form against its
 Table 4, the numeric (QR) method against the closed form, and the numeric method on other joint types."""
 
 import freefloat as ff
@@ -7,7 +7,7 @@ import pytest
 import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 import scipy.linalg
 
-# Naveen et al., Table 4 "True" column, phi_m(1..52) in the paper's order.  Printed to 3 decimals, so
+# Naveen, Shah, Misra, Table 4 "True" column, phi_m(1..52) in the paper's order.  Printed to 3 decimals, so
 # the tolerance is half a unit of the last digit (5e-4, e.g. 2.1125 printed 2.112) plus float slack.
 TABLE4_TRUE = [
     2130.560, 2078.560, 1555.700, -96.630, -269.450, -148.890, 2265.000, 440.500, 679.500, 1033.000,
@@ -80,7 +80,7 @@ def test_deleted_directions_are_exact_combinations(dual_arm):
     G = unknown_regressor(m, mpn, Q, V).reshape(-1, 70)
     for mp in (mpn, mpc):
         N = scipy.linalg.null_space(mp.matrix)
-        assert N.shape == (70, 18)  # 3 per revolute joint (Naveen et al., eqs. 18-20)
+        assert N.shape == (70, 18)  # 3 per revolute joint (Naveen, Shah, Misra, eqs. 18-20)
         assert np.abs(G @ N).max() <= 1e-12 * np.abs(G).max()
 
 

@@ -1,4 +1,4 @@
-"""Zhang et al. 2020 post-capture identification (issue 3): closed forms, simulation, both estimators, bad input.
+"""Zhang, Yue, Yuan 2020 post-capture identification (issue 3): closed forms, simulation, both estimators, bad input.
 
 Truth is read from the model YAML files themselves (mass, CoM offset, inertia about the CoM), not from
 the code under test; cross-checks use conservation laws, the closed-form attitude response of eq. (39),

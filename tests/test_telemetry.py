@@ -1,4 +1,4 @@
-"""Telemetry: file round trips (Parquet, CSV), validation errors that name the column/row, the Naveen et al.
+"""Telemetry: file round trips (Parquet, CSV), validation errors that name the column/row, the Naveen, Shah, Misra
 measurement noise (Sec. VI.C) and pose reconstruction from rates (Appendix C)."""
 
 import freefloat as ff

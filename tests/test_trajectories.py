@@ -1,4 +1,4 @@
-"""Naveen et al. trajectories: direction combinations (V.B), multi-interval cycloids (eqs. 28–31), wheel
+"""Naveen, Shah, Misra trajectories: direction combinations (V.B), multi-interval cycloids (eqs. 28–31), wheel
 seeds (VI.A.2), Fourier evaluation trajectory (eqs. 40–41), and a prescribed simulation of the
 dual-arm robot with its wheels that must keep the total momentum at zero."""
 
@@ -8,7 +8,7 @@ import pytest
 from freefloat import trajectories as tr
 from freefloat._core import InputError
 
-# Table 3 of Naveen et al.: start angles in degrees; ranges read as radians, scaled down here
+# Table 3 of Naveen, Shah, Misra: start angles in degrees; ranges read as radians, scaled down here
 # so the short test run stays gentle.
 TABLE3_START = np.deg2rad([40.661, -109.403, -78.782, 125.089, -110.0, 51.228])
 TABLE3_RANGE = np.array([0.524, 2.51, 2.51, 2.513, 2.036, 2.5])
@@ -93,7 +93,7 @@ def test_cycloid_rests_outside_its_duration():
 
 
 def test_wheel_peak_momentum_matches_seed():
-    # Naveen et al. VI.A.2: start 0, range 3π per 1-s interval -> 18.8496 kg·m²/s for a 1 kg·m² wheel.
+    # Naveen, Shah, Misra VI.A.2: start 0, range 3π per 1-s interval -> 18.8496 kg·m²/s for a 1 kg·m² wheel.
     c = tr.Cycloidal([tr.WHEEL_START], [tr.WHEEL_RANGE], [[1]], interval=1.0)
     _, qd, _ = c.evaluate(np.linspace(0, 1, 10001))
     assert abs(1.0 * qd.max() - 18.8496) < 1e-4

@@ -200,7 +200,7 @@ def simulate_driven(model: Model, trajectory, joints, dt: float, *, held=(), t_f
     """Simulate `model` while the named `joints` follow a joint `trajectory` (an object with `prescription`
     and `duration`, e.g. from `freefloat.trajectories`) and the joints in `held` stay at their neutral angle; the
     base floats with zero total momentum, its initial twist solved from the momentum model,
-    A_b v_b = −A_j q̇_j (Naveen et al.). t_final: default the trajectory's duration."""
+    A_b v_b = −A_j q̇_j (Naveen, Shah, Misra). t_final: default the trajectory's duration."""
     from .algorithms import centroidal_momentum_matrix
 
     presc = trajectory.prescription(model, joints)  # entries it does not drive: neutral angle, at rest

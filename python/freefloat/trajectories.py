@@ -1,10 +1,10 @@
-"""Joint trajectories of Naveen et al. (Naveen, Shah, Misra, "Momentum model-based minimal parameter
+"""Joint trajectories of Naveen, Shah, Misra (Naveen, Shah, Misra, "Momentum model-based minimal parameter
 identification of a space robot"): the multi-interval cycloidal exciting trajectory (Section V.B–D,
 eqs. 28–31) and the Fourier trajectory used to evaluate the estimates (Section VI.D, eqs. 40–41).
 
 Both give joint angle, rate and acceleration as functions of time, vectorised over time, and a
 `prescription(model, joint_names)` that `freefloat.simulate(..., prescribed=..., prescription=...)`
-accepts. The reaction wheels of Naveen et al. are ordinary joints of the model, so they are driven like the
+accepts. The reaction wheels of Naveen, Shah, Misra are ordinary joints of the model, so they are driven like the
 arm joints: `with_wheels` appends their predetermined seeds (start 0, range 3π per interval, Sec. VI.A.2)."""
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from ._core import InputError
 from .constants import WHEEL_RANGE, WHEEL_START
 
 def direction_combinations(n: int, fixed: int = 0, fastest: str = "last") -> np.ndarray:
-    """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (Naveen et al. V.B:
+    """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (Naveen, Shah, Misra V.B:
     one joint keeps its direction, so there are 2^(n-1) combinations, 256 for 6 arm joints + 3 wheels).
 
     The paper fixes neither the joint nor the order. Ordering chosen here:
@@ -115,7 +115,7 @@ class MultiSine(_JointTrajectory):
 
 
 class Cycloidal(_JointTrajectory):
-    """Multi-interval cycloidal joint trajectory of Naveen et al., eqs. 28–31.
+    """Multi-interval cycloidal joint trajectory of Naveen, Shah, Misra, eqs. 28–31.
 
     start (n,)      θ_js, angle at t = 0 (eq. 30, k = 1)
     range_ (n,)     θ_jd > 0, distance moved per interval
@@ -152,7 +152,7 @@ class Cycloidal(_JointTrajectory):
             raise InputError("Cycloidal: start and range_ must be finite")
         if np.any(self.range_ <= 0):
             j = int(np.argmax(self.range_ <= 0))
-            raise InputError(f"Cycloidal: range_ must be > 0 (Naveen et al. eq. 37); joint {j} has {self.range_[j]}")
+            raise InputError(f"Cycloidal: range_ must be > 0 (Naveen, Shah, Misra eq. 37); joint {j} has {self.range_[j]}")
         if not np.all(np.isin(self.directions, (-1.0, 1.0))):
             raise InputError("Cycloidal: directions must be +1 or -1")
         if not (self.interval > 0 and np.isfinite(self.interval)):
@@ -195,7 +195,7 @@ class Cycloidal(_JointTrajectory):
 
 
 class Fourier(_JointTrajectory):
-    """Finite Fourier joint trajectory of Naveen et al. Sec. VI.D, eqs. 40–41:
+    """Finite Fourier joint trajectory of Naveen, Shah, Misra Sec. VI.D, eqs. 40–41:
         q_j  = q_j0 + Σ_i a_ji sin(iω_f t) + b_ji cos(iω_f t)                  (40)
         q̇_j  = Σ_i iω_f (a_ji cos(iω_f t) − b_ji sin(iω_f t))                   (41)
         q̈_j  = −Σ_i (iω_f)² (a_ji sin(iω_f t) + b_ji cos(iω_f t))              (derivative of 41)

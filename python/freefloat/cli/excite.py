@@ -14,7 +14,7 @@ from ._common import load_model, tqdm_bar
 @click.command("excite")
 @click.argument("model")
 @click.option("--guess", help="Robot (built-in name or file) whose inertial parameters are the rough guess the design "
-                              "uses for the base response (default: MODEL's own). For Naveen et al.: naveen_dual_arm_offset.")
+                              "uses for the base response (default: MODEL's own). For Naveen, Shah, Misra: naveen_dual_arm_offset.")
 @click.option("--weight", type=float, default=None, help="w of eq. 32 (default 1000 rad²/s², see docs/excitation.md).")
 @click.option("--min-gain", type=float, default=None,
               help="Relative decrease of the condition number that counts as an improvement in the pruning "
@@ -32,7 +32,7 @@ from ._common import load_model, tqdm_bar
 @click.option("--out", default="freefloat-excite", show_default=True,
               help="Directory for trajectory.json, results.json and fig4.png.")
 def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc_limit, compare, fourier, out):
-    """Design an exciting trajectory for identifying MODEL's minimal parameters (Naveen et al., Sec. V).
+    """Design an exciting trajectory for identifying MODEL's minimal parameters (Naveen, Shah, Misra, Sec. V).
 
     Three steps, each with a progress bar: (1) SQP over two seeds per arm joint (start angle and range of the
     cycloids, eqs. 28-31) on every direction combination of the driven joints, minimising eq. 32 (condition

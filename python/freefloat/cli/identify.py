@@ -27,12 +27,12 @@ def identify_group():
                                                   "(labels as in a `freefloat simulate` output) and optionally momentum.px ... momentum.Lz "
                                                   "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).")
 @click.option("--simulate", "n_sim", type=int, help="Instead of --data: simulate N one-second excitation intervals of the "
-                                                     "Naveen et al. robot (cycloids from the paper's Table 3 seeds) with the paper's rate noise.")
+                                                     "Naveen, Shah, Misra robot (cycloids from the paper's Table 3 seeds) with the paper's rate noise.")
 @click.option("--trajectory", "traj_file", type=click.Path(exists=True, dir_okay=False),
               help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
                    "`freefloat excite`) with the paper's rate noise, and identify from that.")
 @click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="closed-form", show_default=True,
-              help="Minimal-parameter set: Naveen et al.'s closed form (revolute trees in modified-DH frames) "
+              help="Minimal-parameter set: Naveen, Shah, Misra's closed form (revolute trees in modified-DH frames) "
                    "or numeric (any robot).")
 @click.option("--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel').")
 @click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns "
@@ -49,7 +49,7 @@ def identify_group():
                               "parts the data cannot see (default: MODEL itself; for naveen_dual_arm try naveen_dual_arm_offset).")
 @click.option("--validate/--no-validate", default=False, show_default=True,
               help="Predict base twist and joint torques of the true (MODEL) and identified robots along the paper's "
-                   "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to Naveen et al. Table 6. Implies --full.")
+                   "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to Naveen, Shah, Misra Table 6. Implies --full.")
 @click.option("--truth/--no-truth", default=True, show_default=True,
               help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).")
 @click.option("--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf).")

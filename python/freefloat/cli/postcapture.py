@@ -25,7 +25,7 @@ import click
 @click.option("--impulses", type=click.Choice(["simpson", "trapezoid"]),
               help="Thrust impulses for the momentum form: Simpson on the 1 kHz thrust (default) or trapezoid on the samples.")
 def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses):
-    """Zhang et al. 2020: identify base and captured target online, in one step (momentum- and force-based).
+    """Zhang, Yue, Yuan 2020: identify base and captured target online, in one step (momentum- and force-based).
 
     SCENARIO is a built-in name (`freefloat scenarios`) or a YAML file. Simulates the post-capture motion
     (RK4, 1 ms; eq. 40 momentum damping, eq. 39 attitude stabilisation by the arm), samples it at the
@@ -83,7 +83,7 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
 
 @click.command("scenarios")
 def scenarios_cmd():
-    """List the built-in post-capture scenarios (Zhang et al. 2020), one per line with what it reproduces.
+    """List the built-in post-capture scenarios (Zhang, Yue, Yuan 2020), one per line with what it reproduces.
 
     A scenario file (YAML; the built-in ones ship inside the package) names the robot, the captured target, the
     controller gains, the initial velocities and the identification settings. Run one with

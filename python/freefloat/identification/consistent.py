@@ -133,7 +133,7 @@ def representative_parameters(mp, phi, prior=None) -> np.ndarray:
     """(nbodies, 10) standard parameters that map exactly to `phi`, the smallest change of `prior` (default:
     mp.model's parameters) that does: P_u = P0 + Bᵀ(BBᵀ)⁻¹(φ − B P0).  Linear and exact, but not necessarily
     physically consistent — use it when only momentum and dynamics matter (prediction), e.g. for a robot whose
-    true parameters are themselves inconsistent (Naveen et al. Table 2)."""
+    true parameters are themselves inconsistent (Naveen, Shah, Misra Table 2)."""
     phi = np.asarray(phi, dtype=float)
     if phi.shape != (mp.n_min,) or not np.all(np.isfinite(phi)):
         raise InputError(f"argument `phi`: expected {mp.n_min} finite numbers, got shape {phi.shape}")

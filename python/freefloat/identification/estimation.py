@@ -1,4 +1,4 @@
-"""Least-squares identification of the minimal inertial parameters from momentum (Naveen et al., eqs. 26-27).
+"""Least-squares identification of the minimal inertial parameters from momentum (Naveen, Shah, Misra, eqs. 26-27).
 
 `least_squares(model, Q, V, H, mp)` solves `G_m phi_m = m` (eq. 26: the minimal regressor stacked over samples,
 with the known bodies' momentum moved to the right-hand side) in Rust, streaming over the samples so the
@@ -84,7 +84,7 @@ def least_squares(model, Q, V, H, mp, P_known=None, weights=None, method: str = 
 
 
 def relative_errors(estimate, truth) -> tuple[float, float]:
-    """Naveen et al.'s error figures in percent: (median_i |(phi_i - phi_hat_i) / phi_i|, max_i ...)  (eqs. 38, 39)."""
+    """Naveen, Shah, Misra's error figures in percent: (median_i |(phi_i - phi_hat_i) / phi_i|, max_i ...)  (eqs. 38, 39)."""
     est, tru = np.asarray(estimate, dtype=float), np.asarray(truth, dtype=float)
     if est.shape != tru.shape or est.ndim != 1:
         raise InputError(f"arguments `estimate`, `truth`: expected two equal 1-d shapes, got {est.shape}, {tru.shape}")

@@ -31,7 +31,7 @@ class Limits:
 
     @classmethod
     def naveen(cls, n: int = 6) -> "Limits":
-        """Our documented choice for the Naveen et al. arms (the paper gives none)."""
+        """Our documented choice for the Naveen, Shah, Misra arms (the paper gives none)."""
         return cls(np.full(n, -1.5 * np.pi), np.full(n, 1.5 * np.pi), np.full(n, 1.6 * np.pi), np.full(n, 1.6 * np.pi**2))
 
     @classmethod
@@ -90,7 +90,7 @@ class DesignResult:
         n = d.n_arm
         s, r = self.step3.x[:n], self.step3.x[n:]
         head = f"{'seed':10s}" + "".join(f"{j:>10s}" for j in d.arm)
-        lines = ["optimal seed parameters (Naveen et al. Table 3 format)", head,
+        lines = ["optimal seed parameters (Naveen, Shah, Misra Table 3 format)", head,
                  f"{'start deg':10s}" + "".join(f"{np.rad2deg(v):10.3f}" for v in s),
                  f"{'range rad':10s}" + "".join(f"{v:10.3f}" for v in r),
                  f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_START_DEG),

@@ -1,4 +1,4 @@
-"""Minimal-parameter identification of a free-floating robot from its momentum (Naveen et al., Secs. III-IV, VI.C).
+"""Minimal-parameter identification of a free-floating robot from its momentum (Naveen, Shah, Misra, Secs. III-IV, VI.C).
 
     res = ff.identify_minimal(model, data)        # data: Trajectory, Telemetry, or a .parquet/.csv telemetry file
     print(res.table(truth=model.parameters()))     # name, true value, estimate, std, relative error
@@ -52,7 +52,7 @@ class IdentificationResult:
         return self.mp.from_standard(P)
 
     def errors(self, truth) -> dict:
-        """Naveen et al.'s error figures against `truth` (eqs. 38-39), in percent."""
+        """Naveen, Shah, Misra's error figures against `truth` (eqs. 38-39), in percent."""
         med, mx = relative_errors(self.estimate, self.truth_values(truth))
         return {"median_rel_error_pct": med, "max_rel_error_pct": mx}
 
@@ -75,7 +75,7 @@ class IdentificationResult:
                      f"solver: {self.fit.method}")
         if tv is not None:
             e = self.errors(truth)
-            lines.append(f"relative error (Naveen et al. eqs. 38-39): median {e['median_rel_error_pct']:.3g} %, "
+            lines.append(f"relative error (Naveen, Shah, Misra eqs. 38-39): median {e['median_rel_error_pct']:.3g} %, "
                          f"max {e['max_rel_error_pct']:.3g} %")
         return "\n".join(lines)
 
@@ -108,7 +108,7 @@ def identify_minimal(model, data, known=None, method: str = "closed-form", h0=No
     data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
     optionally momentum.<px..Lz> or wrench.<fx..mz>). known: bodies whose parameters are known (default: those
     tagged known/wheel).
-    method: "closed-form" (Naveen et al.'s grouping; revolute trees in modified-DH frames) or "numeric" (any tree).
+    method: "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH frames) or "numeric" (any tree).
     h0: the total momentum at the start (6,). Without momentum columns it is conserved (zero if not given), or,
     with wrench columns, the start of their integral; given explicitly, it overrides a momentum column.
     weights: (6,) inverse variances of the momentum components, or "auto": solve once unweighted, estimate each
@@ -151,7 +151,7 @@ def bias_compensated(mp, q, v, fit, sigma, stride: int = 10, chunk: int = 512):
         N_G = Σ_t Σ_j σ_j² A_jᵀA_j,   N_y = Σ_t Σ_j σ_j² A_jᵀ b_j,
     with A_j = K_u(q_t, e_j) (unknown bodies' minimal columns at a unit rate j) and b_j = K_k(q_t, e_j) P_k (the
     known bodies' momentum at that rate).  Least squares therefore shrinks the estimate towards zero along the
-    directions whose signal is weak next to that noise — for the Naveen et al. robot the overall scale, which only
+    directions whose signal is weak next to that noise — for the Naveen, Shah, Misra robot the overall scale, which only
     the wheels' momentum anchors (about −0.05 % with the paper's noise).  Solving (GᵀG − N_G) φ = Gᵀy + N_y
     removes the bias (bias-compensated least squares).  GᵀG is recovered from the fit's covariance
     (σ̂² (GᵀG)⁻¹), and the N terms are expectations over smooth functions of q, so every `stride`-th sample
@@ -262,7 +262,7 @@ def _plot_errors(res: IdentificationResult, truth: np.ndarray, path: Path) -> No
     ax.errorbar(k + 1, rel, yerr=bar, fmt="o", ms=3, capsize=2, label="estimate − truth (± 1 std), % of |truth|")
     ax.axhline(0, color="k", lw=0.8)
     ax.set_yscale("symlog", linthresh=0.1)
-    ax.set_xlabel("minimal parameter index (Naveen et al. Table 4 order for the closed form)")
+    ax.set_xlabel("minimal parameter index (Naveen, Shah, Misra Table 4 order for the closed form)")
     ax.set_ylabel("relative error [%]")
     ax.set_title(f"{res.mp.model.name}: identified minimal parameters")
     ax.grid(alpha=0.3)
@@ -273,7 +273,7 @@ def _plot_errors(res: IdentificationResult, truth: np.ndarray, path: Path) -> No
 
 def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every: int = 1, noise: bool = True,
                     seed: int = 0, progress: bool = False, spread: bool = True):
-    """Simulated identification data for the Naveen et al. robot, as the paper produces it (Sec. VI.A-C).
+    """Simulated identification data for the Naveen, Shah, Misra robot, as the paper produces it (Sec. VI.A-C).
 
     The six arm joints and three wheels follow multi-interval cycloids (eqs. 28-31) from Table 3's seeds (wheels:
     start 0, range 3π), one 1-s interval per direction combination, the first `n_intervals` of the 256 (an
@@ -286,7 +286,7 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
 
     arm, wheels = model.joints_tagged("arm_"), model.joints_tagged("wheel")
     if len(arm) != 6 or len(wheels) != 3:
-        raise InputError(f"excitation_data needs the Naveen et al. robot (6 arm joints tagged arm_*, 3 wheels); " f"'{model.name}' has {len(arm)} and {len(wheels)}")
+        raise InputError(f"excitation_data needs the Naveen, Shah, Misra robot (6 arm joints tagged arm_*, 3 wheels); " f"'{model.name}' has {len(arm)} and {len(wheels)}")
     start, range_ = tr.with_wheels(np.deg2rad(TABLE3_START_DEG), TABLE3_RANGE_RAD)
     all_dirs = tr.direction_combinations(9)
     if not 1 <= n_intervals <= len(all_dirs):
@@ -301,7 +301,7 @@ def trajectory_data(model, trajectory, joints, dt: float = 1e-3, record_every: i
                     seed: int = 0, progress: bool = False):
     """Simulated identification data along any joint trajectory (e.g. a designed one, `freefloat excite`): the
     named joints follow it, the base floats with zero total momentum (its initial twist solved from the
-    momentum model when the trajectory starts moving), the other joints rest.  With `noise`, Naveen et al.'s rate
+    momentum model when the trajectory starts moving), the other joints rest.  With `noise`, Naveen, Shah, Misra's rate
     noise and pose rebuild (Appendix C).  Returns (telemetry, trajectory)."""
     from ..io import telemetry as tm
     from ..simulation import simulate_driven

@@ -2,14 +2,14 @@
 
 The momentum of a free-floating tree is linear in the standard parameters, `h = K(q, v) @ P.ravel()`, but the
 columns of K are not independent: every revolute joint makes three of its child's columns combinations of the
-parent's (Naveen et al., eqs. 18-20).  `minimal_parameters` finds a linear map B and a column subset so that
+parent's (Naveen, Shah, Misra, eqs. 18-20).  `minimal_parameters` finds a linear map B and a column subset so that
 
     K_unknown @ P_unknown.ravel() == K_min @ phi_min,   phi_min = B @ P_unknown.ravel(),   K_min = K_unknown[:, columns]
 
 for every state.  Two methods:
 
 * "numeric": any model.  Rank-revealing QR of the regressor stacked over random states (Gautier's method).
-* "closed-form": Naveen et al.'s recursive grouping (eqs. 21-25) for revolute trees in modified-DH
+* "closed-form": Naveen, Shah, Misra's recursive grouping (eqs. 21-25) for revolute trees in modified-DH
   frames; names and order follow the paper's Table 4 / Appendix A.
 
 Bodies treated as known (default: tagged "known" or "wheel") are not identified; their momentum is moved to the
@@ -26,7 +26,7 @@ from ..algorithms import momentum_regressor
 
 #: our standard-parameter order (ARCHITECTURE.md), used to name columns
 PARAM_NAMES = ("m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
-#: Naveen et al.'s order [Ixx Iyy Izz Ixy Iyz Izx m mx my mz] (eq. 10) as indices into ours
+#: Naveen, Shah, Misra's order [Ixx Iyy Izz Ixy Iyz Izx m mx my mz] (eq. 10) as indices into ours
 PAPER_ORDER = np.array([4, 6, 9, 5, 8, 7, 0, 1, 2, 3])
 #: relative tolerance on |R_kk| / |R_00| of the column-scaled, pivoted QR; the seed-001 gap is ~1e-3 -> ~1e-16
 RANK_RTOL = 1e-10
@@ -61,7 +61,7 @@ class MinimalParameters:
         return [f"{bn[b]}.{p}" for b in self.unknown for p in PARAM_NAMES]
 
     def expressions(self, digits: int = 6) -> list[str]:
-        """Each minimal parameter as a linear combination of standard parameters (like Naveen et al., Appendix A)."""
+        """Each minimal parameter as a linear combination of standard parameters (like Naveen, Shah, Misra, Appendix A)."""
         cols = self.standard_names()
         return [_format_row(row, cols, digits) for row in self.matrix]
 
@@ -102,7 +102,7 @@ class MinimalParameters:
 def minimal_parameters(model, method: str = "numeric", known=None) -> MinimalParameters:
     """Minimal parameters of `model`'s momentum model.
 
-    method: "numeric" (any model) or "closed-form" (Naveen et al.'s grouping; revolute trees in modified-DH frames).
+    method: "numeric" (any model) or "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH frames).
     known: body names treated as known (moved to the right-hand side); default: bodies tagged "known" or "wheel".
     """
     unknown, known_idx = _split_bodies(model, known)
@@ -189,7 +189,7 @@ def _numeric_names(model, unknown, B, indep) -> list[str]:
 
 # ---------------------------------------------------------------------------------------------- closed form
 def _check_closed_form_model(model, unknown):
-    """Naveen et al.'s grouping assumes a free base and revolute joints about z of modified-DH frames whose rest
+    """Naveen, Shah, Misra's grouping assumes a free base and revolute joints about z of modified-DH frames whose rest
     placement is Rx(α_j) with an arbitrary offset ^i b_j."""
     hint = 'use method="numeric", which works for any model'
     if model.joint_types[0] != "free" or 0 not in unknown:
@@ -214,7 +214,7 @@ def _dh_geometry(model, j):
 
 
 def _k_vectors(b, alpha):
-    """k_{1,j}, k_{2,j}, k_{3,j} of Naveen et al., 10-vectors in the paper's order
+    """k_{1,j}, k_{2,j}, k_{3,j} of Naveen, Shah, Misra, 10-vectors in the paper's order
     [Ixx Iyy Izz Ixy Iyz Izx m mx my mz]."""
     C, S = np.cos(alpha), np.sin(alpha)
     b1, b2, b3 = b
@@ -236,7 +236,7 @@ BASE_LABELS = ["Ixx", "Iyy", "Izz", "Ixy", "Iyz", "Ixz", "m", "mcx", "mcy", "mcz
 
 
 def _group(phi, parents, geometry):
-    """Naveen et al.'s recursion on paper-ordered parameters phi (nb, 10) of the unknown tree (local indices,
+    """Naveen, Shah, Misra's recursion on paper-ordered parameters phi (nb, 10) of the unknown tree (local indices,
     parents[j] < j).  Returns φ_m (10 + 7 n).  Linear in phi."""
     ph = np.array(phi, dtype=float)
     for j in range(len(ph) - 1, 0, -1):               # children first: eqs. (21)-(23)

@@ -2,7 +2,7 @@
 
 - `RecursiveLS(theta0, p0, forgetting=1.0)`: ordinary RLS for `phi @ theta = y` (rows of one sample in `phi`),
   with an optional forgetting factor.
-- `ModifiedRLS(coupling, mu0, p_mu0, theta0, p_theta0)`: Zhang et al. 2020's modified RLS (eqs. 34-38) for
+- `ModifiedRLS(coupling, mu0, p_mu0, theta0, p_theta0)`: Zhang, Yue, Yuan 2020's modified RLS (eqs. 34-38) for
   `A mu = b` and `Phi theta = y + Psi D(mu)`, `D(mu) = [m_1 J(b'_1); m_n J(b'_n)]`; coupling "spatial" (3D)
   or "planar".
 

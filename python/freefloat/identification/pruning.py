@@ -43,7 +43,7 @@ def _kappa(sv, n: int | None = None) -> float:
 
 
 def prune_intervals(blocks, u_max: int = U_MAX, delta: float = DELTA, min_gain: float = MIN_GAIN) -> PruneResult:
-    """Algorithm 1 of Naveen et al. on per-interval regressor blocks (K, rows, n), with the fix:
+    """Algorithm 1 of Naveen, Shah, Misra on per-interval regressor blocks (K, rows, n), with the fix:
     s_prev and cn_prev follow the accepted matrix.  An interval is kept if it raises the number of significant
     singular values or lowers the condition number by more than `min_gain` (relative; 0 is the printed test);
     otherwise it may still be kept while fewer than u_max non-improving acceptances have happened in a row (the
@@ -92,7 +92,7 @@ def _stack(R, block):
 
 
 def plot_fig4(pr: PruneResult, path) -> None:
-    """Naveen et al. Fig. 4: condition number and significant singular values per interval index, single intervals
+    """Naveen, Shah, Misra Fig. 4: condition number and significant singular values per interval index, single intervals
     and the accepted concatenation."""
     from ..viz import pyplot
 
@@ -112,6 +112,6 @@ def plot_fig4(pr: PruneResult, path) -> None:
     for a in ax:
         a.grid(alpha=0.3)
         a.legend()
-    ax[0].set_title(f"pruning (Naveen et al. Algorithm 1, Fig. 4): {len(pr.kept)} of {len(k)} intervals kept")
+    ax[0].set_title(f"pruning (Naveen, Shah, Misra Algorithm 1, Fig. 4): {len(pr.kept)} of {len(k)} intervals kept")
     fig.savefig(path, dpi=110)
     plt.close(fig)

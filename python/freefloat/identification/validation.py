@@ -1,4 +1,4 @@
-"""Validation of identified parameters by prediction (Naveen et al., Sec. VI.D, Table 6).
+"""Validation of identified parameters by prediction (Naveen, Shah, Misra, Sec. VI.D, Table 6).
 
 The true and the identified robots are driven along the same joint trajectory — the finite Fourier series of
 eqs. 40-41 with N_h = 2 and ω_f = π/20 (one 40-s period) — with the base floating and the total momentum zero.
@@ -28,7 +28,7 @@ from ..constants import SIGMA_ANG, SIGMA_LIN, SIGMA_TORQUE
 from ..simulation import simulate_driven
 from ..trajectories import Fourier
 
-#: Naveen et al. Table 6: RMS prediction errors of base twist [m/s, rad/s] and arm torques [N·m]
+#: Naveen, Shah, Misra Table 6: RMS prediction errors of base twist [m/s, rad/s] and arm torques [N·m]
 PAPER_TABLE6_TWIST = (1.7e-4, 1.6e-4, 0.6e-4, 2.1e-4, 1.8e-4, 3.5e-4)
 PAPER_TABLE6_TORQUE = (0.2961, 0.1665, 0.0778, 0.0922, 0.0368, 0.0262)
 #: the paper's noise references for Table 6: rate noise (Sec. VI.C) and the torque-sensor sigma of its ref. [33]
@@ -61,7 +61,7 @@ class PredictionResult:
 
     @property
     def rms_twist(self) -> np.ndarray:
-        """RMS error of each base-twist component (Naveen et al. eq. 42)."""
+        """RMS error of each base-twist component (Naveen, Shah, Misra eq. 42)."""
         return np.sqrt(np.mean((self.twist_true - self.twist_pred) ** 2, axis=0))
 
     @property
@@ -70,9 +70,9 @@ class PredictionResult:
         return np.sqrt(np.mean((self.tau_true - self.tau_pred) ** 2, axis=0))
 
     def table(self) -> str:
-        """Table 6 of Naveen et al., ours beside the paper's, with the ratio to the paper's noise references."""
+        """Table 6 of Naveen, Shah, Misra, ours beside the paper's, with the ratio to the paper's noise references."""
         sig = [NOISE_LIN] * 3 + [NOISE_ANG] * 3
-        lines = ["prediction RMS error (Naveen et al. eq. 42, Table 6)",
+        lines = ["prediction RMS error (Naveen, Shah, Misra eq. 42, Table 6)",
                  f"{'':10s} {'ours':>11s} {'paper':>11s} {'ours/noise':>11s} {'paper/noise':>12s}"]
         for k, name in enumerate(TWIST_NAMES):
             unit = "m/s" if k < 3 else "rad/s"
@@ -121,7 +121,7 @@ class PredictionResult:
         for a in ax:
             a.grid(alpha=0.3)
             a.legend(ncol=6, fontsize=8)
-        ax[0].set_title("prediction error: true minus identified robot (Naveen et al. Sec. VI.D)")
+        ax[0].set_title("prediction error: true minus identified robot (Naveen, Shah, Misra Sec. VI.D)")
         fig.savefig(path, dpi=110)
         plt.close(fig)
 
@@ -134,7 +134,7 @@ def identified_model(model, result, prior=None):
     """The identified robot as a full model, for prediction: (Model, ConsistentEstimate, how it was chosen).
 
     Preferably the physically consistent estimate (`consistent_parameters`).  When no consistent robot has the
-    identified minimal parameters (Naveen et al.'s own Table 2 robot is inconsistent, so its noise-free minimal
+    identified minimal parameters (Naveen, Shah, Misra's own Table 2 robot is inconsistent, so its noise-free minimal
     parameters are out of reach by several percent), prediction would measure that gap rather than the
     identification, so the exact linear representative is used instead — if the model admits non-physical
     parameters for those bodies."""

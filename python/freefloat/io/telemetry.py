@@ -1,6 +1,6 @@
 """Measured motion ("telemetry"): time, configuration and velocity samples of a robot, read from and
 written to Parquet or CSV with named columns, validated on reading, and the measurement model of
-Naveen et al. (Sec. VI.C and Appendix C): white Gaussian noise on the measured rates and poses rebuilt by
+Naveen, Shah, Misra (Sec. VI.C and Appendix C): white Gaussian noise on the measured rates and poses rebuilt by
 integrating those noisy rates.
 
 Columns are named like `Trajectory.to_parquet`: `t`, `q.<label>` for `model.q_labels()` and `v.<label>`
@@ -73,7 +73,7 @@ class Telemetry:
     def integrated_momentum(self, h0=None) -> np.ndarray:
         """(T, 6) total momentum h(t) = h0 + ∫₀ᵗ w dt from the recorded external wrench w = [f; m about the
         inertial origin] (trapezoidal rule; exact for a piecewise-linear wrench), starting at h0 (default
-        zero: released at rest).  This is Naveen et al.'s "integrated external impulses" right-hand side."""
+        zero: released at rest).  This is Naveen, Shah, Misra's "integrated external impulses" right-hand side."""
         if self.wrench is None:
             raise InputError("Telemetry.integrated_momentum: this telemetry has no wrench.* columns")
         h0 = np.zeros(6) if h0 is None else np.asarray(h0, dtype=float)
@@ -227,10 +227,10 @@ def _check_time(t: np.ndarray, where: str) -> None:
                          f"is more than {GAP_FACTOR}× the median step {med:.6g} s ({int(gap.sum())} gap(s))")
 
 
-# -- measurement model (Naveen et al. Sec. VI.C, Appendix C) -------------------------------------------------
+# -- measurement model (Naveen, Shah, Misra Sec. VI.C, Appendix C) -------------------------------------------------
 def add_noise(telem: Telemetry, model, rng, sigma_lin: float = SIGMA_LIN, sigma_ang: float = SIGMA_ANG,
               sigma_joint: float = SIGMA_JOINT, reconstruct_poses: bool = True) -> Telemetry:
-    """Noisy telemetry as in Naveen et al. Sec. VI.C (`rng`: a numpy Generator or a seed): zero-mean white Gaussian noise, independent per
+    """Noisy telemetry as in Naveen, Shah, Misra Sec. VI.C (`rng`: a numpy Generator or a seed): zero-mean white Gaussian noise, independent per
     sample and component, added to the measured rates with standard deviations sigma_lin on the base
     linear velocity (m/s), sigma_ang on the base angular velocity (rad/s) and sigma_joint on every
     joint rate (rad/s, or m/s for prism. joints), reaction wheels included (they are joints; the paper

@@ -203,7 +203,7 @@ def known_params(model, unknown: list[int]) -> np.ndarray:
 
 @dataclass
 class PaperRows:
-    """Zhang et al. 2020's regression in the modified-RLS form (eqs. 34-35), one block per sample."""
+    """Zhang, Yue, Yuan 2020's regression in the modified-RLS form (eqs. 34-35), one block per sample."""
 
     t: np.ndarray
     A: np.ndarray
