@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Minimal-parameter identification from momentum (Naveen, Shah, Misra, eqs. 26-27): freefloat vs a vectorised numpy peer.
+"""Minimal-parameter identification from momentum (Naveen, Shah, Misra, eqs. 26-27):
+freefloat vs a vectorised numpy peer.
 
 Problem: naveen_dual_arm, 67 intervals x 1 s at 1 kHz = 67,000 samples -> a 402,000 x 52 minimal regressor
 (wheels known, closed-form minimal parameters).  The states come from a simulation (ff.simulate, RK4, dt = 1 ms,

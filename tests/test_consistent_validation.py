@@ -127,7 +127,8 @@ def test_noisy_identification_predicts_far_below_the_noise_floor(consistent_robo
 
 @pytest.fixture(scope="module")
 def thrust_run():
-    """Naveen, Shah, Misra robot with base thrusters firing while the arms and wheels move (16 intervals, all 52 excited)."""
+    """Naveen, Shah, Misra robot with base thrusters firing while the arms and wheels move (16 intervals, all 52
+    excited)."""
     m = ff.models.load("naveen_dual_arm")
     arm, wh = m.joints_tagged("arm_"), m.joints_tagged("wheel")
     start, rng_ = tr.with_wheels(np.deg2rad(idf.TABLE3_START_DEG), idf.TABLE3_RANGE_RAD)

@@ -17,7 +17,8 @@ def demo_cmd(out, t_final):
     2. Identification: the exciting trajectory designed by `freefloat excite` (shipped in the package) with the paper's
        rate noise, then the 52 minimal parameters from the momentum model; prints the paper's error
        figures and plots every parameter's error.
-    3. Validation by prediction (Naveen, Shah, Misra Sec. VI.D): true and identified robots along a Fourier trajectory."""
+    3. Validation by prediction (Naveen, Shah, Misra Sec. VI.D): true and identified robots along a Fourier
+       trajectory."""
     from .. import demo
 
     demo.run(out, t_final, echo=click.echo, progress=True)

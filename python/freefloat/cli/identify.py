@@ -49,7 +49,8 @@ def identify_group():
                               "parts the data cannot see (default: MODEL itself; for naveen_dual_arm try naveen_dual_arm_offset).")
 @click.option("--validate/--no-validate", default=False, show_default=True,
               help="Predict base twist and joint torques of the true (MODEL) and identified robots along the paper's "
-                   "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to Naveen, Shah, Misra Table 6. Implies --full.")
+                   "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to Naveen, Shah, Misra "
+                   "Table 6. Implies --full.")
 @click.option("--truth/--no-truth", default=True, show_default=True,
               help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).")
 @click.option("--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf).")

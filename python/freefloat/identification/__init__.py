@@ -2,7 +2,8 @@
 tree-type free-floating robot), in pipeline order:
 
 - `minimal`: the minimal (identifiable) parameters — closed-form grouping and a numeric method for any tree;
-- `excitation` (+ `excitation_results`, `pruning`, `comparison`): design of exciting trajectories (cycloids, eq. 32, Algorithm 1);
+- `excitation` (+ `excitation_results`, `pruning`, `comparison`): design of exciting trajectories (cycloids,
+  eq. 32, Algorithm 1);
 - `estimation`: streaming least squares in the engine, with covariance and rank checks;
 - `identify`: `identify_minimal` from telemetry (weighted, errors-in-variables bias compensation);
 - `consistent`: physically consistent standard parameters reproducing the minimal ones (a convex program);

@@ -84,7 +84,8 @@ def least_squares(model, Q, V, H, mp, P_known=None, weights=None, method: str = 
 
 
 def relative_errors(estimate, truth) -> tuple[float, float]:
-    """Naveen, Shah, Misra's error figures in percent: (median_i |(phi_i - phi_hat_i) / phi_i|, max_i ...)  (eqs. 38, 39)."""
+    """Naveen, Shah, Misra's error figures in percent: (median_i |(phi_i - phi_hat_i) / phi_i|, max_i ...)
+    (eqs. 38, 39)."""
     est, tru = np.asarray(estimate, dtype=float), np.asarray(truth, dtype=float)
     if est.shape != tru.shape or est.ndim != 1:
         raise InputError(f"arguments `estimate`, `truth`: expected two equal 1-d shapes, got {est.shape}, {tru.shape}")

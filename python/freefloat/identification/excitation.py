@@ -12,7 +12,8 @@ Three steps (the paper's Fig. 2), from nothing but the geometry and a rough gues
 
 The base response the objective needs comes from the momentum model of the *guessed* robot, in Rust
 (`freefloat_core::excitation`), as does the objective itself; Python drives scipy's SLSQP, with finite-difference
-gradients whose 2n+1 evaluations go to Rust in one call (worker threads).  The reaction wheels follow Naveen, Shah, Misra's
+gradients whose 2n+1 evaluations go to Rust in one call (worker threads).  The reaction wheels follow
+Naveen, Shah, Misra's
 predetermined seeds (start 0, range 3π per interval) and are not design variables.
 
 Choices the paper leaves open, all arguments here:

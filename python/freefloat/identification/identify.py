@@ -1,4 +1,5 @@
-"""Minimal-parameter identification of a free-floating robot from its momentum (Naveen, Shah, Misra, Secs. III-IV, VI.C).
+"""Minimal-parameter identification of a free-floating robot from its momentum (Naveen, Shah, Misra,
+Secs. III-IV, VI.C).
 
     res = ff.identify_minimal(model, data)        # data: Trajectory, Telemetry, or a .parquet/.csv telemetry file
     print(res.table(truth=model.parameters()))     # name, true value, estimate, std, relative error
@@ -108,7 +109,8 @@ def identify_minimal(model, data, known=None, method: str = "closed-form", h0=No
     data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
     optionally momentum.<px..Lz> or wrench.<fx..mz>). known: bodies whose parameters are known (default: those
     tagged known/wheel).
-    method: "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH frames) or "numeric" (any tree).
+    method: "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH frames) or "numeric"
+        (any tree).
     h0: the total momentum at the start (6,). Without momentum columns it is conserved (zero if not given), or,
     with wrench columns, the start of their integral; given explicitly, it overrides a momentum column.
     weights: (6,) inverse variances of the momentum components, or "auto": solve once unweighted, estimate each

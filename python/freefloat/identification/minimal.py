@@ -61,7 +61,8 @@ class MinimalParameters:
         return [f"{bn[b]}.{p}" for b in self.unknown for p in PARAM_NAMES]
 
     def expressions(self, digits: int = 6) -> list[str]:
-        """Each minimal parameter as a linear combination of standard parameters (like Naveen, Shah, Misra, Appendix A)."""
+        """Each minimal parameter as a linear combination of standard parameters (like Naveen, Shah, Misra,
+        Appendix A)."""
         cols = self.standard_names()
         return [_format_row(row, cols, digits) for row in self.matrix]
 
@@ -102,7 +103,8 @@ class MinimalParameters:
 def minimal_parameters(model, method: str = "numeric", known=None) -> MinimalParameters:
     """Minimal parameters of `model`'s momentum model.
 
-    method: "numeric" (any model) or "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH frames).
+    method: "numeric" (any model) or "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in
+      modified-DH frames).
     known: body names treated as known (moved to the right-hand side); default: bodies tagged "known" or "wheel".
     """
     unknown, known_idx = _split_bodies(model, known)
