@@ -164,8 +164,8 @@ def simulate(
     progress: True for a progress bar, or a callable progress(fraction) returning False to abort.
     formulation: "aba" (the engine's articulated-body algorithm) or "dq" (the dual-quaternion Newton-Euler
       system of Valverde 2018 ch. 6, `dq_dynamics`: same motion to round-off, slower; free or fixed base with
-      revolute, prismatic, spherical, cylindrical, universal and fixed joints). With "dq" the recorded momentum and kinetic energy
-      are the formulation's own (2.53)/(2.54)."""
+      revolute, prismatic, spherical, cylindrical, universal and fixed joints). With "dq" the recorded momentum
+      and kinetic energy are the formulation's own (2.53)/(2.54)."""
     if not isinstance(model, Model):
         raise TypeError(f"expected a freefloat.Model, got {type(model).__name__}")
     if isinstance(prescribed, str):

@@ -6,8 +6,9 @@ integrating those noisy rates.
 Columns are named like `Trajectory.to_parquet`: `t`, `q.<label>` for `model.q_labels()` and `v.<label>`
 for `model.v_labels()`, optionally `momentum.<px…Lz>` (the total momentum, when it is measured or known) or
 `wrench.<fx…mz>` (the external wrench on the robot — thrusters, contact — in the inertial frame with the moment
-about the inertial origin; the momentum is then its time integral, see `Telemetry.integrated_momentum`). Conventions (ARCHITECTURE.md): q = [base position,
-base quaternion xyzw, joints], v = [base linear, base angular velocity in the BASE frame, joint rates]."""
+about the inertial origin; the momentum is then its time integral, see `Telemetry.integrated_momentum`).
+Conventions (docs/architecture.md): q = [base position, base quaternion xyzw, joints], v = [base linear, base
+angular velocity in the BASE frame, joint rates]."""
 
 from __future__ import annotations
 
@@ -209,7 +210,8 @@ def _check_finite(cols: dict, names: list, where: str) -> None:
         bad = ~np.isfinite(cols[c])
         if bad.any():
             r = int(np.argmax(bad))
-            raise InputError(f"{where}: column '{c}' row {r} is {cols[c][r]} (not finite); {int(bad.sum())} such value(s) in this column")
+            raise InputError(f"{where}: column '{c}' row {r} is {cols[c][r]} (not finite); "
+                             f"{int(bad.sum())} such value(s) in this column")
 
 
 def _check_time(t: np.ndarray, where: str) -> None:
@@ -230,8 +232,8 @@ def _check_time(t: np.ndarray, where: str) -> None:
 # -- measurement model (Naveen, Shah, Misra Sec. VI.C, Appendix C) -------------------------------------------------
 def add_noise(telem: Telemetry, model, rng, sigma_lin: float = SIGMA_LIN, sigma_ang: float = SIGMA_ANG,
               sigma_joint: float = SIGMA_JOINT, reconstruct_poses: bool = True) -> Telemetry:
-    """Noisy telemetry as in Naveen, Shah, Misra Sec. VI.C (`rng`: a numpy Generator or a seed): zero-mean white Gaussian noise, independent per
-    sample and component, added to the measured rates with standard deviations sigma_lin on the base
+    """Noisy telemetry as in Naveen, Shah, Misra Sec. VI.C (`rng`: a numpy Generator or a seed): zero-mean white
+    Gaussian noise, independent per sample and component, added to the measured rates with standard deviations sigma_lin on the base
     linear velocity (m/s), sigma_ang on the base angular velocity (rad/s) and sigma_joint on every
     joint rate (rad/s, or m/s for prism. joints), reaction wheels included (they are joints; the paper
     adds noise to "the joint rates and base velocities").
