@@ -233,8 +233,8 @@ def _check_time(t: np.ndarray, where: str) -> None:
 def add_noise(telem: Telemetry, model, rng, sigma_lin: float = SIGMA_LIN, sigma_ang: float = SIGMA_ANG,
               sigma_joint: float = SIGMA_JOINT, reconstruct_poses: bool = True) -> Telemetry:
     """Noisy telemetry as in Naveen, Shah, Misra Sec. VI.C (`rng`: a numpy Generator or a seed): zero-mean white
-    Gaussian noise, independent per sample and component, added to the measured rates with standard deviations sigma_lin on the base
-    linear velocity (m/s), sigma_ang on the base angular velocity (rad/s) and sigma_joint on every
+    Gaussian noise, independent per sample and component, added to the measured rates with standard deviations
+    sigma_lin on the base linear velocity (m/s), sigma_ang on the base angular velocity (rad/s) and sigma_joint on every
     joint rate (rad/s, or m/s for prism. joints), reaction wheels included (they are joints; the paper
     adds noise to "the joint rates and base velocities").
 
