@@ -393,7 +393,13 @@ pub fn inertia_com_form<'py>(
     let n = x.len() / 10;
     let (mut ms, mut bs, mut is) = (Vec::with_capacity(n), Vec::with_capacity(3 * n), Vec::with_capacity(9 * n));
     for (k, p) in x.chunks_exact(10).enumerate() {
-        let (m, b, i) = guard(|| eq::com_form(p)).map_err(|e| input_err(format!("item {k}: {e}")))?;
+        let (m, b, i) = match eq::com_form(p) {
+            Ok(x) => x,
+            Err(freefloat_core::FfError::Argument { name, msg }) => {
+                return Err(input_err(format!("argument `{name}`: item {k}: {msg}")))
+            }
+            Err(e) => return Err(crate::errors::to_py(e)),
+        };
         ms.push(m);
         bs.extend_from_slice(b.as_slice());
         for r in 0..3 {

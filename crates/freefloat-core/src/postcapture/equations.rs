@@ -488,12 +488,13 @@ fn at(e: FfError, s: usize) -> FfError {
 // -- parameters in each form ----------------------------------------------------------------------------
 
 /// `(m, b', I'_c)` from standard parameters `[m, m b', I about the reference point]` (engine order):
-/// `b' = h/m`, `I'_c = I_o − m (|b'|² 1 − b' b'ᵀ)` (parallel axes). Errors for a non-positive mass.
+/// `b' = h/m`, `I'_c = I_o − m (|b'|² 1 − b' b'ᵀ)` (parallel axes). A negative mass is allowed (an
+/// estimator's history can pass through one); a zero mass is an error (no centre of mass).
 pub fn com_form(p: &[f64]) -> Result<(f64, V3, M3)> {
     check_vec("params", p, 10)?;
     let m = p[0];
-    if !(m > 0.0) {
-        return Err(FfError::arg("params", format!("the mass must be positive to define a centre of mass, got {m}")));
+    if m == 0.0 {
+        return Err(FfError::arg("params", "the mass is zero: the centre of mass is undefined"));
     }
     let h = V3::new(p[1], p[2], p[3]);
     let io = M3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]);
@@ -510,7 +511,7 @@ pub fn standard_form(m: f64, b: &V3, ic: &M3) -> [f64; 10] {
 
 /// Nearest physically consistent standard parameters in the Frobenius norm of the pseudo-inertia
 /// `J = [[½ tr(I) 1 − I, h], [hᵀ, m]]` (positive definite exactly for physical bodies): eigenvalues clipped
-/// at `eps · max`.
+/// at `eps · max`. A consistent set is returned unchanged.
 pub fn project_consistent(p: &[f64], eps: f64) -> Result<[f64; 10]> {
     check_vec("params", p, 10)?;
     let i = M3::new(p[4], p[5], p[7], p[5], p[6], p[8], p[7], p[8], p[9]);
@@ -523,6 +524,10 @@ pub fn project_consistent(p: &[f64], eps: f64) -> Result<[f64; 10]> {
     j[(3, 3)] = p[0];
     let eig = j.symmetric_eigen();
     let top = eig.eigenvalues.max().max(1e-300);
+    if eig.eigenvalues.min() >= eps * top {
+        // already consistent: it is its own nearest point (returned exactly, not rebuilt from the eigenvectors)
+        return Ok(std::array::from_fn(|k| p[k]));
+    }
     let w = eig.eigenvalues.map(|x| x.max(eps * top));
     let jp = eig.eigenvectors * nalgebra::Matrix4::from_diagonal(&w) * eig.eigenvectors.transpose();
     let s: M3 = jp.fixed_view::<3, 3>(0, 0).into_owned();
@@ -598,5 +603,6 @@ mod tests {
             assert!((pp[k] - p[k]).abs() < 1e-12, "{k}");
         }
         assert!(com_form(&[0.0; 10]).is_err());
+        assert!(com_form(&[-1.0, 0.1, 0.0, 0.0, 1.0, 0.0, 1.0, 0.0, 0.0, 1.0]).is_ok());
     }
 }
