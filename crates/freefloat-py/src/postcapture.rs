@@ -459,7 +459,11 @@ pub fn inertia_standard_form<'py>(
 /// `eps`·max; `postcapture::equations::project_consistent`).
 #[pyfunction]
 #[pyo3(signature = (params, eps = 1e-9))]
-pub fn inertia_project_consistent<'py>(py: Python<'py>, params: &Bound<'py, PyAny>, eps: f64) -> PyResult<Bound<'py, PyAny>> {
+pub fn inertia_project_consistent<'py>(
+    py: Python<'py>,
+    params: &Bound<'py, PyAny>,
+    eps: f64,
+) -> PyResult<Bound<'py, PyAny>> {
     use freefloat_core::postcapture::equations as eq;
     let a = crate::batch::array_arg(params, "params")?;
     let s = a.shape().to_vec();

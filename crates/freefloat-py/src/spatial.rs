@@ -23,7 +23,12 @@ fn trailing(name: &str, obj: &Bound<'_, PyAny>, inner: &[usize]) -> PyResult<(Ve
     let data: Vec<f64> = a.as_array().iter().copied().collect();
     let width: usize = inner.iter().product();
     if let Some(j) = data.iter().position(|x| !x.is_finite()) {
-        return Err(input_err(format!("argument `{name}`: item {}, entry {} is {} (must be finite)", j / width, j % width, data[j])));
+        return Err(input_err(format!(
+            "argument `{name}`: item {}, entry {} is {} (must be finite)",
+            j / width,
+            j % width,
+            data[j]
+        )));
     }
     Ok((shape[..k - inner.len()].to_vec(), data))
 }
@@ -44,7 +49,9 @@ pub fn quat_to_matrix<'py>(py: Python<'py>, quat: Arr<'_, 'py>) -> PyResult<Boun
     for (k, (qk, o)) in q.chunks_exact(4).zip(out.chunks_exact_mut(9)).enumerate() {
         let n = qk.iter().map(|x| x * x).sum::<f64>().sqrt();
         if (n - 1.0).abs() > 1e-6 {
-            return Err(input_err(format!("argument `quat`: item {k} has norm {n:.6}; it must be a unit quaternion (x y z w)")));
+            return Err(input_err(format!(
+                "argument `quat`: item {k} has norm {n:.6}; it must be a unit quaternion (x y z w)"
+            )));
         }
         let r = if n == 1.0 { rot_from_quat(qk) } else { rot_from_quat(&[qk[0] / n, qk[1] / n, qk[2] / n, qk[3] / n]) };
         for i in 0..3 {
@@ -66,7 +73,10 @@ pub fn matrix_to_quat<'py>(py: Python<'py>, rot: Arr<'_, 'py>) -> PyResult<Bound
         let m = M3::from_row_slice(rk);
         let err = (m.transpose() * m - M3::identity()).amax();
         if err > 1e-6 || m.determinant() < 0.0 {
-            return Err(input_err(format!("argument `rot`: item {k} is not a rotation matrix (|RᵀR − 1| = {err:.2e}, det = {:.6})", m.determinant())));
+            return Err(input_err(format!(
+                "argument `rot`: item {k} is not a rotation matrix (|RᵀR − 1| = {err:.2e}, det = {:.6})",
+                m.determinant()
+            )));
         }
         o.copy_from_slice(&quat_from_rot(&m));
     }

@@ -148,8 +148,7 @@ mod tests {
             let nb = m.nvs[0];
             for trial in 0..5 {
                 let (q, rates) = random_state(&m, &mut seed);
-                let h0: [f64; 6] =
-                    if trial == 0 { [0.0; 6] } else { std::array::from_fn(|_| 10.0 * lcg(&mut seed)) };
+                let h0: [f64; 6] = if trial == 0 { [0.0; 6] } else { std::array::from_fn(|_| 10.0 * lcg(&mut seed)) };
                 let tw = base_twist_for_momentum(&m, &mut d, &q, &rates, &h0).unwrap();
                 let mut v = vec![0.0; m.nv];
                 base_velocity_coordinates(&m, &tw, &mut v[..nb]).unwrap();

@@ -165,30 +165,58 @@ impl Layout {
         }
     }
     pub fn lin_rows(&self) -> &'static [usize] {
-        if self.planar { &[0, 1] } else { &[0, 1, 2] }
+        if self.planar {
+            &[0, 1]
+        } else {
+            &[0, 1, 2]
+        }
     }
     pub fn ang_rows(&self) -> &'static [usize] {
-        if self.planar { &[2] } else { &[0, 1, 2] }
+        if self.planar {
+            &[2]
+        } else {
+            &[0, 1, 2]
+        }
     }
     /// of one body's 4 columns `[m, m bx, m by, m bz]`
     pub fn mu_cols(&self) -> &'static [usize] {
-        if self.planar { &[0, 1, 2] } else { &[0, 1, 2, 3] }
+        if self.planar {
+            &[0, 1, 2]
+        } else {
+            &[0, 1, 2, 3]
+        }
     }
     /// of one body's `I#` (6)
     pub fn th_cols(&self) -> &'static [usize] {
-        if self.planar { &[5] } else { &[0, 1, 2, 3, 4, 5] }
+        if self.planar {
+            &[5]
+        } else {
+            &[0, 1, 2, 3, 4, 5]
+        }
     }
     /// of one body's `m J` (10)
     pub fn d_cols(&self) -> &'static [usize] {
-        if self.planar { &[0, 1, 2, 4] } else { &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9] }
+        if self.planar {
+            &[0, 1, 2, 4]
+        } else {
+            &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]
+        }
     }
     /// of one body's 10 standard parameters
     pub fn std_cols(&self) -> &'static [usize] {
-        if self.planar { &[0, 1, 2, 9] } else { &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9] }
+        if self.planar {
+            &[0, 1, 2, 9]
+        } else {
+            &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]
+        }
     }
     /// rows of the engine's momentum `[p; L]` used
     pub fn momentum_rows(&self) -> &'static [usize] {
-        if self.planar { &[0, 1, 5] } else { &[0, 1, 2, 3, 4, 5] }
+        if self.planar {
+            &[0, 1, 5]
+        } else {
+            &[0, 1, 2, 3, 4, 5]
+        }
     }
 }
 
@@ -223,10 +251,16 @@ impl Measurements<'_> {
             ("impulse_M", self.impulse_m, 3),
         ] {
             if x.len() != n * w {
-                return Err(FfError::arg(name, format!("expected {n} samples × {w} = {} numbers, got {}", n * w, x.len())));
+                return Err(FfError::arg(
+                    name,
+                    format!("expected {n} samples × {w} = {} numbers, got {}", n * w, x.len()),
+                ));
             }
             if let Some(k) = x.iter().position(|v| !v.is_finite()) {
-                return Err(FfError::arg(name, format!("sample {}, entry {} is not finite", k / w.max(1), k % w.max(1))));
+                return Err(FfError::arg(
+                    name,
+                    format!("sample {}, entry {} is not finite", k / w.max(1), k % w.max(1)),
+                ));
             }
         }
         Ok(n)
@@ -260,7 +294,10 @@ pub struct StandardRows {
 fn check_bodies(m: &Model, base: usize, target: usize) -> Result<()> {
     let n = m.nbodies();
     if base >= n || target >= n || base == target {
-        return Err(FfError::arg("base/target", format!("need two different bodies of the {n}, got {base} and {target}")));
+        return Err(FfError::arg(
+            "base/target",
+            format!("need two different bodies of the {n}, got {base} and {target}"),
+        ));
     }
     Ok(())
 }
@@ -350,11 +387,11 @@ pub fn paper_momentum_rows(m: &Model, meas: &Measurements, base: usize, target: 
         let imp_f = V3::from_column_slice(&meas.impulse_f[3 * s..3 * s + 3]);
         let imp_m = V3::from_column_slice(&meas.impulse_m[3 * s..3 * s + 3]);
         let sample = PaperSample {
-            a: pair(&b_block(&p1), &b_block(&pn)),                // eq. (12)
-            b: imp_f - V3::new(kn[0], kn[1], kn[2]),              // eq. (13)
-            phi: pair(&d_block(&p1), &d_block(&pn)),              // eq. (17)
-            y: imp_m - V3::new(kn[3], kn[4], kn[5]),              // eq. (18)
-            psi: pair(&h_block(&p1), &h_block(&pn)),              // eq. (19)
+            a: pair(&b_block(&p1), &b_block(&pn)),   // eq. (12)
+            b: imp_f - V3::new(kn[0], kn[1], kn[2]), // eq. (13)
+            phi: pair(&d_block(&p1), &d_block(&pn)), // eq. (17)
+            y: imp_m - V3::new(kn[3], kn[4], kn[5]), // eq. (18)
+            psi: pair(&h_block(&p1), &h_block(&pn)), // eq. (19)
         };
         match &first {
             None => first = Some(sample),
@@ -394,9 +431,9 @@ pub fn paper_force_rows(m: &Model, meas: &Measurements, base: usize, target: usi
         let (f3, m3) = planar_wrench_3d(&l, &w[..nb]);
         let sample = PaperSample {
             a: pair(&g_block(&p1s), &g_block(&pns)),   // eq. (29)
-            b: p1.rot * f3,                           // eq. (30)
+            b: p1.rot * f3,                            // eq. (30)
             phi: pair(&q_block(&p1s), &q_block(&pns)), // eq. (32)
-            y: p1.rot * m3,                           // eq. (33), about the base sensor
+            y: p1.rot * m3,                            // eq. (33), about the base sensor
             psi: pair(&s_block(&p1s), &s_block(&pns)), // eq. (31)
         };
         out.t.push(meas.t[s]);
@@ -532,7 +569,18 @@ pub fn project_consistent(p: &[f64], eps: f64) -> Result<[f64; 10]> {
     let jp = eig.eigenvectors * nalgebra::Matrix4::from_diagonal(&w) * eig.eigenvectors.transpose();
     let s: M3 = jp.fixed_view::<3, 3>(0, 0).into_owned();
     let ip = M3::identity() * s.trace() - s;
-    Ok([jp[(3, 3)], jp[(0, 3)], jp[(1, 3)], jp[(2, 3)], ip[(0, 0)], ip[(0, 1)], ip[(1, 1)], ip[(0, 2)], ip[(1, 2)], ip[(2, 2)]])
+    Ok([
+        jp[(3, 3)],
+        jp[(0, 3)],
+        jp[(1, 3)],
+        jp[(2, 3)],
+        ip[(0, 0)],
+        ip[(0, 1)],
+        ip[(1, 1)],
+        ip[(0, 2)],
+        ip[(1, 2)],
+        ip[(2, 2)],
+    ])
 }
 
 #[cfg(test)]
@@ -555,7 +603,14 @@ mod tests {
             let wx = rd * rot(t).transpose();
             V3::new(wx[(2, 1)], wx[(0, 2)], wx[(1, 0)])
         };
-        PointMotion { r: r(t), rot: rot(t), v: dr(&r, t), w: w(t), a: (r(t + h) - 2.0 * r(t) + r(t - h)) / (h * h), b: dr(&w, t) }
+        PointMotion {
+            r: r(t),
+            rot: rot(t),
+            v: dr(&r, t),
+            w: w(t),
+            a: (r(t + h) - 2.0 * r(t) + r(t - h)) / (h * h),
+            b: dr(&w, t),
+        }
     }
 
     fn close(a: &V3, b: &V3, tol: f64, what: &str) {

@@ -31,13 +31,19 @@ impl Steps<'_> {
             Steps::Uniform(_) => Ok(()),
             Steps::Times(t) => {
                 if t.len() != samples {
-                    return Err(FfError::arg("t", format!("expected {samples} times (one per twist), got {}", t.len())));
+                    return Err(FfError::arg(
+                        "t",
+                        format!("expected {samples} times (one per twist), got {}", t.len()),
+                    ));
                 }
                 if let Some(k) = t.iter().position(|x| !x.is_finite()) {
                     return Err(FfError::arg("t", format!("entry {k} is {} (must be finite)", t[k])));
                 }
                 if let Some(k) = (1..t.len()).find(|&k| !(t[k] > t[k - 1])) {
-                    return Err(FfError::arg("t", format!("times must increase: t[{k}] = {} after {}", t[k], t[k - 1])));
+                    return Err(FfError::arg(
+                        "t",
+                        format!("times must increase: t[{k}] = {} after {}", t[k], t[k - 1]),
+                    ));
                 }
                 Ok(())
             }
@@ -77,7 +83,10 @@ pub fn integrate_base_poses(steps: Steps, twists: &[f64], pose0: &[f64], out: &m
     let mut quat = [pose0[3], pose0[4], pose0[5], pose0[6]];
     let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
     if (norm - 1.0).abs() > 1e-6 {
-        return Err(FfError::arg("pose0", format!("the quaternion (x y z w) has norm {norm:.6}; it must be a unit quaternion")));
+        return Err(FfError::arg(
+            "pose0",
+            format!("the quaternion (x y z w) has norm {norm:.6}; it must be a unit quaternion"),
+        ));
     }
     quat_normalize(&mut quat);
     let tw = |k: usize| &twists[6 * k..6 * k + 6];
@@ -152,8 +161,13 @@ mod tests {
         for n in [41usize, 81] {
             let twists: Vec<f64> = (0..n).flat_map(|_| [v.x, v.y, v.z, w.x, w.y, w.z]).collect();
             let mut out = vec![0.0; 7 * n];
-            integrate_base_poses(Steps::Uniform(t_end / (n - 1) as f64), &twists, &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0], &mut out)
-                .unwrap();
+            integrate_base_poses(
+                Steps::Uniform(t_end / (n - 1) as f64),
+                &twists,
+                &[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+                &mut out,
+            )
+            .unwrap();
             let last = &out[7 * (n - 1)..];
             let r = rot_from_quat(&last[3..7]);
             let r_exact = rot_from_quat(&quat_exp(&(w * t_end)));
@@ -169,10 +183,12 @@ mod tests {
     fn times_and_uniform_step_agree() {
         let n = 30;
         let h = 0.01;
-        let twists: Vec<f64> = (0..n).flat_map(|k| {
-            let s = k as f64 * h;
-            [s.sin(), 0.2, -s, 0.3 * s.cos(), 0.1, s * s]
-        }).collect();
+        let twists: Vec<f64> = (0..n)
+            .flat_map(|k| {
+                let s = k as f64 * h;
+                [s.sin(), 0.2, -s, 0.3 * s.cos(), 0.1, s * s]
+            })
+            .collect();
         let t: Vec<f64> = (0..n).map(|k| k as f64 * h).collect();
         let pose0 = [1.0, 2.0, 3.0, 0.0, 0.0, 0.6f64.sin(), 0.6f64.cos()];
         let (mut a, mut b) = (vec![0.0; 7 * n], vec![0.0; 7 * n]);
@@ -188,22 +204,34 @@ mod tests {
     fn planar_matches_free_in_plane() {
         let n = 50;
         let h = 0.05;
-        let rates: Vec<[f64; 3]> = (0..n).map(|k| {
-            let s = k as f64 * h;
-            [0.5 + s.sin(), -0.3 * s, 0.2 + 0.4 * s.cos()]
-        }).collect();
+        let rates: Vec<[f64; 3]> = (0..n)
+            .map(|k| {
+                let s = k as f64 * h;
+                [0.5 + s.sin(), -0.3 * s, 0.2 + 0.4 * s.cos()]
+            })
+            .collect();
         let planar: Vec<f64> = rates.iter().flatten().copied().collect();
         let free: Vec<f64> = rates.iter().flat_map(|r| [r[0], r[1], 0.0, 0.0, 0.0, r[2]]).collect();
         let yaw0 = 0.3f64;
         let (mut p, mut f) = (vec![0.0; 3 * n], vec![0.0; 7 * n]);
         integrate_planar_base_poses(Steps::Uniform(h), &planar, &[1.0, -1.0, yaw0], &mut p).unwrap();
-        integrate_base_poses(Steps::Uniform(h), &free, &[1.0, -1.0, 0.0, 0.0, 0.0, (yaw0 / 2.0).sin(), (yaw0 / 2.0).cos()], &mut f)
-            .unwrap();
+        integrate_base_poses(
+            Steps::Uniform(h),
+            &free,
+            &[1.0, -1.0, 0.0, 0.0, 0.0, (yaw0 / 2.0).sin(), (yaw0 / 2.0).cos()],
+            &mut f,
+        )
+        .unwrap();
         for k in 0..n {
             let r: M3 = rot_from_quat(&f[7 * k + 3..7 * k + 7]);
             let yaw = r[(1, 0)].atan2(r[(0, 0)]);
             assert!((p[3 * k] - f[7 * k]).abs() < 1e-12 && (p[3 * k + 1] - f[7 * k + 1]).abs() < 1e-12);
-            assert!(((p[3 * k + 2] - yaw + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI).abs() < 1e-12);
+            assert!(
+                ((p[3 * k + 2] - yaw + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
+                    - std::f64::consts::PI)
+                    .abs()
+                    < 1e-12
+            );
         }
     }
 
