@@ -21,7 +21,7 @@
 
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
-use crate::kinematics::{classical_acceleration, forward_accelerations};
+use crate::kinematics::classical_acceleration;
 use crate::model::{JointType, Model};
 use crate::regressors::{dynamics_regressor, momentum_regressor};
 use crate::spatial::{skew, M3, V3};
@@ -51,7 +51,7 @@ impl PointMotion {
     }
 
     /// The motion of body `body`'s frame origin from the kinematics in `d` (after `forward_accelerations`,
-    /// or `forward_velocities` with `with_acc = false`).
+    /// e.g. through `dynamics_regressor`, or `forward_velocities` with `with_acc = false`).
     pub fn of_body(d: &Data, body: usize, with_acc: bool) -> PointMotion {
         let x = &d.o_mi[body];
         let tw = &d.v[body];
@@ -291,6 +291,33 @@ pub struct StandardRows {
     pub dims: [usize; 2],
 }
 
+impl PaperRows {
+    /// Empty rows with room for `n` sample blocks (no reallocation in the per-sample loop).
+    fn with_capacity(dims: [usize; 5], n: usize) -> PaperRows {
+        let [nl, nmu, na, nth, nd] = dims;
+        PaperRows {
+            t: Vec::with_capacity(n),
+            a: Vec::with_capacity(n * nl * nmu),
+            b: Vec::with_capacity(n * nl),
+            phi: Vec::with_capacity(n * na * nth),
+            y: Vec::with_capacity(n * na),
+            psi: Vec::with_capacity(n * na * nd),
+            dims,
+        }
+    }
+}
+
+impl StandardRows {
+    fn with_capacity(dims: [usize; 2], n: usize) -> StandardRows {
+        StandardRows {
+            t: Vec::with_capacity(n),
+            phi: Vec::with_capacity(n * dims[0] * dims[1]),
+            y: Vec::with_capacity(n * dims[0]),
+            dims,
+        }
+    }
+}
+
 fn check_bodies(m: &Model, base: usize, target: usize) -> Result<()> {
     let n = m.nbodies();
     if base >= n || target >= n || base == target {
@@ -377,7 +404,7 @@ pub fn paper_momentum_rows(m: &Model, meas: &Measurements, base: usize, target: 
     let mut d = Data::new(m);
     let mut buf = Vec::with_capacity(m.nq);
     let mut k = DMatrix::zeros(6, 10 * m.nbodies());
-    let mut out = PaperRows { dims: paper_dims(&l), ..Default::default() };
+    let mut out = PaperRows::with_capacity(paper_dims(&l), n);
     let mut first: Option<PaperSample> = None;
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
@@ -415,14 +442,14 @@ pub fn paper_force_rows(m: &Model, meas: &Measurements, base: usize, target: usi
     let mut d = Data::new(m);
     let mut buf = Vec::with_capacity(m.nq);
     let mut y = DMatrix::zeros(m.nv, 10 * m.nbodies());
-    let mut out = PaperRows { dims: paper_dims(&l), ..Default::default() };
+    let mut out = PaperRows::with_capacity(paper_dims(&l), n);
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         let (v, a) = (&meas.v[s * m.nv..(s + 1) * m.nv], &meas.ddq[s * m.nv..(s + 1) * m.nv]);
-        forward_accelerations(m, &mut d, q, v, a);
+        // the regressor runs `forward_accelerations` and leaves the body twists and accelerations in `d`
+        dynamics_regressor(m, &mut d, q, v, a, &mut y);
         let (p1, pn) = (PointMotion::of_body(&d, base, true), PointMotion::of_body(&d, target, true));
         let (p1s, pns) = (p1.shifted(&p1.r), pn.shifted(&p1.r));
-        dynamics_regressor(m, &mut d, q, v, a, &mut y);
         // base-frame wrench of the thrusters minus the known links' share (base rows of the regressor)
         let mut w = [0.0; 6];
         for r in 0..nb {
@@ -462,7 +489,7 @@ pub fn standard_momentum_rows(m: &Model, meas: &Measurements, base: usize, targe
     let mut k = DMatrix::zeros(6, 10 * m.nbodies());
     let width = rows.len() * cols.len();
     let (mut phi0, mut y0) = (vec![0.0; width], vec![0.0; rows.len()]);
-    let mut out = StandardRows { dims: [rows.len(), cols.len()], ..Default::default() };
+    let mut out = StandardRows::with_capacity([rows.len(), cols.len()], n);
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k);
@@ -501,7 +528,7 @@ pub fn standard_force_rows(m: &Model, meas: &Measurements, base: usize, target: 
     let mut d = Data::new(m);
     let mut buf = Vec::with_capacity(m.nq);
     let mut y = DMatrix::zeros(m.nv, 10 * m.nbodies());
-    let mut out = StandardRows { dims: [nb, cols.len()], ..Default::default() };
+    let mut out = StandardRows::with_capacity([nb, cols.len()], n);
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         let (v, a) = (&meas.v[s * m.nv..(s + 1) * m.nv], &meas.ddq[s * m.nv..(s + 1) * m.nv]);
