@@ -200,6 +200,12 @@ class RecursiveLS:
 def aba(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
     """Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`."""
 
+def base_twist_for_momentum(model: Model, q: ArrayLike, joint_rates: ArrayLike, momentum: ArrayLike | None = None) -> Any:
+    """Base velocity (…, nb) — a free base's twist [v; ω] in the base frame, a planar base's [vx, vy, yaw
+rate] — that gives the total momentum `momentum` (6: [p; L about the inertial origin], inertial frame;
+default zero) when the other joints move with `joint_rates` (…, nv − nb) at `q` (…, nq).
+    """
+
 def body_accelerations(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, classical: bool = False) -> np.ndarray:
     """Body accelerations (nbodies, 6) in body frames: spatial (d/dt of the body-frame twist
 components, Pinocchio LOCAL) or, with `classical`, the acceleration of each body origin.
@@ -311,8 +317,35 @@ streaming QR) or "qr". Returns a dict: x, std, covariance, rss, dof, condition_n
 rows, method. Raises NumericalError naming the unexcited combinations if rank deficient.
     """
 
+def inertia_com_form(params: ArrayLike) -> Any:
+    """`(m, b', I'_c)` from standard parameters (…, 10) about a reference point: masses (…), centres of mass
+(…, 3), inertias about the centre of mass (…, 3, 3) (parallel axes; `postcapture::equations::com_form`).
+    """
+
+def inertia_project_consistent(params: ArrayLike, eps: ArrayLike = 1e-09) -> Any:
+    """Nearest physically consistent standard parameters (…, 10) (pseudo-inertia eigenvalues clipped at
+`eps`·max; `postcapture::equations::project_consistent`).
+    """
+
+def inertia_standard_form(mass: ArrayLike, com: ArrayLike, inertia: ArrayLike) -> Any:
+    """Standard parameters (…, 10) about the reference point from masses (…), centres of mass (…, 3) and
+inertias about the centre of mass (…, 3, 3) (`postcapture::equations::standard_form`).
+    """
+
+def integrate_base_poses(t: ArrayLike, twists: ArrayLike, pose0: ArrayLike) -> Any:
+    """Base poses from sampled base twists by the trapezoidal rule on the group (`sim::integrate_base_poses`).
+Free base: `twists` (T, 6) = [v; ω] in the base frame, `pose0` (7) = position, quaternion x y z w;
+returns (T, 7). Planar base: `twists` (T, 3) = [vx, vy, yaw rate], `pose0` (3) = [x, y, yaw]; returns
+(T, 3). `t` (T,) the increasing sample times.
+    """
+
 def kinetic_energy(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
     ...
+
+def matrix_to_quat(rot: ArrayLike) -> Any:
+    """Unit quaternions (…, 4), x, y, z, w with w ≥ 0, of rotation matrices (…, 3, 3) (Shepperd's method).
+Matrices farther than 1e-6 from a rotation are rejected.
+    """
 
 def momentum(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
     """Total momentum [linear; angular about the inertial origin], inertial frame."""
@@ -328,9 +361,25 @@ regressor and right-hand side and discards it (no solve). Returns the sum of the
 sides. Same arguments as `identify_momentum`.
     """
 
+def postcapture_m_j(mass: ArrayLike, com: ArrayLike) -> Any:
+    """`m J(b')` (10) = [m, m b', m mono(b')] (Zhang 2020, eq. (23))."""
+
+def postcapture_rows(model: Model, form: ArrayLike, solver: ArrayLike, t: ArrayLike, q: ArrayLike, v: ArrayLike, ddq: ArrayLike, base_wrench: ArrayLike, impulse_f: ArrayLike, impulse_m: ArrayLike, base: str, target: ArrayLike) -> Any:
+    """Seed 000's regression rows over a whole measurement record (Zhang, Yue, Yuan 2020), computed by the
+engine (`postcapture::equations`). `form`: "momentum" (eqs. 11-19; cumulative differences from the first
+sample, so one block fewer) or "force" (eqs. 26-33, about the base sensor). `solver`: "paper" (dict with
+t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict with t, Phi, y, standard
+parameters about the reference points). Arrays have a leading sample axis.
+    """
+
 def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1) -> Any:
     """Simulate the post-capture scenario. Returns a dict like `simulate` (t, q, v, ddq, tau, momentum,
 kinetic_energy, work) recorded every `record_every` RK4 steps.
+    """
+
+def quat_to_matrix(quat: ArrayLike) -> Any:
+    """Rotation matrices (…, 3, 3) (frame → inertial) of quaternions (…, 4) in x, y, z, w order. Norms within
+1e-6 of one are normalised, others rejected (ARCHITECTURE.md quaternion policy).
     """
 
 def rnea(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
@@ -338,3 +387,6 @@ def rnea(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fext: ArrayLike
 
 def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba') -> Any:
     ...
+
+def skew(v: ArrayLike) -> Any:
+    """Cross-product matrices (…, 3, 3): `skew(a) @ b == a × b`."""

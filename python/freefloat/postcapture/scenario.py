@@ -13,7 +13,7 @@ import yaml
 from .. import algorithms as alg
 from .. import data, models
 from .._core import InputError
-from .._rotations import quat_to_matrix
+from ..algorithms import quat_to_matrix
 
 # Noise study levels (the paper has no noise): white, per sample. Velocities [m/s, rad/s] and accelerations
 # [m/s², rad/s²] at the 10 Hz samples; thrust [N, N·m] at the 1 kHz step rate before integration.

@@ -8,7 +8,7 @@ import numpy as np
 from .. import _core, models
 from .. import algorithms as alg
 from .._core import InputError
-from .._rotations import quat_to_matrix
+from ..algorithms import quat_to_matrix
 from . import equations as eq
 from .scenario import Scenario
 

@@ -1,10 +1,12 @@
 //! Forward kinematics, centre of mass, momentum, Jacobians.
 
+mod base_twist;
 mod com;
 mod fk;
 mod jacobian;
 mod momentum;
 
+pub use base_twist::{base_twist_for_momentum, base_velocity_coordinates};
 pub use com::center_of_mass;
 pub use fk::{
     classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities, joint_bias, joint_velocity,
