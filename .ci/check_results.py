@@ -28,7 +28,10 @@ def finite(x, where: str) -> float:
 def check_scenarios(path: str) -> None:
     lines = [ln for ln in open(path, encoding="utf-8").read().splitlines() if ln.strip() and not ln.startswith(" ")]
     if len(lines) < 5:
-        fail(f"`freefloat scenarios` listed {len(lines)} entries, expected the built-in ones (>= 5):\n" + "\n".join(lines))
+        fail(
+            f"`freefloat scenarios` listed {len(lines)} entries, expected the built-in ones (>= 5):\n"
+            + "\n".join(lines)
+        )
     print(f"check_results: {len(lines)} built-in scenarios listed")
 
 

@@ -65,17 +65,25 @@ TARGETS = {
 # set-up
 # ---------------------------------------------------------------------------------------------------
 
+
 def parse_args(argv=None):
     p = argparse.ArgumentParser(
         description="Time freefloat against Pinocchio (batched C++ and single Python calls) and against "
         "Pinocchio/Crocoddyl RK4 simulation loops, on the same robot, in one run. Prints a markdown "
         "report and writes compare_pinocchio.json and compare_pinocchio.md.",
     )
-    p.add_argument("--quick", action="store_true",
-                   help="smoke test: 2 repeats, small batch (2000), 2000 single calls, 1 s simulation")
-    p.add_argument("--out", type=Path, default=None,
-                   help="output directory (default: benches/results next to this script; with --quick, "
-                   "benches/results/quick so a smoke test never overwrites the full results)")
+    p.add_argument(
+        "--quick",
+        action="store_true",
+        help="smoke test: 2 repeats, small batch (2000), 2000 single calls, 1 s simulation",
+    )
+    p.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output directory (default: benches/results next to this script; with --quick, "
+        "benches/results/quick so a smoke test never overwrites the full results)",
+    )
     p.add_argument("--repeats", type=int, default=None, help="repeats of every measurement (default 5; quick 2)")
     p.add_argument("--batch", type=int, default=None, help="batch size N for the core-to-core rows (default 20000)")
     p.add_argument("--calls", type=int, default=None, help="single calls per repeat (default 20000)")
@@ -94,8 +102,9 @@ def parse_args(argv=None):
 
 def build_models(tmpdir: Path):
     """(ff model, Pinocchio model with revolute joints, Pinocchio model as exported (continuous))."""
-    import freefloat as ff
     import pinocchio as pin
+
+    import freefloat as ff
 
     m = ff.models.load(MODEL)
     raw = tmpdir / f"{MODEL}.urdf"
@@ -105,7 +114,12 @@ def build_models(tmpdir: Path):
     # URDF requires <limit> on a revolute joint; the export writes none for unlimited joints, so give
     # the revolute version wide ones (limits play no part in aba/rnea/crba/simulation).
     import re
-    text = re.sub(r'type="continuous">', 'type="revolute">\n    <limit lower="-1e6" upper="1e6" velocity="1e6" effort="1e6"/>', text)
+
+    text = re.sub(
+        r'type="continuous">',
+        'type="revolute">\n    <limit lower="-1e6" upper="1e6" velocity="1e6" effort="1e6"/>',
+        text,
+    )
     rev = tmpdir / f"{MODEL}_revolute.urdf"
     rev.write_text(text)
 
@@ -128,7 +142,7 @@ def q_to_unbounded(pm_raw, q):
         j = pm_raw.joints[jid]
         ang = q[7 + (j.idx_v - 6)]
         if j.nq == 2:
-            out[j.idx_q:j.idx_q + 2] = (np.cos(ang), np.sin(ang))
+            out[j.idx_q : j.idx_q + 2] = (np.cos(ang), np.sin(ang))
         else:
             out[j.idx_q] = ang
     return out
@@ -136,8 +150,9 @@ def q_to_unbounded(pm_raw, q):
 
 def check_agreement(m, pm, pm_raw, rng, n=5, tol=1e-9):
     """pin.aba == ff.aba (and rnea, crba, momentum) on random states; abort otherwise."""
-    import freefloat as ff
     import pinocchio as pin
+
+    import freefloat as ff
 
     pd, pd_raw = pm.createData(), pm_raw.createData()
     worst = {}
@@ -156,7 +171,8 @@ def check_agreement(m, pm, pm_raw, rng, n=5, tol=1e-9):
         errs = {
             "aba": rel(ff.aba(m, q, v, tau), pin.aba(pm, pd, q, v, tau)),
             "aba (exported URDF as is, continuous joints)": rel(
-                ff.aba(m, q, v, tau), pin.aba(pm_raw, pd_raw, q_to_unbounded(pm_raw, q), v, tau)),
+                ff.aba(m, q, v, tau), pin.aba(pm_raw, pd_raw, q_to_unbounded(pm_raw, q), v, tau)
+            ),
             "rnea": rel(ff.rnea(m, q, v, a), pin.rnea(pm, pd, q, v, a)),
             "crba": rel(ff.crba(m, q), pin.crba(pm, pd, q)),
             "momentum": rel(ff.momentum(m, q, v), mom_pin),
@@ -170,11 +186,13 @@ def check_agreement(m, pm, pm_raw, rng, n=5, tol=1e-9):
 
 
 def environment():
-    import freefloat as ff
     import pinocchio as pin
+
+    import freefloat as ff
 
     try:
         import crocoddyl
+
         croc = crocoddyl.__version__
     except ImportError as e:
         croc = f"unavailable ({e})"
@@ -187,10 +205,17 @@ def environment():
     git = None
     try:
         import subprocess
+
         root = Path(__file__).resolve().parent.parent
-        head = subprocess.run(["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True, check=False).stdout.strip()
+        head = subprocess.run(
+            ["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True, text=True, check=False
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True,
+            text=True,
+            check=False,
+        ).stdout.strip()
         git = head + ("+dirty" if dirty else "") if head else None
     except OSError:
         pass
@@ -211,6 +236,7 @@ def environment():
 # ---------------------------------------------------------------------------------------------------
 # timing helpers
 # ---------------------------------------------------------------------------------------------------
+
 
 def _clock(fn):
     gc.collect()
@@ -239,18 +265,24 @@ def run_interleaved(cases: dict, repeats: int, per: dict):
 
 
 def summary(samples):
-    return {"median": statistics.median(samples["wall"]), "min": min(samples["wall"]),
-            "max": max(samples["wall"]), "cpu_median": statistics.median(samples["cpu"]),
-            "wall": samples["wall"]}
+    return {
+        "median": statistics.median(samples["wall"]),
+        "min": min(samples["wall"]),
+        "max": max(samples["wall"]),
+        "cpu_median": statistics.median(samples["cpu"]),
+        "wall": samples["wall"],
+    }
 
 
 # ---------------------------------------------------------------------------------------------------
 # 1 + 2: algorithms
 # ---------------------------------------------------------------------------------------------------
 
+
 def bench_algorithms(m, pm, args, rng):
-    import freefloat as ff
     import pinocchio as pin
+
+    import freefloat as ff
 
     N, C, R = args.batch, args.calls, args.repeats
     Q = np.array([m.random_configuration(rng) for _ in range(N)])
@@ -270,6 +302,7 @@ def bench_algorithms(m, pm, args, rng):
         def run():
             for k in range(N):
                 fn(k)
+
         return run
 
     pd = pm.createData()
@@ -297,6 +330,7 @@ def bench_algorithms(m, pm, args, rng):
         def run():
             for _ in range(C):
                 f()
+
         return run
 
     single = {
@@ -320,6 +354,7 @@ def bench_algorithms(m, pm, args, rng):
 # ---------------------------------------------------------------------------------------------------
 # 3: simulation
 # ---------------------------------------------------------------------------------------------------
+
 
 def initial_state(m):
     q = m.neutral()
@@ -404,7 +439,9 @@ def make_croc(pm, dt, poly_two):
     state = crocoddyl.StateMultibody(pm)
     act = crocoddyl.ActuationModelFloatingBase(state)
     if act.nu != pm.nv - 6:
-        raise SystemExit(f"crocoddyl actuation has nu={act.nu}, expected {pm.nv - 6} (free-flyer name must be root_joint)")
+        raise SystemExit(
+            f"crocoddyl actuation has nu={act.nu}, expected {pm.nv - 6} (free-flyer name must be root_joint)"
+        )
     costs = crocoddyl.CostModelSum(state, act.nu)
     dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, act, costs)
     if poly_two:
@@ -435,7 +472,7 @@ def sim_crocoddyl(pm, q0, v0, t_final, dt, poly_two=False):
         x = d.xnext.copy()
         Xs.append(x)
     X = np.array(Xs)
-    return X[:, :pm.nq], X[:, pm.nq:], None
+    return X[:, : pm.nq], X[:, pm.nq :], None
 
 
 _PROBLEMS = {}
@@ -473,10 +510,10 @@ def sim_crocoddyl_rollout_prebuilt(pm, q0, v0, t_final, dt, chunk=1000):
         us += [us[-1]] * (chunk - k)  # a short last chunk: pad, and keep only its k steps
         problem.x0 = x
         xs = problem.rollout(us)
-        Xs.append(np.array(xs[1:k + 1]))
+        Xs.append(np.array(xs[1 : k + 1]))
         x = np.array(xs[k])
     X = np.vstack(Xs)
-    return X[:, :pm.nq], X[:, pm.nq:], None
+    return X[:, : pm.nq], X[:, pm.nq :], None
 
 
 def sim_crocoddyl_rollout(pm, q0, v0, t_final, dt, chunk=1000):
@@ -499,7 +536,7 @@ def sim_crocoddyl_rollout(pm, q0, v0, t_final, dt, chunk=1000):
         Xs.append(np.array(xs[1:]))
         x = np.array(xs[-1])
     X = np.vstack(Xs)
-    return X[:, :pm.nq], X[:, pm.nq:], None
+    return X[:, : pm.nq], X[:, pm.nq :], None
 
 
 def pin_momentum(pm, Q, V):
@@ -517,8 +554,10 @@ def pin_momentum(pm, Q, V):
 
 
 def drift(H):
-    return {"linear_abs": float(np.linalg.norm(H[:, :3] - H[0, :3], axis=1).max()),
-            "angular_abs": float(np.linalg.norm(H[:, 3:] - H[0, 3:], axis=1).max())}
+    return {
+        "linear_abs": float(np.linalg.norm(H[:, :3] - H[0, :3], axis=1).max()),
+        "angular_abs": float(np.linalg.norm(H[:, 3:] - H[0, 3:], axis=1).max()),
+    }
 
 
 def bench_simulation(m, pm, args):
@@ -532,10 +571,12 @@ def bench_simulation(m, pm, args):
         "Pinocchio RK4 loop in Python (naive Lie-group RK4)": lambda: sim_pin_python(pm, q0, v0, tf, dt),
         "Crocoddyl IntegratedActionModelRK(four), u held at mid-step": lambda: sim_crocoddyl(pm, q0, v0, tf, dt),
         "Crocoddyl IntegratedActionModelRK(four), PolyTwoRK control": lambda: sim_crocoddyl(pm, q0, v0, tf, dt, True),
-        "Crocoddyl ShootingProblem.rollout (C++ loop, PolyTwoRK, 1000-node chunks)":
-            lambda: sim_crocoddyl_rollout(pm, q0, v0, tf, dt),
-        "Crocoddyl rollout alone (1000-node problem built outside the timing)":
-            lambda: sim_crocoddyl_rollout_prebuilt(pm, q0, v0, tf, dt),
+        "Crocoddyl ShootingProblem.rollout (C++ loop, PolyTwoRK, 1000-node chunks)": lambda: sim_crocoddyl_rollout(
+            pm, q0, v0, tf, dt
+        ),
+        "Crocoddyl rollout alone (1000-node problem built outside the timing)": lambda: sim_crocoddyl_rollout_prebuilt(
+            pm, q0, v0, tf, dt
+        ),
     }
     sim_crocoddyl_rollout_prebuilt(pm, q0, v0, tf, dt)  # build the re-used problem before timing
     # Time (interleaved repeats), keeping the last output of each for the accuracy columns.
@@ -544,6 +585,7 @@ def bench_simulation(m, pm, args):
     def keep(k, f):
         def run():
             last[k] = f()
+
         return run
 
     res = run_interleaved({k: keep(k, f) for k, f in cases.items()}, args.repeats, {k: 1 for k in cases})
@@ -562,14 +604,17 @@ def bench_simulation(m, pm, args):
         # difference of the final configuration from the ff table run (same forcing => tiny)
         row["final_q_diff_vs_ff"] = float(np.linalg.norm(pin.difference(pm, ref_q[-1], Q[-1])))
         out[k] = row
-    out["_initial_momentum"] = {"p_norm": float(np.linalg.norm(pin_momentum(pm, q0[None], v0[None])[0, :3])),
-                                "L_norm": float(np.linalg.norm(pin_momentum(pm, q0[None], v0[None])[0, 3:]))}
+    out["_initial_momentum"] = {
+        "p_norm": float(np.linalg.norm(pin_momentum(pm, q0[None], v0[None])[0, :3])),
+        "L_norm": float(np.linalg.norm(pin_momentum(pm, q0[None], v0[None])[0, 3:])),
+    }
     return out
 
 
 # ---------------------------------------------------------------------------------------------------
 # report
 # ---------------------------------------------------------------------------------------------------
+
 
 def us(x):
     return f"{x * 1e6:.2f}"
@@ -578,65 +623,100 @@ def us(x):
 def make_report(env, args, agree, batch, single, sim, ratios, checks):
     L = []
     L.append(f"# freefloat vs Pinocchio / Crocoddyl — `{MODEL}` (nq = 16, nv = 15)\n")
-    L.append(f"Run: {time.strftime('%Y-%m-%d %H:%M:%S')}, {env['cpu']}, {env['nproc']} CPUs, "
-             f"load average at start {tuple(round(x, 2) for x in env['loadavg_start'])}, "
-             f"at end {tuple(round(x, 2) for x in env['loadavg_end'])}. "
-             f"freefloat {env['freefloat']} (git {env['git']}), pin {env['pinocchio']}, crocoddyl {env['crocoddyl']}, "
-             f"numpy {env['numpy']}, Python {env['python']}."
-             + (" **--quick run (smoke test; numbers not meaningful).**" if args.quick else "") + "\n")
-    L.append(f"Repeats: {args.repeats} (interleaved). Batch N = {args.batch}; single-call loops of {args.calls} calls. "
-             f"Agreement with Pinocchio before timing (max relative error): "
-             + ", ".join(f"{k} {v:.1e}" for k, v in agree.items()) + ".\n")
+    L.append(
+        f"Run: {time.strftime('%Y-%m-%d %H:%M:%S')}, {env['cpu']}, {env['nproc']} CPUs, "
+        f"load average at start {tuple(round(x, 2) for x in env['loadavg_start'])}, "
+        f"at end {tuple(round(x, 2) for x in env['loadavg_end'])}. "
+        f"freefloat {env['freefloat']} (git {env['git']}), pin {env['pinocchio']}, crocoddyl {env['crocoddyl']}, "
+        f"numpy {env['numpy']}, Python {env['python']}."
+        + (" **--quick run (smoke test; numbers not meaningful).**" if args.quick else "")
+        + "\n"
+    )
+    L.append(
+        f"Repeats: {args.repeats} (interleaved). Batch N = {args.batch}; single-call loops of {args.calls} calls. "
+        f"Agreement with Pinocchio before timing (max relative error): "
+        + ", ".join(f"{k} {v:.1e}" for k, v in agree.items())
+        + ".\n"
+    )
 
     L.append("## Core-to-core: µs per call (batched)\n")
     L.append("| algorithm | freefloat batch median | min | Pinocchio | median | min | ff / pin (median) |")
     L.append("|---|---:|---:|---|---:|---:|---:|")
-    pairs = [("aba", "ff aba", "pin abaInParallel", batch, "abaInParallel(1 thread)"),
-             ("rnea", "ff rnea", "pin rneaInParallel", batch, "rneaInParallel(1 thread)"),
-             ("crba", "ff crba", "pin crba", single, "crba, py-loop (no batched API)"),
-             ("momentum", "ff momentum", "pin computeCentroidalMomentum", single,
-              "computeCentroidalMomentum, py-loop (no batched API)"),
-             ("centroidal momentum matrix", "ff centroidal_momentum_matrix", "pin computeCentroidalMap", single,
-              "computeCentroidalMap, py-loop (no batched API)")]
+    pairs = [
+        ("aba", "ff aba", "pin abaInParallel", batch, "abaInParallel(1 thread)"),
+        ("rnea", "ff rnea", "pin rneaInParallel", batch, "rneaInParallel(1 thread)"),
+        ("crba", "ff crba", "pin crba", single, "crba, py-loop (no batched API)"),
+        (
+            "momentum",
+            "ff momentum",
+            "pin computeCentroidalMomentum",
+            single,
+            "computeCentroidalMomentum, py-loop (no batched API)",
+        ),
+        (
+            "centroidal momentum matrix",
+            "ff centroidal_momentum_matrix",
+            "pin computeCentroidalMap",
+            single,
+            "computeCentroidalMap, py-loop (no batched API)",
+        ),
+    ]
     for name, fk, pk, src, plabel in pairs:
         f, p = batch[fk], src[pk]
-        L.append(f"| {name} | {us(f['median'])} | {us(f['min'])} | {plabel} | {us(p['median'])} | {us(p['min'])} | "
-                 f"{f['median'] / p['median']:.2f} |")
+        L.append(
+            f"| {name} | {us(f['median'])} | {us(f['min'])} | {plabel} | {us(p['median'])} | {us(p['min'])} | "
+            f"{f['median'] / p['median']:.2f} |"
+        )
         if name == "crba":
             small = next(k for k in batch if k.startswith("ff crba, N="))
             f = batch[small]
-            L.append(f"| crba, batch {small.split('N=')[1]} (output fits in cache) | {us(f['median'])} | {us(f['min'])} | "
-                     f"(same) | {us(p['median'])} | {us(p['min'])} | {f['median'] / p['median']:.2f} |")
+            L.append(
+                f"| crba, batch {small.split('N=')[1]} (output fits in cache) | {us(f['median'])} | {us(f['min'])} | "
+                f"(same) | {us(p['median'])} | {us(p['min'])} | {f['median'] / p['median']:.2f} |"
+            )
     L.append("")
-    L.append("Pinocchio has batched C++ entry points only for aba and rnea; the other rows compare freefloat's batch "
-             "against single Pinocchio calls from a Python loop, so those Pinocchio figures overstate its C++ cost "
-             "by the binding overhead (about 0.4-0.9 µs per call). `computeCentroidalMomentum` and "
-             "`computeCentroidalMap` work about the centre of mass, freefloat about the inertial origin (one extra "
-             "shift). abaInParallel/rneaInParallel write into a preallocated output; freefloat allocates its result.\n")
+    L.append(
+        "Pinocchio has batched C++ entry points only for aba and rnea; the other rows compare freefloat's batch "
+        "against single Pinocchio calls from a Python loop, so those Pinocchio figures overstate its C++ cost "
+        "by the binding overhead (about 0.4-0.9 µs per call). `computeCentroidalMomentum` and "
+        "`computeCentroidalMap` work about the centre of mass, freefloat about the inertial origin (one extra "
+        "shift). abaInParallel/rneaInParallel write into a preallocated output; freefloat allocates its result.\n"
+    )
     L.append("## Single call from Python: µs per call\n")
     L.append("| algorithm | freefloat median | min | Pinocchio call | median | min | ff / pin (median) |")
     L.append("|---|---:|---:|---|---:|---:|---:|")
-    for name, fk, pk in [("aba", "ff aba", "pin aba"), ("rnea", "ff rnea", "pin rnea"), ("crba", "ff crba", "pin crba"),
-                         ("momentum", "ff momentum", "pin computeCentroidalMomentum"),
-                         ("centroidal momentum matrix", "ff centroidal_momentum_matrix", "pin computeCentroidalMap")]:
+    for name, fk, pk in [
+        ("aba", "ff aba", "pin aba"),
+        ("rnea", "ff rnea", "pin rnea"),
+        ("crba", "ff crba", "pin crba"),
+        ("momentum", "ff momentum", "pin computeCentroidalMomentum"),
+        ("centroidal momentum matrix", "ff centroidal_momentum_matrix", "pin computeCentroidalMap"),
+    ]:
         f, p = single[fk], single[pk]
-        L.append(f"| {name} | {us(f['median'])} | {us(f['min'])} | `{pk[4:]}` | {us(p['median'])} | {us(p['min'])} | "
-                 f"{f['median'] / p['median']:.2f} |")
+        L.append(
+            f"| {name} | {us(f['median'])} | {us(f['min'])} | `{pk[4:]}` | {us(p['median'])} | {us(p['min'])} | "
+            f"{f['median'] / p['median']:.2f} |"
+        )
     e = single["empty Python loop + lambda"]
     L.append(f"| (empty loop + lambda, included above) | {us(e['median'])} | {us(e['min'])} | | | | |")
     L.append("")
     L.append(f"## Simulation: {args.t_final:g} s at dt = {args.dt:g} s, RK4, sinusoidal arm torques\n")
     im = sim["_initial_momentum"]
-    L.append(f"Initial |p| = {im['p_norm']:.3f} kg·m/s, |L_O| = {im['L_norm']:.3f} kg·m²/s. Drift = max over all steps of "
-             "‖p(t) − p(0)‖ and ‖L_O(t) − L_O(0)‖, computed with Pinocchio from the returned states. "
-             "‖Δq_end‖ = ‖difference(q_end, q_end of the ff table run)‖.\n")
+    L.append(
+        f"Initial |p| = {im['p_norm']:.3f} kg·m/s, |L_O| = {im['L_norm']:.3f} kg·m²/s. Drift = max over all steps of "
+        "‖p(t) − p(0)‖ and ‖L_O(t) − L_O(0)‖, computed with Pinocchio from the returned states. "
+        "‖Δq_end‖ = ‖difference(q_end, q_end of the ff table run)‖.\n"
+    )
     L.append("| method | wall median [s] | min [s] | µs/step | × real time | max‖Δp‖ | max‖ΔL_O‖ | ‖Δq_end‖ vs ff |")
     L.append("|---|---:|---:|---:|---:|---:|---:|---:|")
     for k, r in sim.items():
         if k.startswith("_"):
             continue
-        L.append(f"| {k} | {r['median']:.4f} | {r['min']:.4f} | {r['us_per_step']:.1f} | {r['realtime_factor']:.0f} | "
-                 f"{r['drift_pin']['linear_abs']:.2e} | {r['drift_pin']['angular_abs']:.2e} | " f"{r['final_q_diff_vs_ff']:.1e} |")
+        L.append(
+            f"| {k} | {r['median']:.4f} | {r['min']:.4f} | {r['us_per_step']:.1f} | {r['realtime_factor']:.0f} | "
+            f"{r['drift_pin']['linear_abs']:.2e} | {r['drift_pin']['angular_abs']:.2e} | "
+            f"{r['final_q_diff_vs_ff']:.1e} |"
+        )
     L.append("")
     L.append("## Ratios (same run; > 1 means freefloat is faster)\n")
     L.append("| comparison | median ratio | min ratio | target | met? |")
@@ -649,8 +729,9 @@ def make_report(env, args, agree, batch, single, sim, ratios, checks):
 
 def main(argv=None):
     args = parse_args(argv)
-    import freefloat as ff  # noqa: F401
     import pinocchio as pin  # noqa: F401
+
+    import freefloat as ff  # noqa: F401
 
     env = environment()
     rng = np.random.default_rng(args.seed)
@@ -681,39 +762,63 @@ def main(argv=None):
     cro = sim["Crocoddyl ShootingProblem.rollout (C++ loop, PolyTwoRK, 1000-node chunks)"]
     crp = sim["Crocoddyl rollout alone (1000-node problem built outside the timing)"]
     ratios = {
-        "aba_core_vs_abaInParallel": ratio(batch["pin abaInParallel"], batch["ff aba"],
-                                           "aba: abaInParallel / ff batch", ">= 1"),
-        "rnea_core_vs_rneaInParallel": ratio(batch["pin rneaInParallel"], batch["ff rnea"], "rnea: rneaInParallel / ff batch"),
+        "aba_core_vs_abaInParallel": ratio(
+            batch["pin abaInParallel"], batch["ff aba"], "aba: abaInParallel / ff batch", ">= 1"
+        ),
+        "rnea_core_vs_rneaInParallel": ratio(
+            batch["pin rneaInParallel"], batch["ff rnea"], "rnea: rneaInParallel / ff batch"
+        ),
         "aba_single": ratio(single["pin aba"], single["ff aba"], "aba single call: pin / ff"),
         "rnea_single": ratio(single["pin rnea"], single["ff rnea"], "rnea single call: pin / ff"),
         "crba_single": ratio(single["pin crba"], single["ff crba"], "crba single call: pin / ff"),
-        "momentum_single": ratio(single["pin computeCentroidalMomentum"], single["ff momentum"],
-                                 "momentum single call: pin / ff"),
-        "sim_vs_crocoddyl_rollout": ratio(cro, ft, "sim: Crocoddyl C++ rollout incl. problem construction / ff table", ">= 5"),
-        "sim_vs_crocoddyl_rollout_alone": ratio(crp, ft, "sim: Crocoddyl C++ rollout alone (problem pre-built) / ff table", ">= 5"),
+        "momentum_single": ratio(
+            single["pin computeCentroidalMomentum"], single["ff momentum"], "momentum single call: pin / ff"
+        ),
+        "sim_vs_crocoddyl_rollout": ratio(
+            cro, ft, "sim: Crocoddyl C++ rollout incl. problem construction / ff table", ">= 5"
+        ),
+        "sim_vs_crocoddyl_rollout_alone": ratio(
+            crp, ft, "sim: Crocoddyl C++ rollout alone (problem pre-built) / ff table", ">= 5"
+        ),
         "sim_vs_crocoddyl": ratio(cr, ft, "sim: Crocoddyl RK4 stepped from Python (mid-step u) / ff table", ">= 5"),
         "sim_vs_pin_python": ratio(pl, ft, "sim: Pinocchio Python RK4 loop / ff table", ">= 20"),
         "sim_callable_vs_crocoddyl": ratio(cr, fc, "sim: Crocoddyl RK4 (mid-step u) / ff callable"),
         "sim_callable_vs_pin_python": ratio(pl, fc, "sim: Pinocchio Python RK4 loop / ff callable"),
         "sim_vs_crocoddyl_polytwo": ratio(cr2, ft, "sim: Crocoddyl RK4 (PolyTwoRK) / ff table"),
     }
-    thresholds = {"aba_core_vs_abaInParallel": 1.0, "sim_vs_crocoddyl_rollout": 5.0, "sim_vs_crocoddyl_rollout_alone": 5.0,
-                  "sim_vs_crocoddyl": 5.0,
-                  "sim_vs_pin_python": 20.0}
+    thresholds = {
+        "aba_core_vs_abaInParallel": 1.0,
+        "sim_vs_crocoddyl_rollout": 5.0,
+        "sim_vs_crocoddyl_rollout_alone": 5.0,
+        "sim_vs_crocoddyl": 5.0,
+        "sim_vs_pin_python": 20.0,
+    }
     checks = {k: ("yes" if ratios[k]["median"] >= t else "**NO**") for k, t in thresholds.items()}
 
     report = make_report(env, args, agree, batch, single, sim, ratios, checks)
     print(report)
     args.out.mkdir(parents=True, exist_ok=True)
     result = {
-        "model": MODEL, "environment": env,
-        "settings": {"quick": args.quick, "repeats": args.repeats, "batch": args.batch, "calls": args.calls,
-                     "t_final": args.t_final, "dt": args.dt, "seed": args.seed,
-                     "urdf_continuous_joints_rewritten_as_revolute": n_cont},
+        "model": MODEL,
+        "environment": env,
+        "settings": {
+            "quick": args.quick,
+            "repeats": args.repeats,
+            "batch": args.batch,
+            "calls": args.calls,
+            "t_final": args.t_final,
+            "dt": args.dt,
+            "seed": args.seed,
+            "urdf_continuous_joints_rewritten_as_revolute": n_cont,
+        },
         "agreement_max_rel_error": agree,
         "units": "seconds per call (algorithms), seconds per run (simulation)",
-        "core_batched": batch, "single_call": single, "simulation": sim,
-        "ratios": ratios, "targets": TARGETS, "targets_met": checks,
+        "core_batched": batch,
+        "single_call": single,
+        "simulation": sim,
+        "ratios": ratios,
+        "targets": TARGETS,
+        "targets_met": checks,
     }
     (args.out / "compare_pinocchio.json").write_text(json.dumps(result, indent=1))
     (args.out / "compare_pinocchio.md").write_text(report + "\n")

@@ -60,8 +60,9 @@ def residual_scale(path: str, table: dict):
     return table.get(f"{head}/{name.replace('paper_', 'paper_')}_scale")
 
 
-def compare(before: Path, after: Path, rtol: float, error_atol: float = 1e-12,
-            residual_rtol: float = 1e-13) -> tuple[int, int, float, list]:
+def compare(
+    before: Path, after: Path, rtol: float, error_atol: float = 1e-12, residual_rtol: float = 1e-13
+) -> tuple[int, int, float, list]:
     A = dict(leaves(json.loads(before.read_text())))
     B = dict(leaves(json.loads(after.read_text())))
     bad, compared, worst, rows = 0, 0, 0.0, []
@@ -114,7 +115,10 @@ def main() -> int:
             status = 1
             continue
         bad, n, worst, rows = compare(f, g, a.rtol, a.error_atol, a.residual_rtol)
-        print(f"{f.parent.relative_to(a.before)}: {n} numbers compared, {bad} differ beyond the tolerances; largest relative difference of the others {worst:.3g}")
+        print(
+            f"{f.parent.relative_to(a.before)}: {n} numbers compared, {bad} differ beyond the tolerances; "
+            f"largest relative difference of the others {worst:.3g}"
+        )
         for k, what, r in rows[: a.max_rows]:
             print(f"    {k}: {what}" + (f"  (rel {r:.3g})" if r is not None else ""))
         if len(rows) > a.max_rows:

@@ -1,12 +1,15 @@
 """The demo's consistent fit (cvxpy, SCS status `optimal_inaccurate`) is not continuous at round-off level:
 the reported misfit of the same identification moves by tens of percent when the identified minimal
 parameters are perturbed by 1e-14 relative. Run: python benches/consistent_fit_sensitivity.py"""
-import numpy as np, freefloat as ff
+
+import numpy as np
+
 from freefloat import data, models
-from freefloat.identification import identify as idf
-from freefloat.io.trajectory_files import load_trajectory
 from freefloat.constants import SIGMA_ANG, SIGMA_JOINT, SIGMA_LIN
+from freefloat.identification import identify as idf
 from freefloat.identification.consistent import consistent_parameters
+from freefloat.io.trajectory_files import load_trajectory
+
 m = models.load("naveen_dual_arm")
 with data.path("trajectories", "naveen_exciting_trajectory") as p:
     designed, joints = load_trajectory(p)

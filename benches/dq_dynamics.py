@@ -24,17 +24,26 @@ import freefloat as ff
 
 def random_tree_yaml(n: int, seed: int) -> str:
     rng = np.random.default_rng(seed)
-    lines = [f"name: bench_tree_{n}", "base: free", "gravity: [0, 0, 0]", "bodies:",
-             "  - name: b0", "    inertial: {mass: 50, com: [0.1, 0, 0], inertia: [10, 12, 9]}"]
+    lines = [
+        f"name: bench_tree_{n}",
+        "base: free",
+        "gravity: [0, 0, 0]",
+        "bodies:",
+        "  - name: b0",
+        "    inertial: {mass: 50, com: [0.1, 0, 0], inertia: [10, 12, 9]}",
+    ]
     for i in range(1, n):
         parent = int(rng.integers(max(0, i - 3), i))
         axis = rng.normal(size=3)
         axis /= np.linalg.norm(axis)
         xyz = rng.uniform(-1, 1, size=3)
-        lines += [f"  - name: b{i}", f"    parent: b{parent}",
-                  "    joint: {type: revolute, axis: [" + ", ".join(f"{a:.6f}" for a in axis) + "]}",
-                  "    origin: {xyz: [" + ", ".join(f"{a:.6f}" for a in xyz) + "], rpy: [0, 0, 0]}",
-                  "    inertial: {mass: 2, com: [0.2, 0.05, 0], inertia: [0.3, 0.4, 0.5]}"]
+        lines += [
+            f"  - name: b{i}",
+            f"    parent: b{parent}",
+            "    joint: {type: revolute, axis: [" + ", ".join(f"{a:.6f}" for a in axis) + "]}",
+            "    origin: {xyz: [" + ", ".join(f"{a:.6f}" for a in xyz) + "], rpy: [0, 0, 0]}",
+            "    inertial: {mass: 2, com: [0.2, 0.05, 0], inertia: [0.3, 0.4, 0.5]}",
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -65,7 +74,7 @@ def bench(m, n, reps, rng):
         "dq": lambda: ff.dq_dynamics(m, Q, V, T),
         "decoupled": lambda: ff.dq_dynamics(m, Q, V, T, formulation="decoupled"),
         "aba": lambda: ff.aba(m, Q, V, T),
-        "aba+rnea": lambda: (ff.rnea(m, Q, V, ff.aba(m, Q, V, T))),
+        "aba+rnea": lambda: ff.rnea(m, Q, V, ff.aba(m, Q, V, T)),
     }
     res = {k: [] for k in fns}
     for _ in range(reps):  # interleaved
@@ -87,19 +96,26 @@ def main():
     for m in robots:
         t, err = bench(m, n, reps, rng)
         rows.append((m.name, m.nbodies, m.nv, t["dq"], t["decoupled"], t["aba"], t["aba+rnea"], err))
-        print(f"{m.name:28s} bodies {m.nbodies:3d}  dq {t['dq']:8.2f} us  decoupled {t['decoupled']:8.2f} us  "
-              f"aba {t['aba']:7.2f} us  aba+rnea {t['aba+rnea']:7.2f} us  err {err:.1e}")
-    md = ["| robot | bodies | nv | dq_dynamics [µs] | decoupled (dense) [µs] | ABA [µs] | ABA + RNEA [µs] "
-          "| dq / (ABA+RNEA) | dq / decoupled | dq vs ABA rel. diff |",
-          "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        print(
+            f"{m.name:28s} bodies {m.nbodies:3d}  dq {t['dq']:8.2f} us  decoupled {t['decoupled']:8.2f} us  "
+            f"aba {t['aba']:7.2f} us  aba+rnea {t['aba+rnea']:7.2f} us  err {err:.1e}"
+        )
+    md = [
+        "| robot | bodies | nv | dq_dynamics [µs] | decoupled (dense) [µs] | ABA [µs] | ABA + RNEA [µs] "
+        "| dq / (ABA+RNEA) | dq / decoupled | dq vs ABA rel. diff |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for r in rows:
-        md.append(f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.2f} | {r[4]:.2f} | {r[5]:.2f} | {r[6]:.2f} | "
-                  f"{r[3] / r[6]:.2f} | {r[3] / r[4]:.2f} | {r[7]:.1e} |")
+        md.append(
+            f"| {r[0]} | {r[1]} | {r[2]} | {r[3]:.2f} | {r[4]:.2f} | {r[5]:.2f} | {r[6]:.2f} | "
+            f"{r[3] / r[6]:.2f} | {r[3] / r[4]:.2f} | {r[7]:.1e} |"
+        )
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "dq_dynamics.md").write_text(
         f"Per-evaluation cost, batch of {n} states, median of {reps} interleaved repeats "
-        f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}).\n\n" + "\n".join(md) + "\n")
+        f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}).\n\n" + "\n".join(md) + "\n"
+    )
     print("\n".join(md))
 
 

@@ -65,8 +65,8 @@ from freefloat.identification.estimation import absolute_columns
 MODEL = "naveen_dual_arm_offset"
 #: the issue's targets: one evaluation of eq. 32 over 256 intervals, and the whole three-step design
 TARGETS = {"ff_objective_s": 5e-3, "design_s": 60.0}
-AGREE_RTOL = 1e-6       # κ, mean square, objective (κ from GᵀG: both sides square the condition number)
-REGRESSOR_RTOL = 1e-9   # regressor blocks, same algebra up to rounding
+AGREE_RTOL = 1e-6  # κ, mean square, objective (κ from GᵀG: both sides square the condition number)
+REGRESSOR_RTOL = 1e-9  # regressor blocks, same algebra up to rounding
 
 
 # ----------------------------------------------------------------------------------------------- Pinocchio peer
@@ -82,9 +82,11 @@ class PinPeer:
         g.to_urdf(raw)
         # The export writes unlimited joints as URDF "continuous", which Pinocchio parametrises by (cos, sin);
         # as revolute joints (wide limits, which play no part here) the q layout is ours.
-        text = re.sub(r'type="continuous">',
-                      'type="revolute">\n    <limit lower="-1e6" upper="1e6" velocity="1e6" effort="1e6"/>',
-                      raw.read_text())
+        text = re.sub(
+            r'type="continuous">',
+            'type="revolute">\n    <limit lower="-1e6" upper="1e6" velocity="1e6" effort="1e6"/>',
+            raw.read_text(),
+        )
         rev = tmpdir / f"{g.name}_revolute.urdf"
         rev.write_text(text)
         pm = pin.buildModelFromUrdf(str(rev), pin.JointModelFreeFlyer())
@@ -110,7 +112,9 @@ class PinPeer:
         self.q_loc = pin.neutral(pm)
         others = np.setdiff1d(np.arange(7, pm.nq), self.iq)
         if others.size:
-            raise SystemExit("the peer assumes every non-base joint is driven (true for the Naveen, Shah, Misra robots)")
+            raise SystemExit(
+                "the peer assumes every non-base joint is driven (true for the Naveen, Shah, Misra robots)"
+            )
         self.R0 = quat_to_matrix(q0[3:7] / np.linalg.norm(q0[3:7]))
         self.p0 = q0[:3].copy()
 
@@ -131,7 +135,7 @@ class PinPeer:
         for k in range(N):
             A[k] = pin.computeCentroidalMap(pm, pd, Q[k])
         rhs = -np.einsum("nij,nj->ni", A[:, :, 6:], V[:, 6:])
-        tw = np.linalg.solve(A[:, :, :6], rhs[..., None])[..., 0]        # (N, 6) [v; ω]
+        tw = np.linalg.solve(A[:, :, :6], rhs[..., None])[..., 0]  # (N, 6) [v; ω]
         V[:, :6] = tw
         # trapezoidal rule on the group: R_{k+1} = R_k exp(h (ω_k + ω_{k+1}) / 2), p by the mean of R v
         h = d.interval / d.grid
@@ -155,7 +159,7 @@ class PinPeer:
         lam = np.clip(np.linalg.eigvalsh(G.T @ G), 0.0, None)[::-1]
         sv = np.sqrt(lam)
         kappa = sv[0] / max(sv[-1], 1e-16 * sv[0]) if sv[0] > 0 else np.inf
-        sumsq = np.sum(tw[idx] ** 2) + np.sum(qd[idx, :d.n_arm] ** 2)
+        sumsq = np.sum(tw[idx] ** 2) + np.sum(qd[idx, : d.n_arm] ** 2)
         ms = sumsq / ((6 + d.n_arm) * len(idx))
         out = {"objective": kappa + d.weight / ms, "condition_number": kappa, "mean_square": ms, "singular_values": sv}
         if keep:  # states for the regressor check (not part of the timed work)
@@ -190,9 +194,13 @@ def rodrigues(w):
 
 def quat_to_matrix(qt):
     x, y, z, w = qt
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def matrix_to_quat(R):
@@ -237,23 +245,39 @@ def environment():
         pass
     root = Path(__file__).resolve().parent.parent
     try:
-        head = subprocess.run(["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
-        dirty = subprocess.run(["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"],
-                               capture_output=True, text=True).stdout.strip()
+        head = subprocess.run(
+            ["git", "-C", str(root), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "-C", str(root), "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True
+        ).stdout.strip()
         git = head + ("+dirty" if dirty else "") if head else None
     except OSError:
         git = None
-    return {"git": git, "python": sys.version.split()[0], "platform": platform.platform(), "cpu": cpu,
-            "nproc": os.cpu_count(), "loadavg_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
-            "freefloat": ff.__version__, "pinocchio": pin.__version__, "numpy": np.__version__, "scipy": scipy.__version__}
+    return {
+        "git": git,
+        "python": sys.version.split()[0],
+        "platform": platform.platform(),
+        "cpu": cpu,
+        "nproc": os.cpu_count(),
+        "loadavg_start": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+        "freefloat": ff.__version__,
+        "pinocchio": pin.__version__,
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+    }
 
 
 # -------------------------------------------------------------------------------------------------------- main
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog=__doc__.split("\n\n", 1)[1])
-    ap.add_argument("--quick", action="store_true",
-                    help="smoke test: 5 repeats, one design capped at 5 SQP iterations per step")
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=__doc__.split("\n\n", 1)[1],
+    )
+    ap.add_argument(
+        "--quick", action="store_true", help="smoke test: 5 repeats, one design capped at 5 SQP iterations per step"
+    )
     ap.add_argument("--repeats", type=int, default=None, help="timing repeats (default 31, quick 5)")
     ap.add_argument("--design-repeats", type=int, default=None, help="full-design repeats (default 2, quick 1)")
     ap.add_argument("--out", type=Path, default=None)
@@ -286,8 +310,9 @@ def main():
             "condition_number_rel": rel(r_pe["condition_number"], r_ff["condition_number"][0]),
             "mean_square_rel": rel(r_pe["mean_square"], r_ff["mean_square"][0]),
             "objective_rel": rel(r_pe["objective"], r_ff["objective"][0]),
-            "singular_values_max_rel": float(np.max(np.abs(r_pe["singular_values"] - r_ff["singular_values"][0])
-                                                    / r_ff["singular_values"][0])),
+            "singular_values_max_rel": float(
+                np.max(np.abs(r_pe["singular_values"] - r_ff["singular_values"][0]) / r_ff["singular_values"][0])
+            ),
         }
         # the gradient batch must give the sequential numbers (same Rust path, split over threads)
         hstep = 1e-6 * np.maximum(1.0, np.abs(x))
@@ -297,25 +322,34 @@ def main():
         agreement["batch_vs_sequential_max_rel"] = float(np.max(np.abs(rb["objective"] - seq) / np.abs(seq)))
         # A single evaluation splits its rows over both threads, a batch gives each path one thread: the Gram
         # blocks are summed in a different order, so the two agree to rounding (not bitwise).
-        ok = (reg_err <= REGRESSOR_RTOL and agreement["batch_vs_sequential_max_rel"] <= 1e-9
-              and all(agreement[k] <= AGREE_RTOL for k in ("condition_number_rel", "mean_square_rel", "objective_rel")))
+        ok = (
+            reg_err <= REGRESSOR_RTOL
+            and agreement["batch_vs_sequential_max_rel"] <= 1e-9
+            and all(agreement[k] <= AGREE_RTOL for k in ("condition_number_rel", "mean_square_rel", "objective_rel"))
+        )
         if not ok:
             raise SystemExit(f"ABORT: peer and freefloat disagree: {agreement}")
 
         # ---- 1. one evaluation of eq. 32
         q_pre, qd_pre = peer.path(x, dirs)
-        t_obj = interleaved({
-            "ff_evaluate": lambda: d.evaluate(x),
-            "peer_evaluate": lambda: peer.evaluate(x, dirs),
-            "ff_rust_call_only": lambda: d._objective(q_pre[None], qd_pre[None]),
-            "cycloid_only": lambda: peer.path(x, dirs),
-        }, repeats)
+        t_obj = interleaved(
+            {
+                "ff_evaluate": lambda: d.evaluate(x),
+                "peer_evaluate": lambda: peer.evaluate(x, dirs),
+                "ff_rust_call_only": lambda: d._objective(q_pre[None], qd_pre[None]),
+                "cycloid_only": lambda: peer.path(x, dirs),
+            },
+            repeats,
+        )
 
     # ---- 2. the 13 evaluations of one finite-difference gradient
-    t_grad = interleaved({
-        "batch_one_call": lambda: d.evaluate(X),
-        "sequential_13_calls": lambda: [d.evaluate(xi) for xi in X],
-    }, max(3, repeats // 2))
+    t_grad = interleaved(
+        {
+            "batch_one_call": lambda: d.evaluate(X),
+            "sequential_13_calls": lambda: [d.evaluate(xi) for xi in X],
+        },
+        max(3, repeats // 2),
+    )
 
     # ---- 3. the whole design
     designs = []
@@ -323,9 +357,17 @@ def main():
         gc.collect()
         t0 = time.perf_counter()
         res = d.design(maxiter=design_maxiter, progress=False)
-        designs.append({"seconds": time.perf_counter() - t0, "steps_s": res.timings, "kept": int(len(res.prune.kept)),
-                        "condition_number": res.step3.condition_number, "objective": res.step3.objective,
-                        "step1_iterations": res.step1.iterations, "step3_iterations": res.step3.iterations})
+        designs.append(
+            {
+                "seconds": time.perf_counter() - t0,
+                "steps_s": res.timings,
+                "kept": int(len(res.prune.kept)),
+                "condition_number": res.step3.condition_number,
+                "objective": res.step3.objective,
+                "step1_iterations": res.step1.iterations,
+                "step3_iterations": res.step3.iterations,
+            }
+        )
     design_med = statistics.median(v["seconds"] for v in designs)
 
     so = {k: stats(v) for k, v in t_obj.items()}
@@ -335,32 +377,58 @@ def main():
         "sequential_over_batch": sg["sequential_13_calls"]["median"] / sg["batch_one_call"]["median"],
     }
     res = {
-        "benchmark": "excitation objective (Naveen, Shah, Misra eq. 32)", "model": MODEL, "quick": args.quick,
-        "problem": {"intervals": n_int, "grid_points": int(n_int * d.grid + 1), "sampled_points": int(n_int * d.samples),
-                    "regressor_shape": [6 * n_int * d.samples, int(d.n_min)], "weight": d.weight,
-                    "seeds": x.tolist(), "threads": d.threads},
-        "environment": env, "repeats": repeats,
-        "freefloat_at_x": {"objective": float(r_ff["objective"][0]), "condition_number": float(r_ff["condition_number"][0]),
-                           "mean_square": float(r_ff["mean_square"][0])},
-        "agreement": agreement, "agreement_tolerances": {"parts": AGREE_RTOL, "regressor": REGRESSOR_RTOL},
+        "benchmark": "excitation objective (Naveen, Shah, Misra eq. 32)",
+        "model": MODEL,
+        "quick": args.quick,
+        "problem": {
+            "intervals": n_int,
+            "grid_points": int(n_int * d.grid + 1),
+            "sampled_points": int(n_int * d.samples),
+            "regressor_shape": [6 * n_int * d.samples, int(d.n_min)],
+            "weight": d.weight,
+            "seeds": x.tolist(),
+            "threads": d.threads,
+        },
+        "environment": env,
+        "repeats": repeats,
+        "freefloat_at_x": {
+            "objective": float(r_ff["objective"][0]),
+            "condition_number": float(r_ff["condition_number"][0]),
+            "mean_square": float(r_ff["mean_square"][0]),
+        },
+        "agreement": agreement,
+        "agreement_tolerances": {"parts": AGREE_RTOL, "regressor": REGRESSOR_RTOL},
         "agreement_passed": bool(ok),
-        "objective_seconds": so, "gradient_batch_seconds": sg, "gradient_batch_evaluations": int(len(X)),
-        "design": {"maxiter": design_maxiter, "repeats": designs, "seconds_median": design_med,
-                   "kept_intervals": designs[-1]["kept"], "condition_number": designs[-1]["condition_number"],
-                   "paper": {"kept": exc.PAPER_KEPT, "condition_number": exc.PAPER_KAPPA}},
-        "ratios": ratios, "targets": TARGETS,
-        "meets_targets": {"ff_objective_s": bool(so["ff_evaluate"]["median"] < TARGETS["ff_objective_s"]),
-                          "design_s": bool(design_med < TARGETS["design_s"]) if not args.quick else None},
+        "objective_seconds": so,
+        "gradient_batch_seconds": sg,
+        "gradient_batch_evaluations": int(len(X)),
+        "design": {
+            "maxiter": design_maxiter,
+            "repeats": designs,
+            "seconds_median": design_med,
+            "kept_intervals": designs[-1]["kept"],
+            "condition_number": designs[-1]["condition_number"],
+            "paper": {"kept": exc.PAPER_KEPT, "condition_number": exc.PAPER_KAPPA},
+        },
+        "ratios": ratios,
+        "targets": TARGETS,
+        "meets_targets": {
+            "ff_objective_s": bool(so["ff_evaluate"]["median"] < TARGETS["ff_objective_s"]),
+            "design_s": bool(design_med < TARGETS["design_s"]) if not args.quick else None,
+        },
         "loadavg_end": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
     }
 
     ms = lambda s: f"{1e3 * s['median']:.2f}"
     md = [
-        "# Exciting-trajectory objective (Naveen, Shah, Misra eq. 32): freefloat vs a Pinocchio + numpy peer", "",
+        "# Exciting-trajectory objective (Naveen, Shah, Misra eq. 32): freefloat vs a Pinocchio + numpy peer",
+        "",
         f"{MODEL}, {n_int} intervals x 1 s: {res['problem']['grid_points']:,} grid points for the base response, "
-        f"{res['problem']['sampled_points']:,} sampled points -> " f"{6 * n_int * d.samples:,} x {d.n_min} minimal regressor; "
+        f"{res['problem']['sampled_points']:,} sampled points -> "
+        f"{6 * n_int * d.samples:,} x {d.n_min} minimal regressor; "
         f"seeds `d.feasible_start(d.all_directions)`.",
-        f"At these seeds: C = {res['freefloat_at_x']['objective']:.6g}, " f"κ = {res['freefloat_at_x']['condition_number']:.6g}, "
+        f"At these seeds: C = {res['freefloat_at_x']['objective']:.6g}, "
+        f"κ = {res['freefloat_at_x']['condition_number']:.6g}, "
         f"mean square {res['freefloat_at_x']['mean_square']:.6g}.",
         f"Agreement (checked before timing): regressor {reg_err:.1e}, κ {agreement['condition_number_rel']:.1e}, "
         f"mean square {agreement['mean_square_rel']:.1e}, objective {agreement['objective_rel']:.1e} "
@@ -368,27 +436,50 @@ def main():
         f"Median of {repeats} interleaved repeats; {env['nproc']} hardware threads shared with other jobs "
         f"(load average at start {env['loadavg_start'][0]:.2f}, end {res['loadavg_end'][0]:.2f}); {env['cpu']}; "
         f"pinocchio {env['pinocchio']}, numpy {env['numpy']}, git {env['git']}.",
-        "", "## One evaluation of eq. 32", "",
-        "| what | median [ms] | min [ms] |", "|---|---|---|",
+        "",
+        "## One evaluation of eq. 32",
+        "",
+        "| what | median [ms] | min [ms] |",
+        "|---|---|---|",
         f"| freefloat `d.evaluate(x)` | {ms(so['ff_evaluate'])} | {1e3 * so['ff_evaluate']['min']:.2f} |",
         f"| Pinocchio + numpy peer | {ms(so['peer_evaluate'])} | {1e3 * so['peer_evaluate']['min']:.2f} |",
-        f"| freefloat Rust call alone (path pre-evaluated) | {ms(so['ff_rust_call_only'])} | " f"{1e3 * so['ff_rust_call_only']['min']:.2f} |",
-        f"| cycloid evaluation alone (in both of the first two rows) | {ms(so['cycloid_only'])} | " f"{1e3 * so['cycloid_only']['min']:.2f} |",
+        f"| freefloat Rust call alone (path pre-evaluated) | {ms(so['ff_rust_call_only'])} | "
+        f"{1e3 * so['ff_rust_call_only']['min']:.2f} |",
+        f"| cycloid evaluation alone (in both of the first two rows) | {ms(so['cycloid_only'])} | "
+        f"{1e3 * so['cycloid_only']['min']:.2f} |",
         "",
-        f"Peer / freefloat: {ratios['peer_over_ff_evaluate']:.1f}x.  " f"Target for freefloat: < {1e3 * TARGETS['ff_objective_s']:.0f} ms "
+        f"Peer / freefloat: {ratios['peer_over_ff_evaluate']:.1f}x.  "
+        f"Target for freefloat: < {1e3 * TARGETS['ff_objective_s']:.0f} ms "
         f"({'met' if res['meets_targets']['ff_objective_s'] else 'NOT met'}).",
-        "", "## One finite-difference gradient (13 evaluations)", "",
-        "| what | median [ms] | min [ms] |", "|---|---|---|",
-        f"| one `d.evaluate(X)` call, X 13 x 12, {d.threads} worker threads | " f"{ms(sg['batch_one_call'])} | " f"{1e3 * sg['batch_one_call']['min']:.2f} |",
-        f"| 13 sequential `d.evaluate(x_i)` calls | {ms(sg['sequential_13_calls'])} | " f"{1e3 * sg['sequential_13_calls']['min']:.2f} |",
-        "", f"Sequential / batch: {ratios['sequential_over_batch']:.2f}x (with 2 cores the ceiling is 2x).",
-        "", "## Full design (`d.design(progress=False)`)", "",
+        "",
+        "## One finite-difference gradient (13 evaluations)",
+        "",
+        "| what | median [ms] | min [ms] |",
+        "|---|---|---|",
+        f"| one `d.evaluate(X)` call, X 13 x 12, {d.threads} worker threads | "
+        f"{ms(sg['batch_one_call'])} | "
+        f"{1e3 * sg['batch_one_call']['min']:.2f} |",
+        f"| 13 sequential `d.evaluate(x_i)` calls | {ms(sg['sequential_13_calls'])} | "
+        f"{1e3 * sg['sequential_13_calls']['min']:.2f} |",
+        "",
+        f"Sequential / batch: {ratios['sequential_over_batch']:.2f}x (with 2 cores the ceiling is 2x).",
+        "",
+        "## Full design (`d.design(progress=False)`)",
+        "",
         f"maxiter {design_maxiter}{' (capped for --quick: not the real design time)' if args.quick else ''}; "
-        f"{design_repeats} run(s): " + ", ".join(f"{v['seconds']:.1f} s" for v in designs) + f"; median {design_med:.1f} s"
-        + (f" (target < {TARGETS['design_s']:.0f} s: {'met' if res['meets_targets']['design_s'] else 'NOT met'})." if not args.quick else "."),
-        f"Kept intervals {res['design']['kept_intervals']} of {n_int}, " f"κ after step 3 {res['design']['condition_number']:.4g} "
+        f"{design_repeats} run(s): "
+        + ", ".join(f"{v['seconds']:.1f} s" for v in designs)
+        + f"; median {design_med:.1f} s"
+        + (
+            f" (target < {TARGETS['design_s']:.0f} s: {'met' if res['meets_targets']['design_s'] else 'NOT met'})."
+            if not args.quick
+            else "."
+        ),
+        f"Kept intervals {res['design']['kept_intervals']} of {n_int}, "
+        f"κ after step 3 {res['design']['condition_number']:.4g} "
         f"(paper: {exc.PAPER_KEPT} kept, κ {exc.PAPER_KAPPA}); steps (last run): "
-        + ", ".join(f"{k} {v:.1f} s" for k, v in designs[-1]["steps_s"].items()) + ".",
+        + ", ".join(f"{k} {v:.1f} s" for k, v in designs[-1]["steps_s"].items())
+        + ".",
     ]
     text = "\n".join(md) + "\n"
     args.out.mkdir(parents=True, exist_ok=True)

@@ -73,11 +73,13 @@ def make_data(m, seconds):
 def quat_to_rot(qt):
     """(4, ...) quaternion components x y z w -> (3, 3, ...) rotation matrices (components first)."""
     x, y, z, w = qt
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def cross(a, b):
@@ -97,7 +99,7 @@ def numpy_regressor(fk, tw):
     T, nb, _ = fk.shape
     f = np.moveaxis(fk, -1, 0)  # (7, T, nb)
     t = np.moveaxis(tw, -1, 0)  # (6, T, nb)
-    R = quat_to_rot(f[3:])      # (3, 3, T, nb)
+    R = quat_to_rot(f[3:])  # (3, 3, T, nb)
     p, v, w = f[:3], t[:3], t[3:]
     vo = R[:, 0] * v[0] + R[:, 1] * v[1] + R[:, 2] * v[2]
     wo = R[:, 0] * w[0] + R[:, 1] * w[1] + R[:, 2] * w[2]
@@ -134,8 +136,11 @@ def interleaved(jobs, repeats):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
-                                 epilog=__doc__.split("\n\n", 1)[1])
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=__doc__.split("\n\n", 1)[1],
+    )
     ap.add_argument("--quick", action="store_true", help="6,700 samples and 3 repeats (smoke test)")
     ap.add_argument("--repeats", type=int, default=None, help="timing repeats (default 7, quick 3)")
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results")
@@ -182,35 +187,54 @@ def main():
     }
 
     res = {
-        "model": MODEL, "samples": T, "regressor_shape": [6 * T, int(mp.n_min)], "noise_sigma": NOISE,
+        "model": MODEL,
+        "samples": T,
+        "regressor_shape": [6 * T, int(mp.n_min)],
+        "noise_sigma": NOISE,
         "states": f"ff.simulate RK4 {seconds} s at 1 kHz, prescribed multi-sine on {', '.join(DRIVEN)}",
-        "repeats": repeats, "threads": os.cpu_count(), "machine": platform.processor() or platform.machine(),
-        "numpy": np.__version__, "freefloat_method": r.method, "condition_number": r.condition_number,
+        "repeats": repeats,
+        "threads": os.cpu_count(),
+        "machine": platform.processor() or platform.machine(),
+        "numpy": np.__version__,
+        "freefloat_method": r.method,
+        "condition_number": r.condition_number,
         "agreement": {"regressor_max_rel": reg_err, "estimate_max_rel": est_err},
         "relative_error_percent": {"median": med, "max": mx},
         "seconds_median_min": {k: list(v) for k, v in timings.items()},
-        "ratios": ratios, "ratios_vs_issue_reference_peer": ratios_vs_reference, "issue_reference_seconds": REFERENCE,
+        "ratios": ratios,
+        "ratios_vs_issue_reference_peer": ratios_vs_reference,
+        "issue_reference_seconds": REFERENCE,
         "targets": TARGETS,
         "meets_targets": {k: bool(ratios[k] >= TARGETS[k]) for k in TARGETS},
     }
     md = [
-        "# Identification from momentum: freefloat vs a vectorised numpy peer", "",
+        "# Identification from momentum: freefloat vs a vectorised numpy peer",
+        "",
         f"{MODEL}, {T:,} samples -> {6 * T:,} x {mp.n_min} minimal regressor; {res['states']}; noise sigma {NOISE}.",
         f"freefloat route: {r.method}; condition number {r.condition_number:.1f}; "
-        f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}; " f"eqs. 38-39 errors: median {med:.3f} %, max {mx:.3f} %.",
-        f"Median of {repeats} repeats, {res['threads']} hardware threads (freefloat uses them; numpy's BLAS may too).", "",
-        "| what | freefloat [s] | numpy peer [s] | ratio | target |", "|---|---|---|---|---|",
+        f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}; "
+        f"eqs. 38-39 errors: median {med:.3f} %, max {mx:.3f} %.",
+        f"Median of {repeats} repeats, {res['threads']} hardware threads (freefloat uses them; numpy's BLAS may too).",
+        "",
+        "| what | freefloat [s] | numpy peer [s] | ratio | target |",
+        "|---|---|---|---|---|",
     ]
-    rows = [("regressor (ff streaming build pass, no solve)", "ff_regressor_stream", "regressor"),
-            ("regressor (ff.momentum_regressor, stacked array)", "ff_regressor_stacked", "regressor_stacked"),
-            ("end to end (regressor + solve)", "ff_end_to_end", "end_to_end")]
+    rows = [
+        ("regressor (ff streaming build pass, no solve)", "ff_regressor_stream", "regressor"),
+        ("regressor (ff.momentum_regressor, stacked array)", "ff_regressor_stacked", "regressor_stacked"),
+        ("end to end (regressor + solve)", "ff_end_to_end", "end_to_end"),
+    ]
     for label, key, rk in rows:
         target = f">= {TARGETS[rk]:.0f}x" if rk in TARGETS else "-"
         npk = "np_end_to_end" if rk == "end_to_end" else "np_regressor"
         md.append(f"| {label} | {timings[key][0]:.4f} | {timings[npk][0]:.4f} | {ratios[rk]:.1f}x | {target} |")
-    md += ["", f"Against the issue's reference peer ({REFERENCE['regressor']} s build, " f"{REFERENCE['end_to_end']} s build + solve "
-           f"for 67,000 samples; only meaningful for the full run): regressor {ratios_vs_reference['regressor']:.1f}x, "
-           f"end to end {ratios_vs_reference['end_to_end']:.1f}x."]
+    md += [
+        "",
+        f"Against the issue's reference peer ({REFERENCE['regressor']} s build, "
+        f"{REFERENCE['end_to_end']} s build + solve "
+        f"for 67,000 samples; only meaningful for the full run): regressor {ratios_vs_reference['regressor']:.1f}x, "
+        f"end to end {ratios_vs_reference['end_to_end']:.1f}x.",
+    ]
     text = "\n".join(md) + "\n"
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "identify_vs_numpy.json").write_text(json.dumps(res, indent=2))

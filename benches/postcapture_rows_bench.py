@@ -1,9 +1,10 @@
-"""Speed of Zhang, Yue, Yuan 2020's identification rows: the engine (`_core.postcapture_rows`, one call per record) against
-the former numpy equations (tests/postcapture_numpy_oracle.py: vectorised numpy over the record, with the
+"""Speed of Zhang, Yue, Yuan 2020's identification rows: the engine (`_core.postcapture_rows`, one call per record)
+against the former numpy equations (tests/postcapture_numpy_oracle.py: vectorised numpy over the record, with the
 engine's stacked kinematics and regressors), on the same simulated record. Best of N repetitions each.
 
     python benches/postcapture_rows_bench.py [SCENARIO] [N]
 """
+
 import sys
 import time
 from pathlib import Path

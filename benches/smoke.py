@@ -37,10 +37,16 @@ def _check_excitation(out: Path) -> list[str]:
     agree, bad = res["agreement"], []
     if res["agreement_passed"] is not True:
         bad.append("agreement_passed is not true")
-    bad += [f"{k} = {agree[k]:.3g} > 1e-6" for k in ("condition_number_rel", "mean_square_rel", "objective_rel")
-            if not agree[k] <= 1e-6]
-    bad += [f"{k} = {agree[k]:.3g} > 1e-9" for k in ("regressor_max_rel", "batch_vs_sequential_max_rel")
-            if not agree[k] <= 1e-9]
+    bad += [
+        f"{k} = {agree[k]:.3g} > 1e-6"
+        for k in ("condition_number_rel", "mean_square_rel", "objective_rel")
+        if not agree[k] <= 1e-6
+    ]
+    bad += [
+        f"{k} = {agree[k]:.3g} > 1e-9"
+        for k in ("regressor_max_rel", "batch_vs_sequential_max_rel")
+        if not agree[k] <= 1e-9
+    ]
     if res["problem"]["intervals"] != 256 or res["problem"]["regressor_shape"] != [7680, 52]:
         bad.append(f"unexpected problem size {res['problem']}")
     d = res["design"]
@@ -88,8 +94,9 @@ def main(argv: list[str]) -> int:
             continue
         with tempfile.TemporaryDirectory() as tmp:
             t0 = time.perf_counter()
-            r = subprocess.run([sys.executable, str(HERE / script), "--quick", "--out", tmp, *extra],
-                               capture_output=True, text=True)
+            r = subprocess.run(
+                [sys.executable, str(HERE / script), "--quick", "--out", tmp, *extra], capture_output=True, text=True
+            )
             wall = time.perf_counter() - t0
             problems = [f"exit code {r.returncode}: {r.stderr.strip()[-1500:]}"] if r.returncode else check(Path(tmp))
         if problems:

@@ -64,8 +64,18 @@ def ch7_torques(m):
 
 
 def run(m, torques, t_final, dt_out, name, out: Path):
-    traj = ff.simulate(m, m.neutral(), np.zeros(m.nv), t_final, dt_out, method="rk45", rtol=1e-12, atol=1e-12,
-                       torques=torques, max_step=0.05)
+    traj = ff.simulate(
+        m,
+        m.neutral(),
+        np.zeros(m.nv),
+        t_final,
+        dt_out,
+        method="rk45",
+        rtol=1e-12,
+        atol=1e-12,
+        torques=torques,
+        max_step=0.05,
+    )
     com = ff.center_of_mass(m, traj.q)
     P, L = traj.momentum[:, :3], traj.momentum[:, 3:]
     ke, work = traj.kinetic_energy, traj.work
@@ -73,7 +83,10 @@ def run(m, torques, t_final, dt_out, name, out: Path):
     a_dec, W_dec = ff.dq_dynamics(m, traj.q, traj.v, traj.tau, formulation="decoupled")
     cond = ff.dq.condition_number(m, traj.q)
     summary = {
-        "run": name, "model": m.name, "t_final": t_final, "samples": len(traj.t),
+        "run": name,
+        "model": m.name,
+        "t_final": t_final,
+        "samples": len(traj.t),
         "com_drift_max_m": float(np.linalg.norm(com - com[0], axis=1).max()),
         "linear_momentum_drift_max": float(np.linalg.norm(P - P[0], axis=1).max()),
         "angular_momentum_drift_max": float(np.linalg.norm(L - L[0], axis=1).max()),
@@ -86,9 +99,11 @@ def run(m, torques, t_final, dt_out, name, out: Path):
     }
     plot(traj, com, r, cond, out / f"{name}.png", f"{m.name}: {name}")
     (out / f"{name}.json").write_text(json.dumps(summary, indent=2))
-    print(f"{name:28s} CoM drift {summary['com_drift_max_m']:.1e} m, |dP| {summary['linear_momentum_drift_max']:.1e}, "
-          f"|dL| {summary['angular_momentum_drift_max']:.1e}, |T - T0 - W| {summary['energy_minus_work_max_J']:.1e} J, "
-          f"dq vs decoupled {summary['dq_vs_decoupled_wrench_max_abs']:.1e}, cond(S) {cond.min():.3g}..{cond.max():.3g}")
+    print(
+        f"{name:28s} CoM drift {summary['com_drift_max_m']:.1e} m, |dP| {summary['linear_momentum_drift_max']:.1e}, "
+        f"|dL| {summary['angular_momentum_drift_max']:.1e}, |T - T0 - W| {summary['energy_minus_work_max_J']:.1e} J, "
+        f"dq vs decoupled {summary['dq_vs_decoupled_wrench_max_abs']:.1e}, cond(S) {cond.min():.3g}..{cond.max():.3g}"
+    )
     return summary
 
 
@@ -138,9 +153,11 @@ def main():
     m5 = ff.models.load("valverde_ch5_single_arm")
     m7 = ff.models.load("valverde_ch7_two_arm")
     t5, t7 = (8.0, 6.0) if args.quick else (70.0, 20.0)
-    res = [run(m5, ch5_torques(m5, True), t5, 0.05, "ch5_smooth_5.141", out),
-           run(m5, ch5_torques(m5, False), t5, 0.05, "ch5_discontinuous_5.142", out),
-           run(m7, ch7_torques(m7), t7, 0.02, "ch7_two_arm_7.16", out)]
+    res = [
+        run(m5, ch5_torques(m5, True), t5, 0.05, "ch5_smooth_5.141", out),
+        run(m5, ch5_torques(m5, False), t5, 0.05, "ch5_discontinuous_5.142", out),
+        run(m7, ch7_torques(m7), t7, 0.02, "ch7_two_arm_7.16", out),
+    ]
     (out / "summary.json").write_text(json.dumps([{k: v for k, v in s.items() if k != "peaks"} for s in res], indent=2))
     print(f"wrote {out}")
 

@@ -16,11 +16,14 @@ from freefloat.postcapture.equations import Layout, Measurements
 def quat_to_matrix(Q) -> np.ndarray:
     """Rotation matrices (T, 3, 3) from unit quaternions (T, 4) in (x, y, z, w) order (frame to inertial)."""
     x, y, z, w = Q.T
-    return np.stack([
-        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-    ], -2)
+    return np.stack(
+        [
+            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+        ],
+        -2,
+    )
 
 
 def skew(v: np.ndarray) -> np.ndarray:
@@ -34,8 +37,9 @@ def sharp(v: np.ndarray) -> np.ndarray:
     """[#v] (…, 3, 6) with I v = [#v] I#, eq. (20)."""
     z = np.zeros_like(v[..., 0])
     a, b, c = v[..., 0], v[..., 1], v[..., 2]
-    return np.stack([np.stack([a, b, c, z, z, z], -1), np.stack([z, a, z, b, c, z], -1),
-                     np.stack([z, z, a, z, b, c], -1)], -2)
+    return np.stack(
+        [np.stack([a, b, c, z, z, z], -1), np.stack([z, a, z, b, c, z], -1), np.stack([z, z, a, z, b, c], -1)], -2
+    )
 
 
 def quad(u: np.ndarray) -> np.ndarray:
@@ -43,8 +47,9 @@ def quad(u: np.ndarray) -> np.ndarray:
     (our closed form, docs/postcapture.md; replaces the garbled Appendix A)."""
     z = np.zeros_like(u[..., 0])
     a, b, c = u[..., 0], u[..., 1], u[..., 2]
-    return np.stack([np.stack([z, -b, -c, a, z, a], -1), np.stack([b, -a, z, z, -c, b], -1),
-                     np.stack([c, z, -a, c, -b, z], -1)], -2)
+    return np.stack(
+        [np.stack([z, -b, -c, a, z, a], -1), np.stack([b, -a, z, z, -c, b], -1), np.stack([c, z, -a, c, -b, z], -1)], -2
+    )
 
 
 def mono(b: np.ndarray) -> np.ndarray:
@@ -77,7 +82,7 @@ class PointMotion:
     a: np.ndarray
     b: np.ndarray
 
-    def shifted(self, origin: np.ndarray) -> "PointMotion":
+    def shifted(self, origin: np.ndarray) -> PointMotion:
         """Positions relative to a moving origin (the force form's base-sensor point);
         velocities and accelerations stay absolute."""
         return PointMotion(self.r - origin, self.A, self.v, self.w, self.a, self.b)
@@ -174,12 +179,12 @@ def paper_momentum_rows(model, meas: Measurements, base: int, target: int) -> Pa
     p1 = point_motion(model, meas.q, meas.v, zero, base)
     pn = point_motion(model, meas.q, meas.v, zero, target)
     K = np.asarray(alg.momentum_regressor(model, meas.q, meas.v))
-    known = K @ known_params(model, [base, target])           # Σ_known [m v ; m r × v + I ω]
-    Bt = np.concatenate([B_block(p1), B_block(pn)], -1)       # eq. (12)
-    C = meas.impulse_F - known[:, :3]                        # eq. (13)
-    Dt = np.concatenate([D_block(p1), D_block(pn)], -1)       # eq. (17)
-    E = meas.impulse_M - known[:, 3:]                        # eq. (18)
-    Ht = np.concatenate([H_block(p1), H_block(pn)], -1)       # eq. (19)
+    known = K @ known_params(model, [base, target])  # Σ_known [m v ; m r × v + I ω]
+    Bt = np.concatenate([B_block(p1), B_block(pn)], -1)  # eq. (12)
+    C = meas.impulse_F - known[:, :3]  # eq. (13)
+    Dt = np.concatenate([D_block(p1), D_block(pn)], -1)  # eq. (17)
+    E = meas.impulse_M - known[:, 3:]  # eq. (18)
+    Ht = np.concatenate([H_block(p1), H_block(pn)], -1)  # eq. (19)
     d = lambda X: X[1:] - X[:1]  # noqa: E731  (eq. 16: H(t) − H(t0), the printed H(t) is a typo)
     return _paper_assemble(L, d(Bt), d(C), d(Dt), d(E), -d(Ht), meas.t[1:])
 
@@ -193,14 +198,14 @@ def paper_force_rows(model, meas: Measurements, base: int, target: int) -> Paper
     p1s, pns = p1.shifted(origin), pn.shifted(origin)
     nb = meas.base_wrench.shape[1]
     Y = np.asarray(alg.dynamics_regressor(model, meas.q, meas.v, meas.ddq))[:, :nb]
-    known_b = Y @ known_params(model, [base, target])         # base-frame wrench of the known links
+    known_b = Y @ known_params(model, [base, target])  # base-frame wrench of the known links
     wrench = meas.base_wrench - known_b
     f3, m3 = _base_wrench_3d(wrench, L.planar)
-    K = mv(p1.A, f3)                                          # eq. (30)
-    R = mv(p1.A, m3)                                          # eq. (33), about the base sensor
-    Gt = np.concatenate([G_block(p1s), G_block(pns)], -1)     # eq. (29)
-    Qt = np.concatenate([Q_block(p1s), Q_block(pns)], -1)     # eq. (32)
-    St = np.concatenate([S_block(p1s), S_block(pns)], -1)     # eq. (31)
+    K = mv(p1.A, f3)  # eq. (30)
+    R = mv(p1.A, m3)  # eq. (33), about the base sensor
+    Gt = np.concatenate([G_block(p1s), G_block(pns)], -1)  # eq. (29)
+    Qt = np.concatenate([Q_block(p1s), Q_block(pns)], -1)  # eq. (32)
+    St = np.concatenate([S_block(p1s), S_block(pns)], -1)  # eq. (31)
     return _paper_assemble(L, Gt, K, Qt, R, -St, meas.t)
 
 
@@ -212,8 +217,8 @@ def _base_wrench_3d(w: np.ndarray, planar: bool):
 
 
 def standard_momentum_rows(model, meas: Measurements, base: int, target: int) -> StandardRows:
-    """Standard-parameter momentum form (docs/postcapture.md): the engine's momentum regressor columns of base and target (standard
-    parameters about the sensor / capture point), cumulative differences from t0."""
+    """Standard-parameter momentum form (docs/postcapture.md): the engine's momentum regressor columns of base
+    and target (standard parameters about the sensor / capture point), cumulative differences from t0."""
     L = Layout(model.joint_types[0] == "planar")
     K = np.asarray(alg.momentum_regressor(model, meas.q, meas.v))
     known = K @ known_params(model, [base, target])
@@ -225,8 +230,8 @@ def standard_momentum_rows(model, meas: Measurements, base: int, target: int) ->
 
 
 def standard_force_rows(model, meas: Measurements, base: int, target: int) -> StandardRows:
-    """Standard-parameter Newton-Euler form (docs/postcapture.md): base rows of the engine's inverse-dynamics regressor (the total
-    wrench at the base sensor, base frame) for the base and target columns."""
+    """Standard-parameter Newton-Euler form (docs/postcapture.md): base rows of the engine's inverse-dynamics
+    regressor (the total wrench at the base sensor, base frame) for the base and target columns."""
     L = Layout(model.joint_types[0] == "planar")
     nb = meas.base_wrench.shape[1]
     Y = np.asarray(alg.dynamics_regressor(model, meas.q, meas.v, meas.ddq))[:, :nb]
@@ -259,8 +264,14 @@ def standard_vector(m: float, b, Ic) -> np.ndarray:
 def from_standard(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Histories (N, 10) of standard parameters → m (N,), b' (N, 3), I'_c (N, 3, 3)."""
     m, h = x[:, 0], x[:, 1:4]
-    Io = np.stack([np.stack([x[:, 4], x[:, 5], x[:, 7]], -1), np.stack([x[:, 5], x[:, 6], x[:, 8]], -1),
-                   np.stack([x[:, 7], x[:, 8], x[:, 9]], -1)], -2)
+    Io = np.stack(
+        [
+            np.stack([x[:, 4], x[:, 5], x[:, 7]], -1),
+            np.stack([x[:, 5], x[:, 6], x[:, 8]], -1),
+            np.stack([x[:, 7], x[:, 8], x[:, 9]], -1),
+        ],
+        -2,
+    )
     b = h / m[:, None]
     hh = np.einsum("ti,tj->tij", h, h)
     Ic = Io - (np.einsum("ti,ti->t", h, h)[:, None, None] * np.eye(3) - hh) / m[:, None, None]

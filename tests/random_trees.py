@@ -32,16 +32,33 @@ TREE_SEEDS = tuple(range(60))
 
 BASE_TYPES = ("free", "planar", "fixed")
 JOINT_TYPES = ("revolute", "prismatic", "spherical", "cylindrical", "universal", "fixed")
-JOINT_NQ = {"free": 7, "planar": 3, "fixed": 0, "revolute": 1, "prismatic": 1, "spherical": 4, "cylindrical": 2,
-            "universal": 2}
-JOINT_NV = {"free": 6, "planar": 3, "fixed": 0, "revolute": 1, "prismatic": 1, "spherical": 3, "cylindrical": 2,
-            "universal": 2}
+JOINT_NQ = {
+    "free": 7,
+    "planar": 3,
+    "fixed": 0,
+    "revolute": 1,
+    "prismatic": 1,
+    "spherical": 4,
+    "cylindrical": 2,
+    "universal": 2,
+}
+JOINT_NV = {
+    "free": 6,
+    "planar": 3,
+    "fixed": 0,
+    "revolute": 1,
+    "prismatic": 1,
+    "spherical": 3,
+    "cylindrical": 2,
+    "universal": 2,
+}
 INERTIAL_FORMS = ("com", "origin", "params")
 
 
 # --------------------------------------------------------------------------------------------------------------
 # small numpy geometry, independent of Pinocchio
 # --------------------------------------------------------------------------------------------------------------
+
 
 def rot_x(a):
     c, s = math.cos(a), math.sin(a)
@@ -82,11 +99,13 @@ def axis_angle_matrix(axis, angle):
 def quat_to_matrix(qxyzw):
     """Rotation matrix of a quaternion in x, y, z, w order (normalised first)."""
     x, y, z, w = np.asarray(qxyzw, float) / np.linalg.norm(qxyzw)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
 
 
 def skew(v):
@@ -121,8 +140,9 @@ def inertia_about_origin(mass, com, inertia_com):
 def standard_parameters(mass, com, inertia_com):
     """[m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz], inertia about the body origin (Pinocchio order)."""
     Io = inertia_about_origin(mass, com, inertia_com)
-    return np.array([mass, *(mass * np.asarray(com, float)),
-                     Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
+    return np.array(
+        [mass, *(mass * np.asarray(com, float)), Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
+    )
 
 
 def yaml_float(x) -> str:
@@ -152,24 +172,25 @@ def yaml_list(values) -> str:
 # description
 # --------------------------------------------------------------------------------------------------------------
 
+
 @dataclass
 class Body:
     name: str
-    parent: int                      # -1 for the base
-    joint_type: str                  # base: free|planar|fixed; others: revolute|prismatic|spherical|cylindrical|universal|fixed
+    parent: int  # -1 for the base
+    joint_type: str  # base: free|planar|fixed; others: revolute|prismatic|spherical|cylindrical|universal|fixed
     mass: float
-    com: np.ndarray                  # (3,) body frame
-    inertia_com: np.ndarray          # (3,3) about the CoM, body axes
-    inertial_form: str = "com"       # which YAML form renders the inertia (all three must load the same)
-    joint_name: str | None = None    # None: rely on the documented default "<body>_joint"
-    axis: np.ndarray | None = None   # unit axis (revolute/prismatic/cylindrical; universal: the first)
+    com: np.ndarray  # (3,) body frame
+    inertia_com: np.ndarray  # (3,3) about the CoM, body axes
+    inertial_form: str = "com"  # which YAML form renders the inertia (all three must load the same)
+    joint_name: str | None = None  # None: rely on the documented default "<body>_joint"
+    axis: np.ndarray | None = None  # unit axis (revolute/prismatic/cylindrical; universal: the first)
     axis2: np.ndarray | None = None  # universal: second axis (intermediate frame), orthogonal to `axis`
-    axis_scale: float = 1.0          # the YAML file holds axis * scale; the loader must normalise it
-    omit_axis: bool = False          # render without `axis:` (documented default z; used with mdh rows)
-    origin_xyz: np.ndarray | None = None   # None: no `origin` key (identity)
+    axis_scale: float = 1.0  # the YAML file holds axis * scale; the loader must normalise it
+    omit_axis: bool = False  # render without `axis:` (documented default z; used with mdh rows)
+    origin_xyz: np.ndarray | None = None  # None: no `origin` key (identity)
     origin_rpy: np.ndarray | None = None
-    mdh: dict | None = None          # {alpha, a, d, theta}, applied after `origin`
-    limits: dict | None = None       # rendered only; no effect on dynamics
+    mdh: dict | None = None  # {alpha, a, d, theta}, applied after `origin`
+    limits: dict | None = None  # rendered only; no effect on dynamics
 
     @property
     def effective_joint_name(self) -> str:
@@ -182,8 +203,13 @@ class Body:
             T = homogeneous(rpy_to_matrix(self.origin_rpy), self.origin_xyz)
         if self.mdh is not None:
             m = self.mdh
-            T = (T @ homogeneous(rot_x(m["alpha"])) @ homogeneous(p=[m["a"], 0.0, 0.0])
-                 @ homogeneous(rot_z(m["theta"])) @ homogeneous(p=[0.0, 0.0, m["d"]]))
+            T = (
+                T
+                @ homogeneous(rot_x(m["alpha"]))
+                @ homogeneous(p=[m["a"], 0.0, 0.0])
+                @ homogeneous(rot_z(m["theta"]))
+                @ homogeneous(p=[0.0, 0.0, m["d"]])
+            )
         return T
 
     def parameters(self) -> np.ndarray:
@@ -208,9 +234,9 @@ class TreeDescription:
     gravity: np.ndarray
     bodies: list[Body]
     frames: list[Frame] = field(default_factory=list)
-    angles: str = "rad"              # unit used when rendering angles to YAML
-    omit_base_key: bool = False      # render without `base:` (default free) to exercise the default
-    omit_gravity_key: bool = False   # render without `gravity:` (default zero)
+    angles: str = "rad"  # unit used when rendering angles to YAML
+    omit_base_key: bool = False  # render without `base:` (default free) to exercise the default
+    omit_gravity_key: bool = False  # render without `gravity:` (default zero)
 
     # ---- sizes and layout --------------------------------------------------------------------------------
     @property
@@ -250,8 +276,10 @@ class TreeDescription:
 
     def joint_rows(self):
         """(joint name, joint type, q slice, v slice) per body, our layout; the base's name is None."""
-        return [(None if b.parent < 0 else b.effective_joint_name, b.joint_type, qs, vs)
-                for b, qs, vs in zip(self.bodies, self.q_slices(), self.v_slices())]
+        return [
+            (None if b.parent < 0 else b.effective_joint_name, b.joint_type, qs, vs)
+            for b, qs, vs in zip(self.bodies, self.q_slices(), self.v_slices())
+        ]
 
     def total_mass(self) -> float:
         return float(sum(b.mass for b in self.bodies))
@@ -341,10 +369,18 @@ class TreeDescription:
         else:
             key, I = "inertia", b.inertia_com
         # products are tensor entries (Ixy = I[0,1] = -int x y dm), exactly as stored in the matrix
-        tensor = ", ".join(f"{k}: {yaml_float(I[r, c])}" for k, (r, c) in
-                           (("xx", (0, 0)), ("yy", (1, 1)), ("zz", (2, 2)),
-                            ("xy", (0, 1)), ("xz", (0, 2)), ("yz", (1, 2))))
-        return (f"{{mass: {yaml_float(b.mass)}, com: {yaml_list(b.com)}, {key}: {{{tensor}}}}}")
+        tensor = ", ".join(
+            f"{k}: {yaml_float(I[r, c])}"
+            for k, (r, c) in (
+                ("xx", (0, 0)),
+                ("yy", (1, 1)),
+                ("zz", (2, 2)),
+                ("xy", (0, 1)),
+                ("xz", (0, 2)),
+                ("yz", (1, 2)),
+            )
+        )
+        return f"{{mass: {yaml_float(b.mass)}, com: {yaml_list(b.com)}, {key}: {{{tensor}}}}}"
 
     def to_yaml(self) -> str:
         lines = [f"name: {self.name}", "description: random tree generated by tests/random_trees.py"]
@@ -368,20 +404,26 @@ class TreeDescription:
                 if b.limits is not None:
                     lim = b.limits
                     conv = self._angle if b.joint_type == "revolute" else yaml_float
-                    lines.append(f"      limits: {{lower: {conv(lim['lower'])}, upper: {conv(lim['upper'])}, "
-                                 f"velocity: {yaml_float(lim['velocity'])}, effort: {yaml_float(lim['effort'])}}}")
+                    lines.append(
+                        f"      limits: {{lower: {conv(lim['lower'])}, upper: {conv(lim['upper'])}, "
+                        f"velocity: {yaml_float(lim['velocity'])}, effort: {yaml_float(lim['effort'])}}}"
+                    )
                 if b.origin_xyz is not None:
                     lines.append(f"    origin: {{xyz: {yaml_list(b.origin_xyz)}, rpy: {self._angles(b.origin_rpy)}}}")
                 if b.mdh is not None:
                     m = b.mdh
-                    lines.append(f"    mdh: {{alpha: {self._angle(m['alpha'])}, a: {yaml_float(m['a'])}, "
-                                 f"d: {yaml_float(m['d'])}, theta: {self._angle(m['theta'])}}}")
+                    lines.append(
+                        f"    mdh: {{alpha: {self._angle(m['alpha'])}, a: {yaml_float(m['a'])}, "
+                        f"d: {yaml_float(m['d'])}, theta: {self._angle(m['theta'])}}}"
+                    )
             lines.append(f"    inertial: {self._inertial_yaml(b)}")
         if self.frames:
             lines += ["", "frames:"]
             for f in self.frames:
-                lines.append(f"  - {{name: {f.name}, body: {self.bodies[f.body].name}, "
-                             f"origin: {{xyz: {yaml_list(f.xyz)}, rpy: {self._angles(f.rpy)}}}}}")
+                lines.append(
+                    f"  - {{name: {f.name}, body: {self.bodies[f.body].name}, "
+                    f"origin: {{xyz: {yaml_list(f.xyz)}, rpy: {self._angles(f.rpy)}}}}}"
+                )
         return "\n".join(lines) + "\n"
 
     def to_urdf(self, render_seed: int = 0) -> str:
@@ -407,7 +449,8 @@ class TreeDescription:
                 f'  <link name="{b.name}">\n    <inertial>\n      <origin xyz="{vec(b.com)}" rpy="{vec(r)}"/>\n'
                 f'      <mass value="{f(b.mass)}"/>\n      <inertia ixx="{f(Ir[0, 0])}" ixy="{f(Ir[0, 1])}" '
                 f'ixz="{f(Ir[0, 2])}" iyy="{f(Ir[1, 1])}" iyz="{f(Ir[1, 2])}" izz="{f(Ir[2, 2])}"/>\n'
-                f'    </inertial>\n  </link>')
+                f"    </inertial>\n  </link>"
+            )
             if b.parent < 0:
                 continue
             if b.joint_type in ("spherical", "cylindrical", "universal"):
@@ -416,27 +459,37 @@ class TreeDescription:
             jtype = b.joint_type
             if jtype == "revolute" and b.limits is None and rng.random() < 0.5:
                 jtype = "continuous"
-            body = [f'    <parent link="{self.bodies[b.parent].name}"/>', f'    <child link="{b.name}"/>',
-                    f'    <origin xyz="{vec(T[:3, 3])}" rpy="{vec(matrix_to_rpy(T[:3, :3]))}"/>']
+            body = [
+                f'    <parent link="{self.bodies[b.parent].name}"/>',
+                f'    <child link="{b.name}"/>',
+                f'    <origin xyz="{vec(T[:3, 3])}" rpy="{vec(matrix_to_rpy(T[:3, :3]))}"/>',
+            ]
             if b.joint_type in ("revolute", "prismatic"):
                 if not np.array_equal(b.axis, [1.0, 0.0, 0.0]):
                     # unit axis: URDF asks for one, and Pinocchio's parser does not normalise it
                     body.append(f'    <axis xyz="{vec(b.axis)}"/>')
                 if jtype != "continuous":
                     lim = b.limits or {"lower": -3.0, "upper": 3.0, "velocity": 2.0, "effort": 50.0}
-                    body.append(f'    <limit lower="{f(lim["lower"])}" upper="{f(lim["upper"])}" '
-                                f'effort="{f(lim["effort"])}" velocity="{f(lim["velocity"])}"/>')
-            joints.append(f'  <joint name="{b.effective_joint_name}" type="{jtype}">\n' + "\n".join(body)
-                          + "\n  </joint>")
+                    body.append(
+                        f'    <limit lower="{f(lim["lower"])}" upper="{f(lim["upper"])}" '
+                        f'effort="{f(lim["effort"])}" velocity="{f(lim["velocity"])}"/>'
+                    )
+            joints.append(
+                f'  <joint name="{b.effective_joint_name}" type="{jtype}">\n' + "\n".join(body) + "\n  </joint>"
+            )
         elements = links + joints
         order = rng.permutation(len(elements))
-        return (f'<?xml version="1.0"?>\n<robot name="{self.name}">\n'
-                + "\n".join(elements[k] for k in order) + "\n</robot>\n")
+        return (
+            f'<?xml version="1.0"?>\n<robot name="{self.name}">\n'
+            + "\n".join(elements[k] for k in order)
+            + "\n</robot>\n"
+        )
 
 
 # --------------------------------------------------------------------------------------------------------------
 # random generation
 # --------------------------------------------------------------------------------------------------------------
+
 
 def random_inertia(rng, mass_range=(0.1, 50.0)):
     """(mass, com, inertia about the CoM) of a physically consistent rigid body.
@@ -464,8 +517,15 @@ def random_axis(rng):
     return ax / np.linalg.norm(ax)
 
 
-def random_tree(rng, name="random_tree", n_children=None, base=None, gravity=None,
-                joint_types=JOINT_TYPES, joint_p=(0.3, 0.15, 0.1, 0.1, 0.15, 0.2)) -> TreeDescription:
+def random_tree(
+    rng,
+    name="random_tree",
+    n_children=None,
+    base=None,
+    gravity=None,
+    joint_types=JOINT_TYPES,
+    joint_p=(0.3, 0.15, 0.1, 0.1, 0.15, 0.2),
+) -> TreeDescription:
     """A random tree: random base type, 1-20 child joints, random placements, inertias and parents."""
     base = base or str(rng.choice(BASE_TYPES, p=[0.5, 0.25, 0.25]))
     n = int(n_children if n_children is not None else rng.integers(1, 21))
@@ -474,16 +534,32 @@ def random_tree(rng, name="random_tree", n_children=None, base=None, gravity=Non
     gravity = np.asarray(gravity, float)
 
     bm, bc, bI = random_inertia(rng, mass_range=(1.0, 500.0))
-    bodies = [Body(name="base", parent=-1, joint_type=base, mass=bm, com=bc, inertia_com=bI,
-                   inertial_form=str(rng.choice(INERTIAL_FORMS)))]
+    bodies = [
+        Body(
+            name="base",
+            parent=-1,
+            joint_type=base,
+            mass=bm,
+            com=bc,
+            inertia_com=bI,
+            inertial_form=str(rng.choice(INERTIAL_FORMS)),
+        )
+    ]
     for i in range(1, n + 1):
         # half chains, half arbitrary branching
         parent = i - 1 if rng.random() < 0.5 else int(rng.integers(0, i))
         jt = str(rng.choice(joint_types, p=joint_p))
         m, c, I = random_inertia(rng)
-        b = Body(name=f"b{i}", parent=parent, joint_type=jt, mass=m, com=c, inertia_com=I,
-                 inertial_form=str(rng.choice(INERTIAL_FORMS)),
-                 joint_name=f"j{i}" if rng.random() < 0.5 else None)
+        b = Body(
+            name=f"b{i}",
+            parent=parent,
+            joint_type=jt,
+            mass=m,
+            com=c,
+            inertia_com=I,
+            inertial_form=str(rng.choice(INERTIAL_FORMS)),
+            joint_name=f"j{i}" if rng.random() < 0.5 else None,
+        )
         if jt in ("cylindrical", "universal"):
             b.axis = random_axis(rng)
             if jt == "universal":
@@ -501,20 +577,29 @@ def random_tree(rng, name="random_tree", n_children=None, base=None, gravity=Non
                 b.axis_scale = float(rng.uniform(0.3, 3.0))
             if rng.random() < 0.3:
                 lo = float(rng.uniform(-3.0, -0.1))
-                b.limits = {"lower": lo, "upper": float(rng.uniform(0.1, 3.0)),
-                            "velocity": float(rng.uniform(0.5, 5)), "effort": float(rng.uniform(1, 100))}
+                b.limits = {
+                    "lower": lo,
+                    "upper": float(rng.uniform(0.1, 3.0)),
+                    "velocity": float(rng.uniform(0.5, 5)),
+                    "effort": float(rng.uniform(1, 100)),
+                }
         use_mdh = jt in ("revolute", "prismatic") and rng.random() < 0.3
         if use_mdh:
             # MDH rows fix the joint axis to z; omit it half the time to exercise the default
             b.axis = np.array([0.0, 0.0, 1.0])
             b.axis_scale = 1.0
             b.omit_axis = bool(rng.random() < 0.5)
-            b.mdh = {"alpha": float(rng.uniform(-math.pi, math.pi)), "a": float(rng.uniform(-1, 1)),
-                     "d": float(rng.uniform(-1, 1)), "theta": float(rng.uniform(-math.pi, math.pi))}
+            b.mdh = {
+                "alpha": float(rng.uniform(-math.pi, math.pi)),
+                "a": float(rng.uniform(-1, 1)),
+                "d": float(rng.uniform(-1, 1)),
+                "theta": float(rng.uniform(-math.pi, math.pi)),
+            }
         if not use_mdh or rng.random() < 0.5:
             b.origin_xyz = rng.uniform(-1.0, 1.0, 3)
-            b.origin_rpy = np.array([rng.uniform(-math.pi, math.pi), rng.uniform(-math.pi / 2, math.pi / 2),
-                                     rng.uniform(-math.pi, math.pi)])
+            b.origin_rpy = np.array(
+                [rng.uniform(-math.pi, math.pi), rng.uniform(-math.pi / 2, math.pi / 2), rng.uniform(-math.pi, math.pi)]
+            )
         bodies.append(b)
 
     # a tree whose every joint is fixed on a fixed base has nv = 0; make sure something moves
@@ -528,11 +613,21 @@ def random_tree(rng, name="random_tree", n_children=None, base=None, gravity=Non
 
     frames = []
     for k in range(int(rng.integers(0, 4))):
-        frames.append(Frame(name=f"f{k}", body=int(rng.integers(0, len(bodies))),
-                            xyz=rng.uniform(-1, 1, 3), rpy=rng.uniform(-1.5, 1.5, 3)))
+        frames.append(
+            Frame(
+                name=f"f{k}",
+                body=int(rng.integers(0, len(bodies))),
+                xyz=rng.uniform(-1, 1, 3),
+                rpy=rng.uniform(-1.5, 1.5, 3),
+            )
+        )
 
     return TreeDescription(
-        name=name, base=base, gravity=gravity, bodies=bodies, frames=frames,
+        name=name,
+        base=base,
+        gravity=gravity,
+        bodies=bodies,
+        frames=frames,
         angles="deg" if rng.random() < 0.2 else "rad",
         omit_base_key=(base == "free" and rng.random() < 0.3),
         omit_gravity_key=(not np.any(gravity) and rng.random() < 0.5),
@@ -550,8 +645,14 @@ URDF_TREE_SEEDS = tuple(range(100, 120))
 def urdf_tree_from_seed(seed: int, base: str = "free") -> TreeDescription:
     """A tree for URDF rendering; `base` is how it will be loaded (it does not change the URDF text)."""
     rng = np.random.default_rng(seed)
-    d = random_tree(rng, name=f"random_urdf_{seed}", base="free", gravity=np.zeros(3),
-                    joint_types=("revolute", "prismatic", "fixed"), joint_p=(0.55, 0.2, 0.25))
+    d = random_tree(
+        rng,
+        name=f"random_urdf_{seed}",
+        base="free",
+        gravity=np.zeros(3),
+        joint_types=("revolute", "prismatic", "fixed"),
+        joint_p=(0.55, 0.2, 0.25),
+    )
     d.base = d.bodies[0].joint_type = base
     d.frames = []
     for b in d.bodies[1:]:
@@ -565,8 +666,10 @@ def urdf_tree_from_seed(seed: int, base: str = "free") -> TreeDescription:
 # Pinocchio model built from the description
 # --------------------------------------------------------------------------------------------------------------
 
+
 def _se3(T):
     import pinocchio as pin
+
     return pin.SE3(np.array(T[:3, :3]), np.array(T[:3, 3]))
 
 
@@ -596,14 +699,15 @@ class PinTree:
     Our layout: joints body by body in file order.  Pinocchio's: joints in depth-first order (see
     `depth_first_order`), planar base as x, y, cos, sin.  Every method below takes and returns our layout.
     """
+
     desc: TreeDescription
     model: object
     data: object
-    joint_of_body: list[int]       # Pinocchio joint carrying each body (0 = universe for fixed-base welds)
-    body_in_joint: list[object]    # pin.SE3 placement of each body frame in that joint's frame
-    frame_id: dict[str, int]       # body name or frame name -> Pinocchio frame id
+    joint_of_body: list[int]  # Pinocchio joint carrying each body (0 = universe for fixed-base welds)
+    body_in_joint: list[object]  # pin.SE3 placement of each body frame in that joint's frame
+    frame_id: dict[str, int]  # body name or frame name -> Pinocchio frame id
     pin_q_slice: list[slice | None]  # per body: its joint's slice of Pinocchio's q (None: no joint of its own)
-    v_perm: np.ndarray             # v_pin = v_ours[v_perm]
+    v_perm: np.ndarray  # v_pin = v_ours[v_perm]
 
     # ---- layout maps -------------------------------------------------------------------------------------
     def q_to_pin(self, q) -> np.ndarray:
@@ -658,6 +762,7 @@ class PinTree:
         the universe (fixed base) do nothing, in Pinocchio as in reality.
         """
         import pinocchio as pin
+
         out = [pin.Force.Zero() for _ in range(self.model.njoints)]
         if fext is None:
             return out
@@ -670,6 +775,7 @@ class PinTree:
     # ---- oracle quantities, all in our layout --------------------------------------------------------------
     def aba(self, q, v, tau, fext=None):
         import pinocchio as pin
+
         args = [self.model, self.data, self.q_to_pin(q), self.v_to_pin(v), self.v_to_pin(tau)]
         if fext is not None:
             args.append(self.fext_to_pin(fext))
@@ -677,6 +783,7 @@ class PinTree:
 
     def rnea(self, q, v, a, fext=None):
         import pinocchio as pin
+
         args = [self.model, self.data, self.q_to_pin(q), self.v_to_pin(v), self.v_to_pin(a)]
         if fext is not None:
             args.append(self.fext_to_pin(fext))
@@ -684,6 +791,7 @@ class PinTree:
 
     def crba(self, q):
         import pinocchio as pin
+
         M = np.array(pin.crba(self.model, self.data, self.q_to_pin(q)), float).reshape(self.model.nv, self.model.nv)
         # pin 4 returns the full matrix; symmetrise anyway in case a version fills only the upper triangle
         M = np.triu(M) + np.triu(M, 1).T
@@ -691,6 +799,7 @@ class PinTree:
 
     def nonlinear_effects(self, q, v):
         import pinocchio as pin
+
         return self.v_from_pin(pin.nonLinearEffects(self.model, self.data, self.q_to_pin(q), self.v_to_pin(v)))
 
     def center_of_mass(self, q):
@@ -705,6 +814,7 @@ class PinTree:
     def forward_kinematics(self, q):
         """(nbodies, 7): position and quaternion xyzw of each body frame in the world."""
         import pinocchio as pin
+
         pin.framesForwardKinematics(self.model, self.data, self.q_to_pin(q))
         out = np.zeros((self.desc.nbodies, 7))
         for i, b in enumerate(self.desc.bodies):
@@ -715,11 +825,13 @@ class PinTree:
 
     def placement(self, q, name) -> np.ndarray:
         import pinocchio as pin
+
         pin.framesForwardKinematics(self.model, self.data, self.q_to_pin(q))
         return self.data.oMf[self.frame_id[name]].homogeneous.copy()
 
     def frame_jacobian(self, q, name, reference="local"):
         import pinocchio as pin
+
         rf = {"local": pin.LOCAL, "world": pin.LOCAL_WORLD_ALIGNED}[reference]
         J = pin.computeFrameJacobian(self.model, self.data, self.q_to_pin(q), self.frame_id[name], rf)
         return self.cols_from_pin(J)
@@ -727,6 +839,7 @@ class PinTree:
     def frame_velocity_local(self, q, v, name):
         """Twist [linear; angular] of a frame, in its own axes (used by the self-checks)."""
         import pinocchio as pin
+
         pin.forwardKinematics(self.model, self.data, self.q_to_pin(q), self.v_to_pin(v))
         pin.updateFramePlacements(self.model, self.data)
         return pin.getFrameVelocity(self.model, self.data, self.frame_id[name], pin.LOCAL).vector.copy()
@@ -789,7 +902,8 @@ def build_pinocchio(desc: TreeDescription) -> PinTree:
         j = joint_of_body[f.body]
         X = body_in_joint[f.body] * _se3(f.placement())
         frame_id[f.name] = model.addFrame(
-            pin.Frame(f.name, j, frame_id[desc.bodies[f.body].name], X, pin.FrameType.OP_FRAME), False)
+            pin.Frame(f.name, j, frame_id[desc.bodies[f.body].name], X, pin.FrameType.OP_FRAME), False
+        )
 
     # layout maps: a body owns a Pinocchio joint iff its own joint moves
     pin_q_slice: list[slice | None] = []
@@ -800,17 +914,25 @@ def build_pinocchio(desc: TreeDescription) -> PinTree:
             continue
         jm = model.joints[jid]
         pin_q_slice.append(slice(jm.idx_q, jm.idx_q + jm.nq))
-        v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
+        v_perm[jm.idx_v : jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
 
-    return PinTree(desc=desc, model=model, data=model.createData(), joint_of_body=joint_of_body,
-                   body_in_joint=body_in_joint, frame_id=frame_id, pin_q_slice=pin_q_slice, v_perm=v_perm)
+    return PinTree(
+        desc=desc,
+        model=model,
+        data=model.createData(),
+        joint_of_body=joint_of_body,
+        body_in_joint=body_in_joint,
+        frame_id=frame_id,
+        pin_q_slice=pin_q_slice,
+        v_perm=v_perm,
+    )
 
 
 def ff_joint_rows(m):
     """`TreeDescription.joint_rows()` for a freefloat model: (joint name, type, q slice, v slice) per body."""
     types = list(m.joint_types)
     names = list(m.joint_names)
-    names = [None] + names[len(names) - (len(types) - 1):]  # with or without a base entry
+    names = [None] + names[len(names) - (len(types) - 1) :]  # with or without a base entry
     rows, q0, v0 = [], 0, 0
     for name, t in zip(names, types):
         qs, vs = slice(q0, q0 + JOINT_NQ[t]), slice(v0, v0 + JOINT_NV[t])
@@ -840,11 +962,11 @@ class NamedLayout:
         self.v_perm = np.zeros(nv, dtype=int)  # v_pin = v_ours[v_perm]
         if self.base != "fixed":
             jm = model.joints[1]
-            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(self.base_v.start, self.base_v.stop)
+            self.v_perm[jm.idx_v : jm.idx_v + jm.nv] = np.arange(self.base_v.start, self.base_v.stop)
         for name, t, _qs, vs in moving:
             jm = model.joints[self.pin_joint[name]]
             assert jm.nv == JOINT_NV[t], f"{name}: nv {jm.nv} in Pinocchio vs {JOINT_NV[t]} ({t})"
-            self.v_perm[jm.idx_v:jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
+            self.v_perm[jm.idx_v : jm.idx_v + jm.nv] = np.arange(vs.start, vs.stop)
         assert sorted(self.v_perm) == list(range(nv))
 
     def q_to_pin(self, q) -> np.ndarray:
@@ -860,9 +982,9 @@ class NamedLayout:
                 continue
             jm = self.model.joints[self.pin_joint[name]]
             if jm.nq == 2 and jm.nv == 1:  # unbounded revolute: cos, sin
-                qp[jm.idx_q:jm.idx_q + 2] = [math.cos(q[qs][0]), math.sin(q[qs][0])]
+                qp[jm.idx_q : jm.idx_q + 2] = [math.cos(q[qs][0]), math.sin(q[qs][0])]
             else:
-                qp[jm.idx_q:jm.idx_q + jm.nq] = q[qs]
+                qp[jm.idx_q : jm.idx_q + jm.nq] = q[qs]
         return qp
 
     def v_to_pin(self, v) -> np.ndarray:
@@ -888,6 +1010,7 @@ class NamedLayout:
     def body_frame(self, name):
         """(frame id, carrying joint, placement in that joint) of a URDF link's Pinocchio BODY frame."""
         import pinocchio as pin
+
         assert self.model.existFrame(name, pin.FrameType.BODY), f"no Pinocchio BODY frame named {name!r}"
         fid = self.model.getFrameId(name, pin.FrameType.BODY)
         f = self.model.frames[fid]
@@ -895,6 +1018,7 @@ class NamedLayout:
 
     def fext_to_pin(self, body_names, fext):
         import pinocchio as pin
+
         out = [pin.Force.Zero() for _ in range(self.model.njoints)]
         for name, f in zip(body_names, np.asarray(fext, float)):
             _, j, X = self.body_frame(name)
@@ -905,6 +1029,7 @@ class NamedLayout:
 def urdf_depth_first_joint_order(urdf_text) -> list[str]:
     """Moving joints depth-first from the root link, children in document order."""
     import xml.etree.ElementTree as ET
+
     root = ET.fromstring(urdf_text)
     joints = root.findall("joint")
     children: dict[str, list] = {}
@@ -931,6 +1056,7 @@ def urdf_depth_first_joint_order(urdf_text) -> list[str]:
 def urdf_total_mass(urdf_text) -> float:
     """Total mass read straight from URDF text."""
     import xml.etree.ElementTree as ET
+
     root = ET.fromstring(urdf_text)
     return float(sum(float(m.get("value")) for m in root.findall("link/inertial/mass")))
 
@@ -938,6 +1064,7 @@ def urdf_total_mass(urdf_text) -> float:
 # --------------------------------------------------------------------------------------------------------------
 # Pinocchio helpers shared by the random-tree and the URDF tests (Pinocchio q/v layout)
 # --------------------------------------------------------------------------------------------------------------
+
 
 def pin_total_mass(model) -> float:
     """Mass of every body, including bodies welded to the universe (which pin.centerOfMass leaves out)."""
@@ -948,6 +1075,7 @@ def pin_center_of_mass(model, data, qp) -> np.ndarray:
     """Whole-system CoM.  pin.centerOfMass skips model.inertias[0] (the universe), where a fixed base and the
     bodies welded to it live, so add that part back (the universe frame is the world frame)."""
     import pinocchio as pin
+
     c_moving = pin.centerOfMass(model, data, qp).copy()
     m_moving = float(data.mass[0])
     Y0 = model.inertias[0]
@@ -961,6 +1089,7 @@ def pin_momentum_at_origin(model, data, qp, vp) -> np.ndarray:
     bodies, world axes); shift it with L_O = L_G + c x p.  Welded bodies do not move, so using the moving-body
     CoM that Pinocchio used is exactly right."""
     import pinocchio as pin
+
     hg = pin.computeCentroidalMomentum(model, data, qp, vp)
     c = data.com[0].copy()
     p = hg.linear.copy()
@@ -970,6 +1099,7 @@ def pin_momentum_at_origin(model, data, qp, vp) -> np.ndarray:
 def pin_momentum_matrix_at_origin(model, data, qp) -> np.ndarray:
     """A_O with [p; L_O] = A_O v, from Pinocchio's centroidal map A_G (same shift as above, row-wise)."""
     import pinocchio as pin
+
     Ag = np.array(pin.ccrba(model, data, qp, np.zeros(model.nv)), float).reshape(6, model.nv)
     c = data.com[0].copy()
     return np.vstack([Ag[:3], Ag[3:] + skew(c) @ Ag[:3]])
@@ -978,6 +1108,7 @@ def pin_momentum_matrix_at_origin(model, data, qp) -> np.ndarray:
 # --------------------------------------------------------------------------------------------------------------
 # comparison helper
 # --------------------------------------------------------------------------------------------------------------
+
 
 def assert_close(actual, expected, rtol=1e-9, atol=1e-12, what=""):
     """Norm-relative comparison: |actual - expected| <= rtol |expected| + atol (Frobenius norms).
@@ -993,4 +1124,5 @@ def assert_close(actual, expected, rtol=1e-9, atol=1e-12, what=""):
     ref = float(np.linalg.norm(e))
     assert err <= rtol * ref + atol, (
         f"{what}: |actual - expected| = {err:.3e} > {rtol:g} * |expected| ({ref:.3e}) + {atol:g}\n"
-        f"actual=\n{a}\nexpected=\n{e}")
+        f"actual=\n{a}\nexpected=\n{e}"
+    )

@@ -33,7 +33,12 @@ def test_good_files_load():
     # [m, m c, I about the body origin]: the CoM inertia (0.01, 0.1, 0.1) moved by 0.5 m along x (parallel axes)
     np.testing.assert_allclose(m.parameters()[1], [1, 0.5, 0, 0, 0.01, 0, 0.35, 0, 0, 0.35], rtol=0, atol=1e-15)
     u = ff.Model.from_urdf_string(URDF)
-    assert (u.name, u.body_names, u.joint_names, u.joint_types) == ("r", ["base", "arm"], ["root_joint", "j1"], ["free", "revolute"])
+    assert (u.name, u.body_names, u.joint_names, u.joint_types) == (
+        "r",
+        ["base", "arm"],
+        ["root_joint", "j1"],
+        ["free", "revolute"],
+    )
     assert u.total_mass == 11.0
     np.testing.assert_allclose(u.parameters()[1], [1, 0, 0, 0, 0.1, 0, 0.1, 0, 0, 0.1], rtol=0, atol=1e-15)
 
@@ -55,11 +60,14 @@ def test_yaml_unknown_parent_and_key():
         ff.Model.from_yaml_string(GOOD_YAML.replace("    parent: base", "    colour: red\n    parent: base"))
 
 
-@pytest.mark.parametrize("inertial,msg", [
-    ("{mass: -1, inertia: [1, 1, 1]}", "negative"),
-    ("{mass: 1, inertia: [1, 1, 3]}", "triangle"),
-    ("{mass: 1, inertia: {xx: 1, yy: 1, zz: 1, xy: 2}}", "positive semi-definite"),
-])
+@pytest.mark.parametrize(
+    "inertial,msg",
+    [
+        ("{mass: -1, inertia: [1, 1, 1]}", "negative"),
+        ("{mass: 1, inertia: [1, 1, 3]}", "triangle"),
+        ("{mass: 1, inertia: {xx: 1, yy: 1, zz: 1, xy: 2}}", "positive semi-definite"),
+    ],
+)
 def test_nonphysical_inertia_is_rejected(inertial, msg):
     text = GOOD_YAML.replace("{mass: 1, com: [0.5, 0, 0], inertia: [0.01, 0.1, 0.1]}", inertial)
     with pytest.raises(ff.ModelError, match=f"'arm'.*{msg}"):
@@ -72,13 +80,16 @@ def test_massless_moving_subtree_is_rejected():
         ff.Model.from_yaml_string(text)
 
 
-@pytest.mark.parametrize("edit,msg", [
-    (lambda s: s.replace('<child link="arm"/>', '<child link="ghost"/>'), r"line 5.*'j1'.*'ghost'"),
-    (lambda s: s.replace('type="revolute"', 'type="screw"'), r"line 5.*unknown joint type 'screw'"),
-    (lambda s: s.replace("</robot>", ""), "not well-formed XML"),
-    (lambda s: s.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 x"/>'), "three finite numbers"),
-    (lambda s: s.replace('<mass value="1"/>', '<mass value="-1"/>'), r"line 4.*'arm'.*negative"),
-])
+@pytest.mark.parametrize(
+    "edit,msg",
+    [
+        (lambda s: s.replace('<child link="arm"/>', '<child link="ghost"/>'), r"line 5.*'j1'.*'ghost'"),
+        (lambda s: s.replace('type="revolute"', 'type="screw"'), r"line 5.*unknown joint type 'screw'"),
+        (lambda s: s.replace("</robot>", ""), "not well-formed XML"),
+        (lambda s: s.replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 x"/>'), "three finite numbers"),
+        (lambda s: s.replace('<mass value="1"/>', '<mass value="-1"/>'), r"line 4.*'arm'.*negative"),
+    ],
+)
 def test_malformed_urdf(edit, msg):
     with pytest.raises(ff.ModelError, match=msg):
         ff.Model.from_urdf_string(edit(URDF))
@@ -172,21 +183,25 @@ def test_simulation_bad_input_and_callback_errors():
         ff.simulate(m, q, v, 1.0, 1e-3, torques=np.zeros((3, m.nv)), torque_times=[0.0, 0.0, 1.0])
 
 
-@pytest.mark.parametrize("joint, msg", [
-    ("{type: universal, axis: [1, 0, 0]}", "needs `axis2`"),
-    ("{type: universal, axis: [1, 0, 0], axis2: [1, 1, 0]}", "must be orthogonal"),
-    ("{type: universal, axis: [1, 0, 0], axis2: [0, 0, 0]}", "zero length"),
-    ("{type: revolute, axis: [1, 0, 0], axis2: [0, 1, 0]}", "only meaningful for a universal joint"),
-    ("{type: cylindrical, axis: [0, 0, 0]}", "zero length"),
-])
+@pytest.mark.parametrize(
+    "joint, msg",
+    [
+        ("{type: universal, axis: [1, 0, 0]}", "needs `axis2`"),
+        ("{type: universal, axis: [1, 0, 0], axis2: [1, 1, 0]}", "must be orthogonal"),
+        ("{type: universal, axis: [1, 0, 0], axis2: [0, 0, 0]}", "zero length"),
+        ("{type: revolute, axis: [1, 0, 0], axis2: [0, 1, 0]}", "only meaningful for a universal joint"),
+        ("{type: cylindrical, axis: [0, 0, 0]}", "zero length"),
+    ],
+)
 def test_cylindrical_and_universal_joint_errors(joint, msg):
     with pytest.raises(ff.ModelError, match=msg) as e:
         ff.Model.from_yaml_string(GOOD_YAML.replace("{type: revolute, axis: [0, 0, 1]}", joint))
     assert "arm" in str(e.value)
 
 
-@pytest.mark.parametrize("joint", ["{type: cylindrical, axis: [0, 0, 1]}",
-                                   "{type: universal, axis: [1, 0, 0], axis2: [0, 1, 0]}"])
+@pytest.mark.parametrize(
+    "joint", ["{type: cylindrical, axis: [0, 0, 1]}", "{type: universal, axis: [1, 0, 0], axis2: [0, 1, 0]}"]
+)
 def test_urdf_has_no_cylindrical_or_universal_joint(joint):
     m = ff.Model.from_yaml_string(GOOD_YAML.replace("{type: revolute, axis: [0, 0, 1]}", joint))
     with pytest.raises(ff.ModelError, match="URDF has no such joint type"):

@@ -17,7 +17,23 @@ def run(*args, ok=True):
     return r
 
 
-@pytest.mark.parametrize("cmd", [[], ["models"], ["simulate"], ["demo"], ["identify"], ["identify", "minimal"], ["params"], ["params", "minimal"], ["excite"], ["reactions"], ["scenarios"], ["identify", "postcapture"]])
+@pytest.mark.parametrize(
+    "cmd",
+    [
+        [],
+        ["models"],
+        ["simulate"],
+        ["demo"],
+        ["identify"],
+        ["identify", "minimal"],
+        ["params"],
+        ["params", "minimal"],
+        ["excite"],
+        ["reactions"],
+        ["scenarios"],
+        ["identify", "postcapture"],
+    ],
+)
 def test_every_command_has_help(cmd):
     r = run(*cmd, "--help")
     assert "Usage:" in r.stdout and len(r.stdout) > 200
@@ -86,8 +102,20 @@ def test_identify_minimal_from_a_simulation_and_from_a_file(tmp_path):
 
 @pytest.mark.slow
 def test_identify_minimal_full_urdf_and_weights(tmp_path):
-    r = run("identify", "minimal", "naveen_dual_arm_consistent", "--simulate", "16", "--weights", "auto", "--full",
-            "--prior", "naveen_dual_arm_offset", "--out", str(tmp_path))
+    r = run(
+        "identify",
+        "minimal",
+        "naveen_dual_arm_consistent",
+        "--simulate",
+        "16",
+        "--weights",
+        "auto",
+        "--full",
+        "--prior",
+        "naveen_dual_arm_offset",
+        "--out",
+        str(tmp_path),
+    )
     assert "physically consistent" in r.stdout
     res = json.loads((tmp_path / "results.json").read_text())
     assert res["consistent"]["max_rel_deviation"] < 1e-5
@@ -107,8 +135,15 @@ def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert 0 < res["n_kept"] < 256 and len(res["kept_intervals"]) == res["n_kept"]
     assert (tmp_path / "fig4.png").stat().st_size > 10_000
-    r2 = run("identify", "minimal", "naveen_dual_arm", "--trajectory", str(tmp_path / "trajectory.json"),
-             "--out", str(tmp_path / "id"))
+    r2 = run(
+        "identify",
+        "minimal",
+        "naveen_dual_arm",
+        "--trajectory",
+        str(tmp_path / "trajectory.json"),
+        "--out",
+        str(tmp_path / "id"),
+    )
     assert "simulating naveen_dual_arm along" in r2.stdout
     ident = json.loads((tmp_path / "id" / "results.json").read_text())
     assert ident["median_rel_error_pct"] < 1.0 and "bias compensation" in ident["solver"]

@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 
 import freefloat as ff
-from freefloat.identification import identify as idf
+from freefloat import quat_to_matrix
 from freefloat import telemetry as tm
 from freefloat import trajectories as tr
-from freefloat import quat_to_matrix
+from freefloat.identification import identify as idf
 from freefloat.identification.consistent import consistent_parameters, is_consistent, pseudo_inertia
 from freefloat.identification.validation import default_fourier, predict
 
@@ -89,7 +89,7 @@ def test_prediction_of_the_same_robot_is_exact_and_of_a_representative_nearly(co
     rep = consistent_parameters(mp, mp.from_standard(m.parameters()), prior=prior).model(m)
     p = predict(m, rep, dt=5e-3)
     assert p.rms_twist.max() < 1e-8
-    assert p.rms_torque.max() < 1e-6 * np.sqrt(np.mean(p.tau_true ** 2))
+    assert p.rms_torque.max() < 1e-6 * np.sqrt(np.mean(p.tau_true**2))
     # The prior alone (Table 2 "offset") predicts badly: the test can tell good from bad parameters.
     bad = predict(m, prior, dt=5e-3)
     assert bad.rms_twist.max() > 1e-4 and bad.rms_torque.max() > 0.1
@@ -145,8 +145,15 @@ def thrust_run():
     R, p = quat_to_matrix(traj.q[:, 3:7]), traj.q[:, :3]
     f = np.einsum("tij,tj->ti", R, traj.tau[:, :3])
     mo = np.cross(p, f) + np.einsum("tij,tj->ti", R, traj.tau[:, 3:6])  # moment about the inertial origin
-    telem = tm.Telemetry(t=traj.t, q=traj.q, v=traj.v, model_name=m.name, q_labels=m.q_labels(),
-                         v_labels=m.v_labels(), wrench=np.hstack([f, mo]))
+    telem = tm.Telemetry(
+        t=traj.t,
+        q=traj.q,
+        v=traj.v,
+        model_name=m.name,
+        q_labels=m.q_labels(),
+        v_labels=m.v_labels(),
+        wrench=np.hstack([f, mo]),
+    )
     return m, traj, telem
 
 
@@ -211,7 +218,7 @@ def test_bias_compensation_removes_the_errors_in_variables_bias():
     ls = ff.identify_minimal(m, telem)
     bc = ff.identify_minimal(m, telem, rate_noise=(tm.SIGMA_LIN, tm.SIGMA_ANG, tm.SIGMA_JOINT))
     rel_ls, rel_bc = (ls.estimate - truth) / truth, (bc.estimate - truth) / truth
-    assert np.median(rel_ls) < -2e-4                      # the bias is there, and it is a shrinkage
+    assert np.median(rel_ls) < -2e-4  # the bias is there, and it is a shrinkage
     assert abs(np.median(rel_bc)) < 0.3 * abs(np.median(rel_ls))
     assert np.median(np.abs(rel_bc)) < 0.5 * np.median(np.abs(rel_ls))
     z_ls = np.sqrt(np.mean(((ls.estimate - truth) / ls.std) ** 2))

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import freefloat as ff
+
 import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 
 try:  # only the tests that compare with Pinocchio need it
@@ -29,6 +30,7 @@ RNG = np.random.default_rng(4)
 # ---------------------------------------------------------------------------------------------------------
 # independent numpy quaternion algebra (scalar first)
 # ---------------------------------------------------------------------------------------------------------
+
 
 def qmul(a, b):
     a0, av, b0, bv = a[0], a[1:], b[0], b[1:]
@@ -60,6 +62,7 @@ def as_pin(qxyzw, t):
 # ---------------------------------------------------------------------------------------------------------
 # algebra
 # ---------------------------------------------------------------------------------------------------------
+
 
 def test_from_pose_layout_and_round_trip():
     for _ in range(50):
@@ -99,7 +102,7 @@ def test_operators_match_numpy_definitions():
         a, b = RNG.normal(size=8), RNG.normal(size=8)
         A, B = ff.dq.DualQuaternion(a), ff.dq.DualQuaternion(b)
         np.testing.assert_allclose(np.asarray(A * B), dqmul(a, b), atol=1e-13)
-        np.testing.assert_allclose(np.asarray(A * b), dqmul(a, b), atol=1e-13)   # array operands
+        np.testing.assert_allclose(np.asarray(A * b), dqmul(a, b), atol=1e-13)  # array operands
         np.testing.assert_allclose(np.asarray(b * A), dqmul(b, a), atol=1e-13)
         np.testing.assert_allclose(np.asarray(2.0 * A), 2 * a)
         np.testing.assert_allclose(np.asarray(A + B), a + b)
@@ -111,8 +114,9 @@ def test_operators_match_numpy_definitions():
         assert A.norm() == pytest.approx(np.linalg.norm(a), rel=1e-14)
         # Table 2.4: dot = (a*b + b*a)/2, cross = (ab - b*a*)/2
         np.testing.assert_allclose(np.asarray(A.dot(B)), 0.5 * (dqmul(dqconj(a), b) + dqmul(dqconj(b), a)), atol=1e-13)
-        np.testing.assert_allclose(np.asarray(A.cross(B)),
-                                   0.5 * (dqmul(a, b) - dqmul(dqconj(b), dqconj(a))), atol=1e-13)
+        np.testing.assert_allclose(
+            np.asarray(A.cross(B)), 0.5 * (dqmul(a, b) - dqmul(dqconj(b), dqconj(a))), atol=1e-13
+        )
         np.testing.assert_allclose(A.left_matrix() @ b, dqmul(a, b), atol=1e-13)
         np.testing.assert_allclose(B.right_matrix() @ a, dqmul(a, b), atol=1e-13)
         np.testing.assert_allclose(np.asarray(A * A.inverse()), [1, 0, 0, 0, 0, 0, 0, 0], atol=1e-10)
@@ -149,12 +153,15 @@ def test_exp_log_screw_dh_reference_values():
     np.testing.assert_allclose(l, [0, 0, 1], atol=1e-15)
     np.testing.assert_allclose(m, [0, -1, 0], atol=1e-15)
     np.testing.assert_allclose(np.asarray(ff.dq.exp(s.log())), np.asarray(s), atol=1e-14)
-    np.testing.assert_allclose(np.asarray(ff.dq.dh(0.3, 0.8, 1.2, -0.6)),
-                               [0.87992318, -0.27219214, -0.11508099, 0.37202555,
-                                0.10751145, 0.54521605, 0.18238651, 0.20103707], atol=1e-8)
+    np.testing.assert_allclose(
+        np.asarray(ff.dq.dh(0.3, 0.8, 1.2, -0.6)),
+        [0.87992318, -0.27219214, -0.11508099, 0.37202555, 0.10751145, 0.54521605, 0.18238651, 0.20103707],
+        atol=1e-8,
+    )
     rows = [[0.3, 0.4, 0.5, 1.2], [-0.2, -1.0, 0.9, -0.7]]
-    np.testing.assert_allclose(np.asarray(ff.dq.dh_chain(rows)),
-                               np.asarray(ff.dq.dh(*rows[0]) * ff.dq.dh(*rows[1])), atol=1e-15)
+    np.testing.assert_allclose(
+        np.asarray(ff.dq.dh_chain(rows)), np.asarray(ff.dq.dh(*rows[0]) * ff.dq.dh(*rows[1])), atol=1e-15
+    )
     # normalisation (2.30) and properisation (2.31)
     noisy = ff.dq.DualQuaternion(np.asarray(s) + 1e-3 * RNG.normal(size=8))
     assert not noisy.is_unit() and noisy.normalized().is_unit()
@@ -180,7 +187,7 @@ def test_body_poses_match_engine_fk():
 def test_constraints_line_of_sight_sign():
     # target A straight ahead of the gripper along y_G: feasible (value <= 0); behind: infeasible
     y = np.array([0.0, 1.0, 0.0])
-    g_ahead = ff.dq.from_pose([0, 0, 0, 1], [0.0, -2.0, 0.0])   # G at -2 y_A: A is at +2 y_G from G
+    g_ahead = ff.dq.from_pose([0, 0, 0, 1], [0.0, -2.0, 0.0])  # G at -2 y_A: A is at +2 y_G from G
     g_behind = ff.dq.from_pose([0, 0, 0, 1], [0.0, 2.0, 0.0])
     v1, g1 = ff.dq.line_of_sight(g_ahead, y, 0.3)
     v2, _ = ff.dq.line_of_sight(g_behind, y, 0.3)
@@ -219,6 +226,7 @@ def test_bad_input_names_the_argument():
 # dynamics
 # ---------------------------------------------------------------------------------------------------------
 
+
 def _spatial_inertia(p):
     """6x6 [lin; ang] spatial inertia about the body origin from [m, mc, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]."""
     m, h = p[0], np.asarray(p[1:4])
@@ -256,8 +264,9 @@ def _legacy_trees():
     tree at 1e-10 by `test_dq_dynamics_with_cylindrical_and_universal_joints`."""
     old = ("revolute", "prismatic", "spherical", "fixed")
     for seed in rt.TREE_SEEDS[:40]:
-        d = rt.random_tree(np.random.default_rng(seed), name=f"random_tree_{seed}", joint_types=old,
-                           joint_p=(0.4, 0.2, 0.2, 0.2))
+        d = rt.random_tree(
+            np.random.default_rng(seed), name=f"random_tree_{seed}", joint_types=old, joint_p=(0.4, 0.2, 0.2, 0.2)
+        )
         if d.base == "planar":
             continue
         yield seed, d
@@ -315,8 +324,7 @@ def test_dq_dynamics_locked_and_batches():
         desc.base = desc.bodies[0].joint_type = "free"
     m = ff.Model.from_yaml_string(desc.to_yaml())
     rng = np.random.default_rng(0)
-    moving = [desc.bodies[i].effective_joint_name for i in range(1, m.nbodies)
-              if desc.bodies[i].joint_type != "fixed"]
+    moving = [desc.bodies[i].effective_joint_name for i in range(1, m.nbodies) if desc.bodies[i].joint_type != "fixed"]
     Q = np.stack([desc.random_q(rng) for _ in range(3)])
     Vv = np.stack([desc.random_v(rng) for _ in range(3)])
     T = rng.normal(size=(3, m.nv))
@@ -362,8 +370,23 @@ def test_reactions_along_a_trajectory_and_cli(tmp_path):
         a = axes[i] / np.linalg.norm(axes[i])
         assert np.abs(r.reaction[:, i, 3:] @ a).max() < 1e-9
         np.testing.assert_allclose(r.wrench[:, i, 3:] @ a, traj.tau[:, m.idx_v[i]], atol=1e-9)
-    out = subprocess.run([sys.executable, "-m", "freefloat", "reactions", "valverde_ch5_single_arm", "--t-final", "0.2",
-                          "--record-every", "20", "--out", str(tmp_path)], capture_output=True, text=True)
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "freefloat",
+            "reactions",
+            "valverde_ch5_single_arm",
+            "--t-final",
+            "0.2",
+            "--record-every",
+            "20",
+            "--out",
+            str(tmp_path),
+        ],
+        capture_output=True,
+        text=True,
+    )
     assert out.returncode == 0, out.stderr
     assert "peak" in out.stdout and (tmp_path / "reactions.png").exists()
     res = json.loads((tmp_path / "results.json").read_text())
@@ -386,8 +409,9 @@ def test_simulate_with_the_dq_formulation():
     presc = ["J2"]
     pres = lambda t: (m.neutral(), np.zeros(m.nv), np.full(m.nv, 0.2))  # noqa: E731
     c = ff.simulate(m, m.neutral(), v0, 0.3, 1e-3, prescribed=presc, prescription=pres, record_every=50)
-    d = ff.simulate(m, m.neutral(), v0, 0.3, 1e-3, prescribed=presc, prescription=pres, record_every=50,
-                    formulation="dq")
+    d = ff.simulate(
+        m, m.neutral(), v0, 0.3, 1e-3, prescribed=presc, prescription=pres, record_every=50, formulation="dq"
+    )
     rt.assert_close(d.v, c.v, rtol=1e-11)
     rt.assert_close(d.tau, c.tau, rtol=1e-10)
     with pytest.raises(ff.InputError, match="formulation"):

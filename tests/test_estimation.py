@@ -3,9 +3,10 @@ naveen_dual_arm driven by a prescribed multi-sine on the six arm joints and thre
 noise-free momentum, consistent standard deviations under noise, agreement with numpy.linalg.lstsq on the
 explicitly built minimal regressor (eq. 26), rank deficiency reported, and the error figures (eqs. 38-39)."""
 
-import freefloat as ff
 import numpy as np
 import pytest
+
+import freefloat as ff
 from freefloat import estimation as est
 
 DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]

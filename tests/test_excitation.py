@@ -10,7 +10,6 @@ import freefloat as ff
 from freefloat import excitation as exc
 from freefloat import trajectories as tr
 
-
 #: κ of the full design on the guessed robot (docs/excitation.md, Results)
 DOCUMENTED_KAPPA = 901.4
 
@@ -27,8 +26,9 @@ def design(guess):
 
 def _x(design):
     # a feasible seed vector with sizeable ranges
-    return design.feasible_start(design.all_directions[:8],
-                                 np.r_[np.deg2rad([10, -40, 30, 60, -20, 45]), [1.2, 0.9, 0.8, 0.6, 0.5, 0.4]])
+    return design.feasible_start(
+        design.all_directions[:8], np.r_[np.deg2rad([10, -40, 30, 60, -20, 45]), [1.2, 0.9, 0.8, 0.6, 0.5, 0.4]]
+    )
 
 
 def test_rows_match_a_simulation_of_the_guessed_robot(guess, design):
@@ -115,9 +115,9 @@ def test_algorithm1_on_synthetic_blocks():
     blocks += [basis.T[:3] * 5, basis.T[3:] * 5]
     pr = exc.prune_intervals(np.array(blocks), u_max=2, delta=1e-3, min_gain=0.0)
     kept = set(pr.kept.tolist())
-    assert set(range(6)) <= kept                          # the start, then each adds a significant singular value
+    assert set(range(6)) <= kept  # the start, then each adds a significant singular value
     assert [i for i in range(6, 14) if i in kept] == [6, 7]  # u_max = 2 non-improving acceptances, then no more
-    assert {14, 15} <= kept                               # the even blocks lower κ
+    assert {14, 15} <= kept  # the even blocks lower κ
     # As printed (s_prev, cn_prev never updated) the copies would be compared with the first block forever;
     # with the fix the reference follows the accepted matrix, so the recorded κ is that of the kept intervals.
     R = np.vstack([blocks[i] for i in sorted(kept)])

@@ -6,13 +6,14 @@ conservation law, or a closed form."""
 from __future__ import annotations
 
 import numpy as np
+import postcapture_numpy_oracle as oracle
 import pytest
 
 import freefloat as ff
-import postcapture_numpy_oracle as oracle
-import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 from freefloat import postcapture as pc
 from freefloat.postcapture import equations as eq
+
+import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 
 
 def unit_quats(rng, shape):
@@ -124,10 +125,12 @@ def _old_integrate_attitude(quat0, omega, dt):
     ex = np.column_stack([half * sc[:, None], np.cos(ang / 2)]).tolist()
     for k in range(n - 1):
         bx, by, bz, bw = ex[k]
-        x, y, z, w = (w * bx + x * bw + y * bz - z * by,
-                      w * by - x * bz + y * bw + z * bx,
-                      w * bz + x * by - y * bx + z * bw,
-                      w * bw - x * bx - y * by - z * bz)
+        x, y, z, w = (
+            w * bx + x * bw + y * bz - z * by,
+            w * by - x * bz + y * bw + z * bx,
+            w * bz + x * by - y * bx + z * bw,
+            w * bw - x * bx - y * by - z * bz,
+        )
         if k % 1000 == 999:
             nrm = (x * x + y * y + z * z + w * w) ** 0.5
             x, y, z, w = x / nrm, y / nrm, z / nrm, w / nrm
@@ -252,7 +255,9 @@ def test_parameter_conversions_match_the_old_numpy():
         mn, bn, In = eq.body_truth(m, body)
         np.testing.assert_allclose([mn, *bn], [mo, *bo], rtol=1e-15, atol=0)
         np.testing.assert_allclose(In, Io, rtol=0, atol=1e-14 * np.abs(Io).max())
-        np.testing.assert_allclose(eq.standard_vector(mo, bo, Io), oracle.standard_vector(mo, bo, Io), rtol=1e-14, atol=1e-15)
+        np.testing.assert_allclose(
+            eq.standard_vector(mo, bo, Io), oracle.standard_vector(mo, bo, Io), rtol=1e-14, atol=1e-15
+        )
         np.testing.assert_allclose(eq.standard_vector(mn, bn, In), P[body], rtol=1e-12, atol=1e-14)
     hist = P[[0, -1]]
     for a, b in zip(eq.from_standard(hist), oracle.from_standard(hist)):
@@ -272,6 +277,7 @@ def test_parameter_conversions_match_the_old_numpy():
 def test_rows_bad_input(measured):
     m, meas = measured
     from dataclasses import replace
+
     with pytest.raises(ff.InputError, match="ddq"):
         eq.paper_force_rows(m, replace(meas, ddq=meas.ddq[:, :-1]), 0, 1)
     bad = meas.v.copy()

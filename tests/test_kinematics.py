@@ -6,7 +6,9 @@ import pytest
 import freefloat as ff
 
 
-@pytest.mark.parametrize("name,frame", [("naveen_dual_arm", "ee_A"), ("zhang2020_3d", "ee"), ("zhang2020_2d_medium", "ee")])
+@pytest.mark.parametrize(
+    "name,frame", [("naveen_dual_arm", "ee_A"), ("zhang2020_3d", "ee"), ("zhang2020_2d_medium", "ee")]
+)
 def test_generalized_jacobian_predicts_end_effector_twist(name, frame):
     m = ff.models.load(name)
     rng = np.random.default_rng(3)
@@ -50,7 +52,7 @@ def test_body_velocities_and_accelerations_match_pinocchio(tmp_path, name):
         if m.nqs[i]:
             jm = pm.joints[pm.getJointId(name)]
             x = q[m.idx_q[i]]
-            q_pin[jm.idx_q:jm.idx_q + jm.nq] = [np.cos(x), np.sin(x)] if jm.nq == 2 else [x]
+            q_pin[jm.idx_q : jm.idx_q + jm.nq] = [np.cos(x), np.sin(x)] if jm.nq == 2 else [x]
     pin.forwardKinematics(pm, pd, q_pin, v, a)
     pin.updateFramePlacements(pm, pd)
     V = ff.body_velocities(m, q, v)
@@ -61,6 +63,8 @@ def test_body_velocities_and_accelerations_match_pinocchio(tmp_path, name):
         fid = pm.getFrameId(body)
         np.testing.assert_allclose(V[i], pin.getFrameVelocity(pm, pd, fid, local).vector, atol=1e-10, err_msg=body)
         np.testing.assert_allclose(A[i], pin.getFrameAcceleration(pm, pd, fid, local).vector, atol=1e-10, err_msg=body)
-        np.testing.assert_allclose(C[i], pin.getFrameClassicalAcceleration(pm, pd, fid, local).vector, atol=1e-10, err_msg=body)
+        np.testing.assert_allclose(
+            C[i], pin.getFrameClassicalAcceleration(pm, pd, fid, local).vector, atol=1e-10, err_msg=body
+        )
     # Stacked form equals the loop.
     np.testing.assert_array_equal(ff.body_velocities(m, np.tile(q, (2, 1)), np.tile(v, (2, 1)))[1], V)

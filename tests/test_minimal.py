@@ -1,22 +1,69 @@
 """Minimal parameters of the momentum model (python/freefloat/minimal.py): Naveen, Shah, Misra's closed form against its
 Table 4, the numeric (QR) method against the closed form, and the numeric method on other joint types."""
 
-import freefloat as ff
 import numpy as np
 import pytest
-import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 import scipy.linalg
+
+import freefloat as ff
+
+import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 
 # Naveen, Shah, Misra, Table 4 "True" column, phi_m(1..52) in the paper's order.  Printed to 3 decimals, so
 # the tolerance is half a unit of the last digit (5e-4, e.g. 2.1125 printed 2.112) plus float slack.
 TABLE4_TRUE = [
-    2130.560, 2078.560, 1555.700, -96.630, -269.450, -148.890, 2265.000, 440.500, 679.500, 1033.000,
-    -2.525, 192.775, 7.400, 3.825, 6.000, 100.000, -4.500,
-    -36.866, 55.134, 1.250, 1.670, -6.700, 46.000, -1.600,
-    -14.010, 55.030, 1.380, 5.500, 3.930, 21.000, 12.000,
-    19.600, 256.670, -18.850, 2.330, 4.810, 122.500, 21.250,
-    -66.290, 81.455, 2.112, 1.462, 21.483, 75.750, 1.750,
-    -25.810, 60.370, 27.100, -1.980, 21.270, 36.000, -30.000,
+    2130.560,
+    2078.560,
+    1555.700,
+    -96.630,
+    -269.450,
+    -148.890,
+    2265.000,
+    440.500,
+    679.500,
+    1033.000,
+    -2.525,
+    192.775,
+    7.400,
+    3.825,
+    6.000,
+    100.000,
+    -4.500,
+    -36.866,
+    55.134,
+    1.250,
+    1.670,
+    -6.700,
+    46.000,
+    -1.600,
+    -14.010,
+    55.030,
+    1.380,
+    5.500,
+    3.930,
+    21.000,
+    12.000,
+    19.600,
+    256.670,
+    -18.850,
+    2.330,
+    4.810,
+    122.500,
+    21.250,
+    -66.290,
+    81.455,
+    2.112,
+    1.462,
+    21.483,
+    75.750,
+    1.750,
+    -25.810,
+    60.370,
+    27.100,
+    -1.980,
+    21.270,
+    36.000,
+    -30.000,
 ]
 TABLE4_ATOL = 5e-4 + 1e-9
 
@@ -121,8 +168,13 @@ def test_numeric_other_joint_types():
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_numeric_random_trees(seed):
     rng = np.random.default_rng(1000 + seed)
-    desc = rt.random_tree(rng, n_children=6, base="free", joint_types=("revolute", "prismatic", "spherical", "fixed"),
-                          joint_p=(0.25, 0.25, 0.3, 0.2))
+    desc = rt.random_tree(
+        rng,
+        n_children=6,
+        base="free",
+        joint_types=("revolute", "prismatic", "spherical", "fixed"),
+        joint_p=(0.25, 0.25, 0.3, 0.2),
+    )
     _check_numeric_reproduces_momentum(ff.Model.from_yaml_string(desc.to_yaml()), seed=seed)
 
 

@@ -5,8 +5,15 @@ import pytest
 
 import freefloat as ff
 
-REQUIRED = ["naveen_dual_arm", "zhang2020_2d_small", "zhang2020_2d_medium", "zhang2020_2d_large", "zhang2020_3d",
-            "valverde_ch5_single_arm", "valverde_ch7_two_arm"]
+REQUIRED = [
+    "naveen_dual_arm",
+    "zhang2020_2d_small",
+    "zhang2020_2d_medium",
+    "zhang2020_2d_large",
+    "zhang2020_3d",
+    "valverde_ch5_single_arm",
+    "valverde_ch7_two_arm",
+]
 
 
 def test_builtin_names_and_loading():
@@ -73,7 +80,9 @@ def test_mdh_equals_explicit_placement():
         "name: t\nbodies:\n  - name: b\n    inertial: {mass: 1, inertia: [1, 1, 1]}\n"
         "  - name: l\n    parent: b\n    joint: {type: revolute}\n"
     )
-    a = ff.Model.from_yaml_string(common + "    mdh: {alpha: 0.4, a: 1.5, d: 0.3, theta: 0.2}\n    inertial: {mass: 1, inertia: [1, 1, 1]}\n")
+    a = ff.Model.from_yaml_string(
+        common + "    mdh: {alpha: 0.4, a: 1.5, d: 0.3, theta: 0.2}\n    inertial: {mass: 1, inertia: [1, 1, 1]}\n"
+    )
     ca, sa, ct, st = np.cos(0.4), np.sin(0.4), np.cos(0.2), np.sin(0.2)
     Rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
     Rz = np.array([[ct, -st, 0], [st, ct, 0], [0, 0, 1]])
@@ -83,7 +92,9 @@ def test_mdh_equals_explicit_placement():
     np.testing.assert_allclose(a.placements[1], T, atol=1e-14)
 
 
-@pytest.mark.parametrize("name", ["naveen_dual_arm_consistent", "zhang2020_3d", "zhang2020_2d_medium", "valverde_ch5_single_arm"])
+@pytest.mark.parametrize(
+    "name", ["naveen_dual_arm_consistent", "zhang2020_3d", "zhang2020_2d_medium", "valverde_ch5_single_arm"]
+)
 def test_urdf_round_trip_preserves_dynamics(tmp_path, name):
     m = ff.models.load(name)
     path = tmp_path / f"{name}.urdf"

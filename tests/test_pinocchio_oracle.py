@@ -40,6 +40,7 @@ N_STATES = 3
 # random trees
 # ----------------------------------------------------------------------------------------------------------------
 
+
 @functools.cache
 def case(seed):
     """(description, freefloat model, Pinocchio tree) for one seed, built once."""
@@ -67,7 +68,7 @@ def test_model_metadata(seed):
     # per-body like parents/joint_types; compare the tail so a list with or without a base entry both pass
     names = list(m.joint_names)
     assert len(names) in (d.nbodies, d.nbodies - 1)
-    assert names[len(names) - (d.nbodies - 1):] == [b.effective_joint_name for b in d.bodies[1:]]
+    assert names[len(names) - (d.nbodies - 1) :] == [b.effective_joint_name for b in d.bodies[1:]]
     close(np.asarray(m.gravity, float), d.gravity, "gravity")
     P = np.asarray(m.parameters(), float)
     assert P.shape == (d.nbodies, 10)
@@ -165,6 +166,7 @@ def test_aba(seed):
 
 # ---- stacked (time-series) inputs ------------------------------------------------------------------------------
 
+
 def _stack_seeds():
     """A few trees: one per base type, plus the largest tree."""
     picked = {}
@@ -189,12 +191,24 @@ def test_stacked_inputs_match_a_loop(seed):
         "forward_kinematics": (lambda *x: ff.forward_kinematics(m, *x), (Q,), (T, d.nbodies, 7), p.forward_kinematics),
         "center_of_mass": (lambda *x: ff.center_of_mass(m, *x), (Q,), (T, 3), p.center_of_mass),
         "momentum": (lambda *x: ff.momentum(m, *x), (Q, V), (T, 6), p.momentum),
-        "centroidal_momentum_matrix": (lambda *x: ff.centroidal_momentum_matrix(m, *x), (Q,), (T, 6, d.nv),
-                                       p.centroidal_momentum_matrix),
-        "frame_jacobian local": (lambda *x: ff.frame_jacobian(m, *x, name, reference="local"), (Q,), (T, 6, d.nv),
-                                 lambda q: p.frame_jacobian(q, name, "local")),
-        "frame_jacobian world": (lambda *x: ff.frame_jacobian(m, *x, name, reference="world"), (Q,), (T, 6, d.nv),
-                                 lambda q: p.frame_jacobian(q, name, "world")),
+        "centroidal_momentum_matrix": (
+            lambda *x: ff.centroidal_momentum_matrix(m, *x),
+            (Q,),
+            (T, 6, d.nv),
+            p.centroidal_momentum_matrix,
+        ),
+        "frame_jacobian local": (
+            lambda *x: ff.frame_jacobian(m, *x, name, reference="local"),
+            (Q,),
+            (T, 6, d.nv),
+            lambda q: p.frame_jacobian(q, name, "local"),
+        ),
+        "frame_jacobian world": (
+            lambda *x: ff.frame_jacobian(m, *x, name, reference="world"),
+            (Q,),
+            (T, 6, d.nv),
+            lambda q: p.frame_jacobian(q, name, "world"),
+        ),
         "crba": (lambda *x: ff.crba(m, *x), (Q,), (T, d.nv, d.nv), p.crba),
         "rnea": (lambda *x: ff.rnea(m, *x), (Q, V, U), (T, d.nv), p.rnea),
         "rnea fext": (lambda *x: ff.rnea(m, *x[:3], fext=x[3]), (Q, V, U, F), (T, d.nv), p.rnea),
@@ -256,6 +270,7 @@ def erd_urdf(rel):
     """
     try:
         from example_robot_data.robots_loader import getModelPath
+
         return os.path.join(getModelPath(rel), rel)
     except (ImportError, OSError):
         pass
@@ -306,8 +321,10 @@ class UrdfPair:
 
 def check_urdf_dynamics(u, label, rng, n_states=3):
     m, model, data, L = u.m, u.model, u.data, u.layout
-    assert (m.nv, m.nq) == (model.nv, model.nq - (u.base == "planar")
-                            - sum(1 for j in model.joints[1:] if j.nq == 2 and j.nv == 1)), f"{label}: nq/nv"
+    assert (m.nv, m.nq) == (
+        model.nv,
+        model.nq - (u.base == "planar") - sum(1 for j in model.joints[1:] if j.nq == 2 and j.nv == 1),
+    ), f"{label}: nq/nv"
     mass = rt.urdf_total_mass(u.text)
     assert np.asarray(m.parameters(), float)[:, 0].sum() == pytest.approx(mass, rel=1e-12), f"{label}: mass"
     assert rt.pin_total_mass(model) == pytest.approx(mass, rel=1e-12)
@@ -318,12 +335,16 @@ def check_urdf_dynamics(u, label, rng, n_states=3):
         close(ff.aba(m, q, v, tau), L.v_from_pin(pin.aba(model, data, qp, vp, tp)), f"{label} aba")
         close(ff.aba(m, q, v, tau, fext=fext), L.v_from_pin(pin.aba(model, data, qp, vp, tp, fp)), f"{label} aba fext")
         close(ff.rnea(m, q, v, tau), L.v_from_pin(pin.rnea(model, data, qp, vp, tp)), f"{label} rnea")
-        close(ff.rnea(m, q, v, tau, fext=fext), L.v_from_pin(pin.rnea(model, data, qp, vp, tp, fp)),
-              f"{label} rnea fext")
+        close(
+            ff.rnea(m, q, v, tau, fext=fext), L.v_from_pin(pin.rnea(model, data, qp, vp, tp, fp)), f"{label} rnea fext"
+        )
         close(ff.crba(m, q), L.matrix_from_pin(pin.crba(model, data, qp)), f"{label} crba")
         close(ff.momentum(m, q, v), rt.pin_momentum_at_origin(model, data, qp, vp), f"{label} momentum")
-        close(ff.centroidal_momentum_matrix(m, q), L.cols_from_pin(rt.pin_momentum_matrix_at_origin(model, data, qp)),
-              f"{label} momentum matrix")
+        close(
+            ff.centroidal_momentum_matrix(m, q),
+            L.cols_from_pin(rt.pin_momentum_matrix_at_origin(model, data, qp)),
+            f"{label} momentum matrix",
+        )
         close(ff.center_of_mass(m, q), rt.pin_center_of_mass(model, data, qp), f"{label} CoM")
 
 
@@ -369,8 +390,12 @@ def erd_pair(robot, base):
         return UrdfPair(fh.read(), base, path=path)
 
 
-ERD_CASES = [(r, "free") for r in ERD_ROBOTS] + [("panda", "fixed"), ("a1", "fixed"), ("ur5", "planar"),
-                                                   ("solo12", "planar")]
+ERD_CASES = [(r, "free") for r in ERD_ROBOTS] + [
+    ("panda", "fixed"),
+    ("a1", "fixed"),
+    ("ur5", "planar"),
+    ("solo12", "planar"),
+]
 
 
 def _rng(*key):
@@ -434,6 +459,7 @@ def test_urdf_from_string_equals_from_file():
 # The example robots leave some of the URDF format unexercised (rotated inertial frames, omitted axes, siblings
 # out of alphabetical order, joints listed before their links).  These trees cover it; the self-checks verify
 # the rendering against a Pinocchio model built directly from the description.
+
 
 @pytest.mark.parametrize("seed", rt.URDF_TREE_SEEDS)
 def test_random_urdf_tree(seed):

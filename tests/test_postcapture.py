@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import postcapture_numpy_oracle as oracle
 import pytest
 import yaml
 from click.testing import CliRunner
@@ -15,9 +16,8 @@ from click.testing import CliRunner
 import freefloat as ff
 from freefloat import _core
 from freefloat import postcapture as pc
-from freefloat.postcapture import equations as eq
-import postcapture_numpy_oracle as oracle
 from freefloat.cli import main
+from freefloat.postcapture import equations as eq
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -92,10 +92,18 @@ def test_closed_forms_match_definitions():
     np.testing.assert_allclose(oracle.D_block(p)[0] @ oracle.inertia_sharp(Ic), Iw @ w, rtol=1e-12)
     np.testing.assert_allclose(oracle.G_block(p)[0] @ np.r_[m, m * b], m * cdd, rtol=1e-5)
     np.testing.assert_allclose(oracle.S_block(p)[0] @ mJ, m * np.cross(c, cdd), rtol=1e-5)
-    np.testing.assert_allclose(oracle.Q_block(p)[0] @ oracle.inertia_sharp(Ic), Iw @ b0 + np.cross(w, Iw @ w), rtol=1e-12)
+    np.testing.assert_allclose(
+        oracle.Q_block(p)[0] @ oracle.inertia_sharp(Ic), Iw @ b0 + np.cross(w, Iw @ w), rtol=1e-12
+    )
     # planar reduction (docs/postcapture.md): the bx² and by² columns of H coincide, the bx·by column vanishes
-    pz = oracle.PointMotion(np.array([[1.0, 2, 0]]), np.eye(3)[None], np.array([[0.3, -1, 0]]),
-                        np.array([[0, 0, 0.4]]), np.zeros((1, 3)), np.zeros((1, 3)))
+    pz = oracle.PointMotion(
+        np.array([[1.0, 2, 0]]),
+        np.eye(3)[None],
+        np.array([[0.3, -1, 0]]),
+        np.array([[0, 0, 0.4]]),
+        np.zeros((1, 3)),
+        np.zeros((1, 3)),
+    )
     H = oracle.H_block(pz)[0]
     assert H[2, 4] == pytest.approx(H[2, 7]) and H[2, 5] == 0
 
@@ -176,7 +184,7 @@ def test_noise_free_3d(spatial):
         for solver in pc.SOLVERS:
             err = dict(zip(names, spatial.rel_error(method, solver)))
             for p in ("m1", "b1x", "b1y", "b1z", "mn", "bnx", "bny", "Inxx", "Inyy", "Inzz", "I1xx", "I1yy", "I1zz"):
-                assert err[p] < 1e-2, (method, solver, p, err[p])   # the paper's 1 % band
+                assert err[p] < 1e-2, (method, solver, p, err[p])  # the paper's 1 % band
             assert abs(spatial.final(method, solver)[names.index("bnz")]) < 1e-8  # zero true value
 
 
@@ -263,8 +271,9 @@ def test_online_wrappers_accept_lists_and_name_bad_arguments():
 
 
 def test_modified_rls_bad_samples_raise_clear_errors():
-    est = _core.ModifiedRLS("planar", np.array([600.0, 0, 0, 100, 10, 10]), np.full(6, 1e6),
-                            np.array([100.0, 10.0]), np.full(2, 1e6))
+    est = _core.ModifiedRLS(
+        "planar", np.array([600.0, 0, 0, 100, 10, 10]), np.full(6, 1e6), np.array([100.0, 10.0]), np.full(2, 1e6)
+    )
     t = np.array([0.1, 0.2])
     A, b = np.ones((2, 2, 6)), np.ones((2, 2))
     Phi, y, Psi = np.ones((2, 1, 2)), np.ones((2, 1)), np.zeros((2, 1, 8))
@@ -281,8 +290,9 @@ def test_modified_rls_bad_samples_raise_clear_errors():
 
 def test_target_must_be_welded_to_the_end_effector():
     text = ff.models.source("zhang2020_2d_medium")
-    loose = ff.Model.from_yaml_string(text.replace("joint: {name: grasp, type: fixed}",
-                                                   "joint: {name: grasp, type: revolute, axis: [0, 0, 1]}"))
+    loose = ff.Model.from_yaml_string(
+        text.replace("joint: {name: grasp, type: fixed}", "joint: {name: grasp, type: revolute, axis: [0, 0, 1]}")
+    )
     with pytest.raises(ff.InputError, match="welded"):
         pc._target_index(loose)
     with pytest.raises(ff.InputError, match="not found"):

@@ -24,8 +24,13 @@ N_STATES = 3
 def _states(desc, seed, n=N_STATES):
     rng = np.random.default_rng(10_000 + seed)
     for _ in range(n):
-        yield (desc.random_q(rng), desc.random_v(rng), rng.normal(size=desc.nv), rng.normal(size=desc.nv),
-               desc.random_fext(rng))
+        yield (
+            desc.random_q(rng),
+            desc.random_v(rng),
+            rng.normal(size=desc.nv),
+            rng.normal(size=desc.nv),
+            desc.random_fext(rng),
+        )
 
 
 _cache = {}
@@ -50,8 +55,11 @@ def spatial_inertia(params):
 # YAML rendering
 # ----------------------------------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("x", [0.0, -0.0, 1.0, -2.5, 1e-05, 1.5e-07, 1e20, 6.02214076e23, 0.1, 1 / 3, math.pi,
-                               -1e-300, 5e-324, 123456789.125])
+
+@pytest.mark.parametrize(
+    "x",
+    [0.0, -0.0, 1.0, -2.5, 1e-05, 1.5e-07, 1e20, 6.02214076e23, 0.1, 1 / 3, math.pi, -1e-300, 5e-324, 123456789.125],
+)
 def test_yaml_float_round_trips_through_pyyaml(x):
     s = rt.yaml_float(x)
     back = yaml.safe_load(f"v: {s}")["v"]
@@ -69,11 +77,17 @@ def test_numpy_geometry_matches_pinocchio():
         rpy = rng.uniform(-3, 3, 3)
         assert_close(rt.rpy_to_matrix(rpy), pin.rpy.rpyToMatrix(rpy), rtol=1e-14, atol=1e-15, what="rpy")
         qx = rt.random_unit_quaternion(rng)
-        assert_close(rt.quat_to_matrix(qx), pin.Quaternion(qx).toRotationMatrix(), rtol=1e-14, atol=1e-15,
-                     what="quaternion xyzw")
+        assert_close(
+            rt.quat_to_matrix(qx), pin.Quaternion(qx).toRotationMatrix(), rtol=1e-14, atol=1e-15, what="quaternion xyzw"
+        )
         ax, th = rt.random_axis(rng), rng.uniform(-4, 4)
-        assert_close(rt.axis_angle_matrix(ax, th), pin.AngleAxis(th, ax).toRotationMatrix(), rtol=1e-14,
-                     atol=1e-15, what="axis-angle")
+        assert_close(
+            rt.axis_angle_matrix(ax, th),
+            pin.AngleAxis(th, ax).toRotationMatrix(),
+            rtol=1e-14,
+            atol=1e-15,
+            what="axis-angle",
+        )
 
 
 def _parse_yaml_model(text):
@@ -82,9 +96,18 @@ def _parse_yaml_model(text):
     deg = doc.get("angles", "rad") == "deg"
     ang = (lambda a: math.radians(a)) if deg else (lambda a: a)
     names = [b["name"] for b in doc["bodies"]]
-    out = {"base": doc.get("base", "free"), "gravity": np.array(doc.get("gravity", [0.0, 0.0, 0.0]), float),
-           "names": names, "parents": [], "types": [], "axes": [], "axes2": [], "placements": [], "params": [],
-           "jnames": []}
+    out = {
+        "base": doc.get("base", "free"),
+        "gravity": np.array(doc.get("gravity", [0.0, 0.0, 0.0]), float),
+        "names": names,
+        "parents": [],
+        "types": [],
+        "axes": [],
+        "axes2": [],
+        "placements": [],
+        "params": [],
+        "jnames": [],
+    }
     for k, b in enumerate(doc["bodies"]):
         inertial = b["inertial"]
         if "params" in inertial:
@@ -92,9 +115,14 @@ def _parse_yaml_model(text):
         else:
             m, c = float(inertial["mass"]), np.array(inertial["com"], float)
             t = inertial.get("inertia", inertial.get("inertia_origin"))
-            I = np.array([[t["xx"], t.get("xy", 0.0), t.get("xz", 0.0)],
-                          [t.get("xy", 0.0), t["yy"], t.get("yz", 0.0)],
-                          [t.get("xz", 0.0), t.get("yz", 0.0), t["zz"]]], float)
+            I = np.array(
+                [
+                    [t["xx"], t.get("xy", 0.0), t.get("xz", 0.0)],
+                    [t.get("xy", 0.0), t["yy"], t.get("yz", 0.0)],
+                    [t.get("xz", 0.0), t.get("yz", 0.0), t["zz"]],
+                ],
+                float,
+            )
             if "inertia" in inertial:
                 I = rt.inertia_about_origin(m, c, I)
             params = np.array([m, *(m * c), I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
@@ -122,17 +150,26 @@ def _parse_yaml_model(text):
         if "origin" in b:
             o = b["origin"]
             # Pinocchio's rpy (the URDF convention), not ours: an independent reading of the file
-            T = rt.homogeneous(pin.rpy.rpyToMatrix(np.array([ang(a) for a in o.get("rpy", [0, 0, 0])], float)),
-                               o.get("xyz", [0, 0, 0]))
+            T = rt.homogeneous(
+                pin.rpy.rpyToMatrix(np.array([ang(a) for a in o.get("rpy", [0, 0, 0])], float)), o.get("xyz", [0, 0, 0])
+            )
         if "mdh" in b:
             h = b["mdh"]
-            T = (T @ rt.homogeneous(rt.rot_x(ang(h["alpha"]))) @ rt.homogeneous(p=[h["a"], 0, 0])
-                 @ rt.homogeneous(rt.rot_z(ang(h["theta"]))) @ rt.homogeneous(p=[0, 0, h["d"]]))
+            T = (
+                T
+                @ rt.homogeneous(rt.rot_x(ang(h["alpha"])))
+                @ rt.homogeneous(p=[h["a"], 0, 0])
+                @ rt.homogeneous(rt.rot_z(ang(h["theta"])))
+                @ rt.homogeneous(p=[0, 0, h["d"]])
+            )
         out["placements"].append(T)
-    out["frames"] = {f["name"]: (names.index(f["body"]),
-                                 rt.homogeneous(pin.rpy.rpyToMatrix(np.array([ang(a) for a in f["origin"]["rpy"]])),
-                                                f["origin"]["xyz"]))
-                     for f in doc.get("frames", [])}
+    out["frames"] = {
+        f["name"]: (
+            names.index(f["body"]),
+            rt.homogeneous(pin.rpy.rpyToMatrix(np.array([ang(a) for a in f["origin"]["rpy"]])), f["origin"]["xyz"]),
+        )
+        for f in doc.get("frames", [])
+    }
     return doc, out
 
 
@@ -219,12 +256,39 @@ def test_generator_covers_every_feature():
             seen["moving_under_fixed"] += b.joint_type != "fixed" and par.joint_type == "fixed"
             seen["welded_to_fixed_base"] += b.joint_type == "fixed" and par.parent < 0 and par.joint_type == "fixed"
         seen["frame_on_fixed_body"] += any(d.bodies[f.body].joint_type == "fixed" for f in d.frames)
-    needed = ["base:free", "base:planar", "base:fixed", "gravity:zero", "gravity:nonzero", "angles:rad",
-              "angles:deg", "omit_base_key", "omit_gravity_key", "non_depth_first_order", "many_bodies", "frames",
-              "form:com", "form:origin", "form:params", "joint:revolute", "joint:prismatic", "joint:spherical",
-              "joint:cylindrical", "joint:universal",
-              "joint:fixed", "default_joint_name", "mdh", "mdh+origin", "omitted_axis", "scaled_axis", "limits",
-              "fixed_on_fixed", "moving_under_fixed", "welded_to_fixed_base", "frame_on_fixed_body"]
+    needed = [
+        "base:free",
+        "base:planar",
+        "base:fixed",
+        "gravity:zero",
+        "gravity:nonzero",
+        "angles:rad",
+        "angles:deg",
+        "omit_base_key",
+        "omit_gravity_key",
+        "non_depth_first_order",
+        "many_bodies",
+        "frames",
+        "form:com",
+        "form:origin",
+        "form:params",
+        "joint:revolute",
+        "joint:prismatic",
+        "joint:spherical",
+        "joint:cylindrical",
+        "joint:universal",
+        "joint:fixed",
+        "default_joint_name",
+        "mdh",
+        "mdh+origin",
+        "omitted_axis",
+        "scaled_axis",
+        "limits",
+        "fixed_on_fixed",
+        "moving_under_fixed",
+        "welded_to_fixed_base",
+        "frame_on_fixed_body",
+    ]
     missing = [k for k in needed if seen[k] == 0]
     assert not missing, f"no tree exercises {missing}; counts {dict(seen)}"
 
@@ -232,6 +296,7 @@ def test_generator_covers_every_feature():
 # ----------------------------------------------------------------------------------------------------------------
 # Pinocchio model vs the description
 # ----------------------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_layout_maps(seed):
@@ -261,9 +326,21 @@ def test_layout_maps(seed):
             moved = np.flatnonzero(np.abs(dq) > 1e-12)
             assert moved.size and set(moved) <= set(range(qs.start, qs.stop)), (i, k, dq)
     # our neutral configuration is Pinocchio's neutral
-    q0 = np.concatenate([{"free": [0, 0, 0, 0, 0, 0, 1], "planar": [0, 0, 0], "spherical": [0, 0, 0, 1],
-                          "revolute": [0], "prismatic": [0], "cylindrical": [0, 0], "universal": [0, 0],
-                          "fixed": []}[b.joint_type] for b in d.bodies]).astype(float)
+    q0 = np.concatenate(
+        [
+            {
+                "free": [0, 0, 0, 0, 0, 0, 1],
+                "planar": [0, 0, 0],
+                "spherical": [0, 0, 0, 1],
+                "revolute": [0],
+                "prismatic": [0],
+                "cylindrical": [0, 0],
+                "universal": [0, 0],
+                "fixed": [],
+            }[b.joint_type]
+            for b in d.bodies
+        ]
+    ).astype(float)
     assert_close(p.q_to_pin(q0), pin.neutral(p.model), rtol=0, atol=0, what="neutral")
 
 
@@ -321,8 +398,9 @@ def test_rnea_fext_equals_body_jacobian_transpose(seed):
     merged fixed bodies are carried to their ancestor joint correctly."""
     d, p = tree(seed)
     for q, v, _, a, fext in _states(d, seed):
-        expected = p.rnea(q, v, a) - sum(p.frame_jacobian(q, b.name, "local").T @ fext[i]
-                                         for i, b in enumerate(d.bodies))
+        expected = p.rnea(q, v, a) - sum(
+            p.frame_jacobian(q, b.name, "local").T @ fext[i] for i, b in enumerate(d.bodies)
+        )
         assert_close(p.rnea(q, v, a, fext), expected, rtol=1e-12, what="rnea fext")
 
 
@@ -382,9 +460,11 @@ def test_planar_base_velocity_convention(seed):
     d, p = tree(seed)
     q = next(_states(d, seed))[0]
     yaw = q[2]
-    for v_base, dpos, dyaw in [([0.3, 0, 0], [0.3 * math.cos(yaw), 0.3 * math.sin(yaw)], 0.0),
-                               ([0, 0.2, 0], [-0.2 * math.sin(yaw), 0.2 * math.cos(yaw)], 0.0),
-                               ([0, 0, 0.7], [0.0, 0.0], 0.7)]:
+    for v_base, dpos, dyaw in [
+        ([0.3, 0, 0], [0.3 * math.cos(yaw), 0.3 * math.sin(yaw)], 0.0),
+        ([0, 0.2, 0], [-0.2 * math.sin(yaw), 0.2 * math.cos(yaw)], 0.0),
+        ([0, 0, 0.7], [0.0, 0.0], 0.7),
+    ]:
         v = np.zeros(d.nv)
         v[:3] = v_base
         q1 = p.q_from_pin(pin.integrate(p.model, p.q_to_pin(q), p.v_to_pin(v)))
@@ -395,6 +475,7 @@ def test_planar_base_velocity_convention(seed):
 # ----------------------------------------------------------------------------------------------------------------
 # URDF rendering (used by the oracle's random-URDF tests)
 # ----------------------------------------------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("seed", rt.URDF_TREE_SEEDS)
 def test_urdf_rendering_matches_direct_model(seed):
@@ -415,19 +496,25 @@ def test_urdf_rendering_matches_direct_model(seed):
         qp = L.q_to_pin(q)
         pin.framesForwardKinematics(model, data, qp)
         for b, T in zip(d.bodies, d.body_placements(q)):
-            assert_close(data.oMf[L.body_frame(b.name)[0]].homogeneous, T, rtol=1e-12, atol=1e-12,
-                         what=f"placement of link {b.name}")
+            assert_close(
+                data.oMf[L.body_frame(b.name)[0]].homogeneous,
+                T,
+                rtol=1e-12,
+                atol=1e-12,
+                what=f"placement of link {b.name}",
+            )
         assert_close(L.matrix_from_pin(pin.crba(model, data, qp)), p.crba(q), rtol=1e-12, what="crba")
         rn = pin.rnea(model, data, qp, L.v_to_pin(v), L.v_to_pin(a), L.fext_to_pin(names, fext))
         assert_close(L.v_from_pin(rn), p.rnea(q, v, a, fext), rtol=1e-12, what="rnea fext")
-        assert_close(rt.pin_momentum_at_origin(model, data, qp, L.v_to_pin(v)), p.momentum(q, v), rtol=1e-12,
-                     what="momentum")
-        assert_close(rt.pin_center_of_mass(model, data, qp), d.center_of_mass(q), rtol=1e-12, atol=1e-13,
-                     what="CoM")
+        assert_close(
+            rt.pin_momentum_at_origin(model, data, qp, L.v_to_pin(v)), p.momentum(q, v), rtol=1e-12, what="momentum"
+        )
+        assert_close(rt.pin_center_of_mass(model, data, qp), d.center_of_mass(q), rtol=1e-12, atol=1e-13, what="CoM")
 
 
 def test_urdf_rendering_covers_the_format():
     import xml.etree.ElementTree as ET
+
     seen = Counter()
     for seed in rt.URDF_TREE_SEEDS:
         d = rt.urdf_tree_from_seed(seed)
@@ -441,13 +528,26 @@ def test_urdf_rendering_covers_the_format():
         order = rt.urdf_depth_first_joint_order(text)
         pin_model = pin.buildModelFromXML(text, pin.JointModelFreeFlyer())
         seen["document_order_is_not_pinocchio_order"] += order != list(pin_model.names)[2:]
-        seen["document_order_is_not_file_order"] += order != [b.effective_joint_name for b in d.bodies[1:]
-                                                              if b.joint_type != "fixed"]
+        seen["document_order_is_not_file_order"] += order != [
+            b.effective_joint_name for b in d.bodies[1:] if b.joint_type != "fixed"
+        ]
         tags = [(e.tag, e.get("name")) for e in root]
         seen["joint_before_its_child_link"] += any(
-            tags.index(("link", j.find("child").get("link"))) > tags.index(("joint", j.get("name"))) for j in joints)
-    missing = [k for k in ("continuous", "fixed", "prismatic", "default_axis", "document_order_is_not_pinocchio_order",
-                           "document_order_is_not_file_order", "joint_before_its_child_link") if not seen[k]]
+            tags.index(("link", j.find("child").get("link"))) > tags.index(("joint", j.get("name"))) for j in joints
+        )
+    missing = [
+        k
+        for k in (
+            "continuous",
+            "fixed",
+            "prismatic",
+            "default_axis",
+            "document_order_is_not_pinocchio_order",
+            "document_order_is_not_file_order",
+            "joint_before_its_child_link",
+        )
+        if not seen[k]
+    ]
     assert not missing, f"no URDF tree exercises {missing}: {dict(seen)}"
 
 

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import freefloat as ff
+
 import random_trees as rt  # tests/ is on sys.path under pytest's default import mode
 
 GRAVITY = np.array([0.3, -1.2, -9.81])
@@ -99,7 +100,7 @@ class PinSide:
         Y = np.zeros((self.model.nv, 10 * len(self.bodies)))
         for i, (_, j, X) in enumerate(self.bodies):
             if j > 0:
-                Y[:, 10 * i:10 * i + 10] = Yp[:, 10 * (j - 1):10 * j] @ carry_matrix(X, P[i])
+                Y[:, 10 * i : 10 * i + 10] = Yp[:, 10 * (j - 1) : 10 * j] @ carry_matrix(X, P[i])
         return self.layout.cols_from_pin(Y.T).T
 
     def momentum_regressor(self, q, v):
@@ -127,8 +128,9 @@ def carry_matrix(X, p):
     """10×10 matrix of the linear map p ↦ params(X·I(p)) (Pinocchio's own Inertia.se3Action), by differences
     about a body with positive mass so that Pinocchio's (mass, com, inertia at com) form is defined."""
     base = X.act(pin.Inertia.FromDynamicParameters(p)).toDynamicParameters()
-    return np.column_stack([X.act(pin.Inertia.FromDynamicParameters(p + e)).toDynamicParameters() - base
-                            for e in np.eye(10)])
+    return np.column_stack(
+        [X.act(pin.Inertia.FromDynamicParameters(p + e)).toDynamicParameters() - base for e in np.eye(10)]
+    )
 
 
 def max_rel(a, b):

@@ -63,11 +63,14 @@ def test_thruster_wrench_changes_momentum_by_its_impulse():
     tau[:3] = F
     tr = ff.simulate(m, q, v, 4.0, 1e-3, torques=lambda t, q, v: tau)
     x, y, z, w = tr.q[:, 3], tr.q[:, 4], tr.q[:, 5], tr.q[:, 6]
-    RF = np.stack([
-        (1 - 2 * (y * y + z * z)) * F[0] + 2 * (x * y - w * z) * F[1] + 2 * (x * z + w * y) * F[2],
-        2 * (x * y + w * z) * F[0] + (1 - 2 * (x * x + z * z)) * F[1] + 2 * (y * z - w * x) * F[2],
-        2 * (x * z - w * y) * F[0] + 2 * (y * z + w * x) * F[1] + (1 - 2 * (x * x + y * y)) * F[2],
-    ], axis=1)
+    RF = np.stack(
+        [
+            (1 - 2 * (y * y + z * z)) * F[0] + 2 * (x * y - w * z) * F[1] + 2 * (x * z + w * y) * F[2],
+            2 * (x * y + w * z) * F[0] + (1 - 2 * (x * x + z * z)) * F[1] + 2 * (y * z - w * x) * F[2],
+            2 * (x * z - w * y) * F[0] + 2 * (y * z + w * x) * F[1] + (1 - 2 * (x * x + y * y)) * F[2],
+        ],
+        axis=1,
+    )
     impulse = np.trapezoid(RF, tr.t, axis=0) if hasattr(np, "trapezoid") else np.trapz(RF, tr.t, axis=0)
     np.testing.assert_allclose(tr.momentum[-1, :3] - tr.momentum[0, :3], impulse, rtol=1e-6)
 
@@ -148,6 +151,7 @@ bodies:
     origin: {{xyz: [1, 0, 0]}}
     inertial: {{mass: 3, com: [0.4, 0, 0], inertia: [0.05, 0.3, 0.33]}}
 """
+
     mp, mf = ff.Model.from_yaml_string(yaml("planar")), ff.Model.from_yaml_string(yaml("free"))
     qp, vp = np.array([0.3, -0.2, 0.7, 0.4, -0.9]), np.array([0.1, 0.2, 0.3, -0.4, 0.5])
     qf = np.array([0.3, -0.2, 0, 0, 0, np.sin(0.35), np.cos(0.35), 0.4, -0.9])
@@ -238,8 +242,10 @@ def test_cylindrical_and_universal_joints_conserve_momentum_and_energy(formulati
 
     # The joints are fast, so RK4's error is visible at dt = 1 ms (drift ~1e-9): check that it is the
     # integrator's, i.e. that it falls by 2⁴ when dt halves (a wrong bias term would leave a floor).
-    runs = [ff.simulate(m, q, v, 3.0, dt, torques=torques, record_every=round(0.05 / dt), formulation=formulation)
-            for dt in (1e-3, 5e-4)]
+    runs = [
+        ff.simulate(m, q, v, 3.0, dt, torques=torques, record_every=round(0.05 / dt), formulation=formulation)
+        for dt in (1e-3, 5e-4)
+    ]
     for tr in runs:
         np.testing.assert_allclose(tr.momentum, ff.momentum(m, tr.q, tr.v), rtol=1e-10, atol=1e-10)
     (d1, d2), (e1, e2) = [r.momentum_drift() for r in runs], [r.energy_balance()["rel"] for r in runs]

@@ -1,9 +1,10 @@
 """Telemetry: file round trips (Parquet, CSV), validation errors that name the column/row, the Naveen, Shah, Misra
 measurement noise (Sec. VI.C) and pose reconstruction from rates (Appendix C)."""
 
-import freefloat as ff
 import numpy as np
 import pytest
+
+import freefloat as ff
 from freefloat import telemetry as te
 from freefloat import trajectories as tr
 from freefloat._core import InputError
@@ -32,7 +33,9 @@ def small(m, n=20):
     rng = np.random.default_rng(0)
     t = np.arange(n) * 0.01
     q = np.array([m.random_configuration(rng) for _ in range(n)])
-    return te.Telemetry(t=t, q=q, v=rng.normal(size=(n, m.nv)), model_name=m.name, q_labels=m.q_labels(), v_labels=m.v_labels())
+    return te.Telemetry(
+        t=t, q=q, v=rng.normal(size=(n, m.nv)), model_name=m.name, q_labels=m.q_labels(), v_labels=m.v_labels()
+    )
 
 
 @pytest.mark.parametrize("ext", ["parquet", "csv"])
@@ -60,7 +63,9 @@ def write_csv(path, tel, edit):
     """Write tel to CSV after `edit(columns dict)` changes it."""
     cols = {k: v.copy() for k, v in tel.columns().items()}
     edit(cols)
-    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
+    np.savetxt(
+        path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="", fmt="%.17g"
+    )
 
 
 def test_missing_column_is_named(robot, tmp_path):

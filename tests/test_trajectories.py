@@ -2,9 +2,10 @@
 seeds (VI.A.2), Fourier evaluation trajectory (eqs. 40–41), and a prescribed simulation of the
 dual-arm robot with its wheels that must keep the total momentum at zero."""
 
-import freefloat as ff
 import numpy as np
 import pytest
+
+import freefloat as ff
 from freefloat import trajectories as tr
 from freefloat._core import InputError
 

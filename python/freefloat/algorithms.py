@@ -24,17 +24,37 @@ from ._core import (
     frame_jacobian,
     frame_placement,
     kinetic_energy,
+    matrix_to_quat,
     momentum,
     momentum_regressor,
+    quat_to_matrix,
     rnea,
+    skew,
 )
-from ._core import matrix_to_quat, quat_to_matrix, skew
 
 __all__ = [
-    "aba", "body_accelerations", "body_velocities", "center_of_mass", "centroidal_momentum_matrix", "crba",
-    "dq_dynamics", "dynamics_regressor", "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian",
-    "hybrid_dynamics", "kinetic_energy", "momentum", "momentum_regressor", "rnea",
-    "base_twist_for_momentum", "integrate_base_poses", "matrix_to_quat", "quat_to_matrix", "skew",
+    "aba",
+    "body_accelerations",
+    "body_velocities",
+    "center_of_mass",
+    "centroidal_momentum_matrix",
+    "crba",
+    "dq_dynamics",
+    "dynamics_regressor",
+    "forward_kinematics",
+    "frame_jacobian",
+    "frame_placement",
+    "generalized_jacobian",
+    "hybrid_dynamics",
+    "kinetic_energy",
+    "momentum",
+    "momentum_regressor",
+    "rnea",
+    "base_twist_for_momentum",
+    "integrate_base_poses",
+    "matrix_to_quat",
+    "quat_to_matrix",
+    "skew",
 ]
 
 
@@ -53,7 +73,6 @@ def integrate_base_poses(t, twists, pose0):
     quaternion x y z w, returns (T, 7). Planar base: twists (T, 3) [vx, vy, yaw rate], pose0 (3,)
     [x, y, yaw], returns (T, 3). t (T,) increasing times (steps may be uneven)."""
     return _core.integrate_base_poses(as_f64(t, "t"), as_f64(twists, "twists"), as_f64(pose0, "pose0"))
-
 
 
 def generalized_jacobian(model, q, name: str, reference: str = "world", h0=None):

@@ -51,8 +51,17 @@ def run(out="freefloat-demo", t_final: float = 20.0, echo=print, progress: bool 
 
     echo(f"demo: {m!r}\n  prescribed joints {', '.join(arm)}; base and wheels float")
     t0 = time.perf_counter()
-    traj = simulate(m, q0, np.zeros(m.nv), t_final, 1e-3, prescribed=arm, prescription=prescription,
-                    record_every=10, progress=progress)
+    traj = simulate(
+        m,
+        q0,
+        np.zeros(m.nv),
+        t_final,
+        1e-3,
+        prescribed=arm,
+        prescription=prescription,
+        record_every=10,
+        progress=progress,
+    )
     s = summarize(traj, time.perf_counter() - t0)
     s["model"] = m.name
     pq = np.asarray(traj.q)
@@ -60,7 +69,9 @@ def run(out="freefloat-demo", t_final: float = 20.0, echo=print, progress: bool 
     s["base_quaternion_final"] = pq[-1, 3:7].tolist()
     s["peak_joint_torque"] = {j: float(np.abs(traj.tau[:, k]).max()) for j, k in zip(arm, vidx)}
     echo(summary_text("Naveen dual-arm manoeuvre (momentum starts at zero and must stay there)", s))
-    echo(f"  base moved to {np.round(pq[-1, :3], 4).tolist()} m, attitude quaternion {np.round(pq[-1, 3:7], 4).tolist()}")
+    echo(
+        f"  base moved to {np.round(pq[-1, :3], 4).tolist()} m, attitude quaternion {np.round(pq[-1, 3:7], 4).tolist()}"
+    )
     echo("  peak joint torques [N m]: " + ", ".join(f"{j} {x:.2f}" for j, x in s["peak_joint_torque"].items()))
     written = write_run(traj, s, out, "demo", "Naveen dual-arm manoeuvre")
     if written:
@@ -71,21 +82,29 @@ def run(out="freefloat-demo", t_final: float = 20.0, echo=print, progress: bool 
 
     with data.path("trajectories", TRAJECTORY) as p:
         designed, joints = load_trajectory(p)
-    echo(f"\nidentification: the designed exciting trajectory ({designed.n_intervals} intervals, `freefloat excite`) "
-         "with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)")
+    echo(
+        f"\nidentification: the designed exciting trajectory ({designed.n_intervals} intervals, `freefloat excite`) "
+        "with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)"
+    )
     telem, _ = idf.trajectory_data(m, designed, joints, progress=progress)
     plain = idf.identify_minimal(m, telem).errors(m)
     res = idf.identify_minimal(m, telem, rate_noise=PAPER_RATE_NOISE)
     e = res.errors(m)
-    echo(f"  {len(res.names)} minimal parameters, condition number {res.fit.condition_number:.4g}; relative error "
-         f"median {e['median_rel_error_pct']:.3g} %, max {e['max_rel_error_pct']:.3g} % (paper, Case 1: 2.08 %, 174 %)")
-    echo(f"  (plain least squares, without removing the errors-in-variables bias: median "
-         f"{plain['median_rel_error_pct']:.3g} %, max {plain['max_rel_error_pct']:.3g} %)")
+    echo(
+        f"  {len(res.names)} minimal parameters, condition number {res.fit.condition_number:.4g}; relative error "
+        f"median {e['median_rel_error_pct']:.3g} %, max {e['max_rel_error_pct']:.3g} % (paper, Case 1: 2.08 %, 174 %)"
+    )
+    echo(
+        f"  (plain least squares, without removing the errors-in-variables bias: median "
+        f"{plain['median_rel_error_pct']:.3g} %, max {plain['max_rel_error_pct']:.3g} %)"
+    )
     ident_dir = Path(out) / "identification"
     res.save(ident_dir, truth=m)
     s["identification"] = res.to_dict(truth=m)
 
-    echo("\nvalidation by prediction (the paper's Sec. VI.D): true and identified robots along a 40-s Fourier trajectory")
+    echo(
+        "\nvalidation by prediction (the paper's Sec. VI.D): true and identified robots along a 40-s Fourier trajectory"
+    )
     ident, _, how = identified_model(m, res, models.load(PRIOR))
     pred = predict(m, ident, dt=2e-3, progress=progress)
     echo(f"  identified robot: {how}")

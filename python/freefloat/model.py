@@ -30,7 +30,7 @@ class Model:
 
     # -- loading and saving ---------------------------------------------------------------------------
     @classmethod
-    def from_urdf(cls, path, base: str = "free", allow_nonphysical: bool = False) -> "Model":
+    def from_urdf(cls, path, base: str = "free", allow_nonphysical: bool = False) -> Model:
         """Load a URDF file; its root link becomes the base, attached by a `base` joint
         ("free", "planar" or "fixed"). Joints are taken depth-first, children in document order.
         Massless leaf links on fixed joints become frames. Links with physically impossible inertia
@@ -40,17 +40,17 @@ class Model:
         return cls(_core.Model.from_urdf_string(_read(p), base, str(p), allow_nonphysical))
 
     @classmethod
-    def from_urdf_string(cls, text: str, base: str = "free", allow_nonphysical: bool = False) -> "Model":
+    def from_urdf_string(cls, text: str, base: str = "free", allow_nonphysical: bool = False) -> Model:
         return cls(_core.Model.from_urdf_string(text, base, "<string>", allow_nonphysical))
 
     @classmethod
-    def from_yaml(cls, path) -> "Model":
+    def from_yaml(cls, path) -> Model:
         """Load the YAML model format (docs/model_format.md)."""
         p = Path(path)
         return cls(_core.Model.from_yaml_string(_read(p), str(p)))
 
     @classmethod
-    def from_yaml_string(cls, text: str) -> "Model":
+    def from_yaml_string(cls, text: str) -> Model:
         return cls(_core.Model.from_yaml_string(text, "<string>"))
 
     def to_urdf(self, path=None) -> str:
@@ -75,9 +75,13 @@ class Model:
     nqs = property(lambda self: self._core.nqs)
     nvs = property(lambda self: self._core.nvs)
     joint_axes = property(lambda self: self._core.joint_axes)
-    joint_axes2 = property(lambda self: self._core.joint_axes2,
-                           doc="Second axis of each universal joint (intermediate frame); z for other joints.")
-    placements = property(lambda self: self._core.placements, doc="(nbodies, 4, 4) rest placement of each joint frame in its parent.")
+    joint_axes2 = property(
+        lambda self: self._core.joint_axes2,
+        doc="Second axis of each universal joint (intermediate frame); z for other joints.",
+    )
+    placements = property(
+        lambda self: self._core.placements, doc="(nbodies, 4, 4) rest placement of each joint frame in its parent."
+    )
     limits = property(lambda self: self._core.limits)
     tags = property(lambda self: self._core.tags)
     frame_names = property(lambda self: self._core.frame_names)
@@ -89,11 +93,11 @@ class Model:
         """(nbodies, 10) standard inertial parameters, rows in `body_names` order."""
         return self._core.parameters()
 
-    def with_parameters(self, P) -> "Model":
+    def with_parameters(self, P) -> Model:
         """A new model with parameters P (nbodies, 10), checked for physical consistency."""
         return Model(self._core.with_parameters(as_f64(P, "P")))
 
-    def with_gravity(self, g) -> "Model":
+    def with_gravity(self, g) -> Model:
         g = as_f64(g, "g")
         if g.shape != (3,):
             raise InputError(f"argument `g`: expected 3 numbers, got shape {g.shape}")
@@ -112,19 +116,19 @@ class Model:
         for i, jt in enumerate(self.joint_types):
             s = self.idx_q[i]
             if i == 0 and jt == "free":
-                q[s:s + 3] = rng.uniform(-position_range, position_range, 3)
-                q[s + 3:s + 7] = _random_quat(rng)
+                q[s : s + 3] = rng.uniform(-position_range, position_range, 3)
+                q[s + 3 : s + 7] = _random_quat(rng)
             elif i == 0 and jt == "planar":
-                q[s:s + 2] = rng.uniform(-position_range, position_range, 2)
+                q[s : s + 2] = rng.uniform(-position_range, position_range, 2)
                 q[s + 2] = rng.uniform(-np.pi, np.pi)
             elif jt == "spherical":
-                q[s:s + 4] = _random_quat(rng)
+                q[s : s + 4] = _random_quat(rng)
             elif jt == "cylindrical":
                 # the model's limits are scalars per joint: they are not applied to 2-coordinate joints
                 q[s] = rng.uniform(-np.pi, np.pi)
                 q[s + 1] = rng.uniform(-position_range, position_range)
             elif jt == "universal":
-                q[s:s + 2] = rng.uniform(-np.pi, np.pi, 2)
+                q[s : s + 2] = rng.uniform(-np.pi, np.pi, 2)
             elif jt in ("revolute", "prismatic"):
                 default = np.pi if jt == "revolute" else position_range
                 a = lo[i] if np.isfinite(lo[i]) else -default
@@ -135,7 +139,9 @@ class Model:
     def q_labels(self) -> list[str]:
         """A name for every entry of q, e.g. base.x … base.qw, J1, ball.qx …, cyl.theta, cyl.d, cardan.theta1,
         cardan.theta2 (the two coordinates of a cylindrical or universal joint name the same thing in q and v)."""
-        return self._labels(("x", "y", "z", "qx", "qy", "qz", "qw"), ("x", "y", "yaw"), ("qx", "qy", "qz", "qw"), self.nqs)
+        return self._labels(
+            ("x", "y", "z", "qx", "qy", "qz", "qw"), ("x", "y", "yaw"), ("qx", "qy", "qz", "qw"), self.nqs
+        )
 
     def v_labels(self) -> list[str]:
         """A name for every entry of v, e.g. base.vx … base.wz, J1, ball.wx …"""
@@ -145,8 +151,17 @@ class Model:
         out = []
         for i, (jt, n) in enumerate(zip(self.joint_types, sizes)):
             owner = self.body_names[0] if i == 0 else self.joint_names[i]
-            parts = {"free": free, "planar": planar, "spherical": spherical,
-                     "cylindrical": ("theta", "d"), "universal": ("theta1", "theta2")}.get(jt) if n > 1 else None
+            parts = (
+                {
+                    "free": free,
+                    "planar": planar,
+                    "spherical": spherical,
+                    "cylindrical": ("theta", "d"),
+                    "universal": ("theta1", "theta2"),
+                }.get(jt)
+                if n > 1
+                else None
+            )
             out += [f"{owner}.{p}" for p in parts] if parts else ([owner] if n == 1 else [])
         return out
 
@@ -158,7 +173,9 @@ class Model:
         try:
             return self.body_names.index(name)
         except ValueError:
-            raise InputError(f"'{name}' is not a body of model '{self.name}' (bodies: {', '.join(self.body_names)})") from None
+            raise InputError(
+                f"'{name}' is not a body of model '{self.name}' (bodies: {', '.join(self.body_names)})"
+            ) from None
 
     def __repr__(self) -> str:
         return repr(self._core)

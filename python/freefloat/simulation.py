@@ -62,7 +62,12 @@ class Trajectory:
         mass, radius = self.stats.get("total_mass", 0.0), self.stats.get("radius", 0.0)
         sp = max(np.linalg.norm(self.momentum[:, :3], axis=1).max(), np.sqrt(2 * mass * e), 1e-300)
         sl = max(np.linalg.norm(self.momentum[:, 3:], axis=1).max(), np.sqrt(2 * mass * radius**2 * e), 1e-300)
-        return {"linear_abs": float(dp), "angular_abs": float(dl), "linear_rel": float(dp / sp), "angular_rel": float(dl / sl)}
+        return {
+            "linear_abs": float(dp),
+            "angular_abs": float(dl),
+            "linear_rel": float(dp / sp),
+            "angular_rel": float(dl / sl),
+        }
 
     def energy_balance(self) -> dict:
         """Largest |ΔE_kin − W| over the run, absolute and relative to the largest kinetic energy."""
@@ -92,7 +97,7 @@ class Trajectory:
         pq.write_table(table, str(path))
 
     @classmethod
-    def from_parquet(cls, path) -> "Trajectory":
+    def from_parquet(cls, path) -> Trajectory:
         """Read a file written by `to_parquet`."""
         import pyarrow.parquet as pq
 
@@ -112,15 +117,23 @@ class Trajectory:
             return np.column_stack([table[c].to_numpy() for c in cs]) if cs else np.zeros((table.num_rows, 0))
 
         def labels(prefix):
-            return [c[len(prefix) + 1:] for c in names if c.startswith(prefix + ".")]
+            return [c[len(prefix) + 1 :] for c in names if c.startswith(prefix + ".")]
 
         raw = (table.schema.metadata or {}).get(b"freefloat", b"{}")
         meta = json.loads(raw)
         return cls(
-            t=table["t"].to_numpy(), q=block("q"), v=block("v"), ddq=block("ddq"), tau=block("tau"),
+            t=table["t"].to_numpy(),
+            q=block("q"),
+            v=block("v"),
+            ddq=block("ddq"),
+            tau=block("tau"),
             momentum=np.column_stack([table[f"momentum.{n}"].to_numpy() for n in MOMENTUM_NAMES]),
-            kinetic_energy=table["kinetic_energy"].to_numpy(), work=table["work"].to_numpy(),
-            model_name=meta.get("model", ""), q_labels=labels("q"), v_labels=labels("v"), stats=meta.get("stats", {}),
+            kinetic_energy=table["kinetic_energy"].to_numpy(),
+            work=table["work"].to_numpy(),
+            model_name=meta.get("model", ""),
+            q_labels=labels("q"),
+            v_labels=labels("v"),
+            stats=meta.get("stats", {}),
         )
 
 
@@ -183,20 +196,53 @@ def simulate(
         torques = as_f64(torques, "torques")
     try:
         out = _core.simulate(
-            model._core, as_f64(q0, "q0"), as_f64(v0, "v0"), float(t_final), float(dt), method, rtol, atol, max_step,
-            int(record_every), torques, tt, hold, controller, controller_period, prescribed, prescription, int(max_steps), cb,
+            model._core,
+            as_f64(q0, "q0"),
+            as_f64(v0, "v0"),
+            float(t_final),
+            float(dt),
+            method,
+            rtol,
+            atol,
+            max_step,
+            int(record_every),
+            torques,
+            tt,
+            hold,
+            controller,
+            controller_period,
+            prescribed,
+            prescription,
+            int(max_steps),
+            cb,
             formulation,
         )
     finally:
         if bar is not None:
             bar.close()
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
-    stats.update(method=method, formulation=formulation, dt=dt, t_final=t_final, total_mass=model.total_mass, radius=_radius(model, q0))
+    stats.update(
+        method=method,
+        formulation=formulation,
+        dt=dt,
+        t_final=t_final,
+        total_mass=model.total_mass,
+        radius=_radius(model, q0),
+    )
     return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
 
 
-def simulate_driven(model: Model, trajectory, joints, dt: float, *, held=(), t_final: float | None = None,
-                    record_every: int = 1, progress=False) -> Trajectory:
+def simulate_driven(
+    model: Model,
+    trajectory,
+    joints,
+    dt: float,
+    *,
+    held=(),
+    t_final: float | None = None,
+    record_every: int = 1,
+    progress=False,
+) -> Trajectory:
     """Simulate `model` while the named `joints` follow a joint `trajectory` (an object with `prescription`
     and `duration`, e.g. from `freefloat.trajectories`) and the joints in `held` stay at their neutral angle; the
     base floats with zero total momentum, its initial twist solved from the momentum model,
@@ -209,15 +255,26 @@ def simulate_driven(model: Model, trajectory, joints, dt: float, *, held=(), t_f
     nb = model.nvs[0]
     v0[:nb] = base_twist_for_momentum(model, q0, v0[nb:])
     t_final = trajectory.duration if t_final is None else t_final
-    return simulate(model, q0, v0, t_final, dt, prescribed=list(joints) + list(held), prescription=presc,
-                    record_every=record_every, progress=progress)
+    return simulate(
+        model,
+        q0,
+        v0,
+        t_final,
+        dt,
+        prescribed=list(joints) + list(held),
+        prescription=presc,
+        record_every=record_every,
+        progress=progress,
+    )
 
 
 def _bar_callback(bar):
     """Progress callback that advances a tqdm bar counting per mille."""
+
     def cb(frac):
         bar.update(int(frac * 1000) - bar.n)
         return True
+
     return cb
 
 

@@ -14,6 +14,7 @@ import numpy as np
 from ._core import InputError
 from .constants import WHEEL_RANGE, WHEEL_START
 
+
 def direction_combinations(n: int, fixed: int = 0, fastest: str = "last") -> np.ndarray:
     """All 2**(n-1) sign patterns of n joint velocities with joint `fixed` kept at +1 (Naveen, Shah, Misra V.B:
     one joint keeps its direction, so there are 2^(n-1) combinations, 256 for 6 arm joints + 3 wheels).
@@ -69,10 +70,15 @@ class _JointTrajectory:
         iq, iv = [], []
         for name in names:
             if name not in model.joint_names:
-                raise InputError(f"prescription: '{name}' is not a joint of model '{model.name}' " f"(joints: {', '.join(model.joint_names[1:])})")
+                raise InputError(
+                    f"prescription: '{name}' is not a joint of model '{model.name}' "
+                    f"(joints: {', '.join(model.joint_names[1:])})"
+                )
             b = model.joint_names.index(name)
             if model.nvs[b] != 1:
-                raise InputError(f"prescription: joint '{name}' has {model.nvs[b]} DoF; only 1-DoF joints can be prescribed here")
+                raise InputError(
+                    f"prescription: joint '{name}' has {model.nvs[b]} DoF; only 1-DoF joints can be prescribed here"
+                )
             iq.append(model.idx_q[b])
             iv.append(model.idx_v[b])
         iq, iv = np.array(iq), np.array(iv)
@@ -95,23 +101,32 @@ class MultiSine(_JointTrajectory):
     def __init__(self, amplitude, frequency, phase):
         self.amp, self.w, self.ph = (np.atleast_2d(np.asarray(x, dtype=float)) for x in (amplitude, frequency, phase))
         if not (self.amp.shape == self.w.shape == self.ph.shape):
-            raise InputError(f"MultiSine: amplitude, frequency and phase must share a shape, " f"got {self.amp.shape}, {self.w.shape}, {self.ph.shape}")
+            raise InputError(
+                f"MultiSine: amplitude, frequency and phase must share a shape, "
+                f"got {self.amp.shape}, {self.w.shape}, {self.ph.shape}"
+            )
         if np.any(self.w <= 0):
             raise InputError("MultiSine: frequencies must be positive")
         self.n = self.amp.shape[0]
 
     @classmethod
-    def random(cls, n: int, rng, terms: int = 3, amplitude=(0.2, 0.6), frequency=(0.5, 3.0)) -> "MultiSine":
+    def random(cls, n: int, rng, terms: int = 3, amplitude=(0.2, 0.6), frequency=(0.5, 3.0)) -> MultiSine:
         """Random amplitudes (rad/s), frequencies (rad/s) and phases, uniform in the given ranges."""
         rng = np.random.default_rng(rng)
-        return cls(rng.uniform(*amplitude, (n, terms)), rng.uniform(*frequency, (n, terms)),
-                   rng.uniform(0.0, 2 * np.pi, (n, terms)))
+        return cls(
+            rng.uniform(*amplitude, (n, terms)),
+            rng.uniform(*frequency, (n, terms)),
+            rng.uniform(0.0, 2 * np.pi, (n, terms)),
+        )
 
     def evaluate(self, t):
         t = np.atleast_1d(np.asarray(t, dtype=float))[:, None, None]
         s = self.w * t + self.ph
-        return ((self.amp / self.w * np.sin(s)).sum(2), (self.amp * np.cos(s)).sum(2),
-                (-self.amp * self.w * np.sin(s)).sum(2))
+        return (
+            (self.amp / self.w * np.sin(s)).sum(2),
+            (self.amp * np.cos(s)).sum(2),
+            (-self.amp * self.w * np.sin(s)).sum(2),
+        )
 
 
 class Cycloidal(_JointTrajectory):
@@ -147,12 +162,16 @@ class Cycloidal(_JointTrajectory):
         if self.range_.shape != (self.n,):
             raise InputError(f"Cycloidal: range_ has shape {self.range_.shape}, expected ({self.n},) like start")
         if self.directions.shape[1] != self.n:
-            raise InputError(f"Cycloidal: directions have {self.directions.shape[1]} columns, expected {self.n} (one per joint)")
+            raise InputError(
+                f"Cycloidal: directions have {self.directions.shape[1]} columns, expected {self.n} (one per joint)"
+            )
         if not np.all(np.isfinite(self.start)) or not np.all(np.isfinite(self.range_)):
             raise InputError("Cycloidal: start and range_ must be finite")
         if np.any(self.range_ <= 0):
             j = int(np.argmax(self.range_ <= 0))
-            raise InputError(f"Cycloidal: range_ must be > 0 (Naveen, Shah, Misra eq. 37); joint {j} has {self.range_[j]}")
+            raise InputError(
+                f"Cycloidal: range_ must be > 0 (Naveen, Shah, Misra eq. 37); joint {j} has {self.range_[j]}"
+            )
         if not np.all(np.isin(self.directions, (-1.0, 1.0))):
             raise InputError("Cycloidal: directions must be +1 or -1")
         if not (self.interval > 0 and np.isfinite(self.interval)):

@@ -12,8 +12,18 @@ from .. import models
 from ..io.results import out_paths, summarize, summary_text, write_run
 from ..model import Model
 
-__all__ = ["MODEL_HELP", "load_model", "out_paths", "parse_vector", "print_summary", "sine_torques", "summarize",
-           "torque_options", "tqdm_bar", "write_outputs"]
+__all__ = [
+    "MODEL_HELP",
+    "load_model",
+    "out_paths",
+    "parse_vector",
+    "print_summary",
+    "sine_torques",
+    "summarize",
+    "torque_options",
+    "tqdm_bar",
+    "write_outputs",
+]
 
 MODEL_HELP = "a built-in robot name (see `freefloat models`) or a .yaml / .urdf file"
 
@@ -44,7 +54,9 @@ def load_model(spec: str, base: str = "free") -> Model:
         return Model.from_yaml(p)
     if p.suffix.lower() == ".urdf":
         return Model.from_urdf(p, base=base)
-    raise click.BadParameter(f"'{spec}' is neither a built-in robot ({', '.join(models.names())}) nor a .yaml/.urdf file", param_hint="MODEL")
+    raise click.BadParameter(
+        f"'{spec}' is neither a built-in robot ({', '.join(models.names())}) nor a .yaml/.urdf file", param_hint="MODEL"
+    )
 
 
 def parse_vector(text: str | None, n: int, name: str, default: np.ndarray) -> np.ndarray:

@@ -6,7 +6,9 @@ import click
 
 
 @click.command("demo")
-@click.option("--out", default="freefloat-demo", show_default=True, help="Directory for the trajectory, results.json and figure.")
+@click.option(
+    "--out", default="freefloat-demo", show_default=True, help="Directory for the trajectory, results.json and figure."
+)
 @click.option("--t-final", type=float, default=20.0, show_default=True, help="Length of the manoeuvre [s].")
 def demo_cmd(out, t_final):
     """Run the main job on its built-in default, on the Naveen, Shah, Misra dual-arm robot with three reaction wheels.

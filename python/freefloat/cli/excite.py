@@ -13,24 +13,45 @@ from ._common import load_model, tqdm_bar
 
 @click.command("excite")
 @click.argument("model")
-@click.option("--guess", help="Robot (built-in name or file) whose inertial parameters are the rough guess the design "
-                              "uses for the base response (default: MODEL's own). For Naveen, Shah, Misra: naveen_dual_arm_offset.")
+@click.option(
+    "--guess",
+    help="Robot (built-in name or file) whose inertial parameters are the rough guess the design "
+    "uses for the base response (default: MODEL's own). For Naveen, Shah, Misra: naveen_dual_arm_offset.",
+)
 @click.option("--weight", type=float, default=None, help="w of eq. 32 (default 1000 rad²/s², see docs/excitation.md).")
-@click.option("--min-gain", type=float, default=None,
-              help="Relative decrease of the condition number that counts as an improvement in the pruning "
-                   "(default 0.01; 0 is Algorithm 1 as printed, which keeps nearly every interval).")
+@click.option(
+    "--min-gain",
+    type=float,
+    default=None,
+    help="Relative decrease of the condition number that counts as an improvement in the pruning "
+    "(default 0.01; 0 is Algorithm 1 as printed, which keeps nearly every interval).",
+)
 @click.option("--maxiter", type=int, default=100, show_default=True, help="SQP iterations per optimisation step.")
 @click.option("--q-limit", type=float, default=None, help="Arm joint position limit ±[deg] (default 270).")
 @click.option("--rate-limit", type=float, default=None, help="Arm joint rate limit [rad/s] (default 1.6π ≈ 5.03).")
-@click.option("--acc-limit", type=float, default=None, help="Arm joint acceleration limit [rad/s²] (default 1.6π² ≈ 15.79).")
-@click.option("--compare/--no-compare", default=False, show_default=True,
-              help="Then simulate MODEL along the designed trajectory, along the same number of un-designed intervals "
-                   "and along the un-pruned step-1 trajectory, with the paper's noise, and compare identification errors.")
-@click.option("--fourier/--no-fourier", default=False, show_default=True,
-              help="Also optimise the paper's baseline, a 5-term Fourier series per arm joint (11 variables each), on the "
-                   "same objective over the same duration; written as fourier_trajectory.json and compared with --compare.")
-@click.option("--out", default="freefloat-excite", show_default=True,
-              help="Directory for trajectory.json, results.json and fig4.png.")
+@click.option(
+    "--acc-limit", type=float, default=None, help="Arm joint acceleration limit [rad/s²] (default 1.6π² ≈ 15.79)."
+)
+@click.option(
+    "--compare/--no-compare",
+    default=False,
+    show_default=True,
+    help="Then simulate MODEL along the designed trajectory, along the same number of un-designed intervals "
+    "and along the un-pruned step-1 trajectory, with the paper's noise, and compare identification errors.",
+)
+@click.option(
+    "--fourier/--no-fourier",
+    default=False,
+    show_default=True,
+    help="Also optimise the paper's baseline, a 5-term Fourier series per arm joint (11 variables each), on the "
+    "same objective over the same duration; written as fourier_trajectory.json and compared with --compare.",
+)
+@click.option(
+    "--out",
+    default="freefloat-excite",
+    show_default=True,
+    help="Directory for trajectory.json, results.json and fig4.png.",
+)
 def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc_limit, compare, fourier, out):
     """Design an exciting trajectory for identifying MODEL's minimal parameters (Naveen, Shah, Misra, Sec. V).
 
@@ -54,8 +75,10 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
         limits.qdd_max = np.full(n_arm, acc_limit)
     kw = {} if weight is None else {"weight": weight}
     design = exc.ExcitationDesign(g, limits=limits, **kw)
-    click.echo(f"designing an exciting trajectory for {m.name} (guess: {g.name}): {design.n_arm} arm joints, "
-               f"{len(design.wheels)} wheels, {design.n_intervals} direction combinations, {design.n_min} minimal parameters")
+    click.echo(
+        f"designing an exciting trajectory for {m.name} (guess: {g.name}): {design.n_arm} arm joints, "
+        f"{len(design.wheels)} wheels, {design.n_intervals} direction combinations, {design.n_min} minimal parameters"
+    )
     res = design.design(maxiter=maxiter, progress=True, **({} if min_gain is None else {"min_gain": min_gain}))
     click.echo(res.summary())
     click.echo(res.table3())
@@ -66,16 +89,24 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
     if fourier:
         bar = tqdm_bar(maxiter, "Fourier baseline: SQP over 11 coefficients per joint")
         try:
-            fstep, ftraj = design.fourier_baseline(res.directions, maxiter=maxiter,
-                                                   progress=lambda it, c: (bar.update(1), bar.set_postfix(C=f"{c:.4g}")))
+            fstep, ftraj = design.fourier_baseline(
+                res.directions, maxiter=maxiter, progress=lambda it, c: (bar.update(1), bar.set_postfix(C=f"{c:.4g}"))
+            )
         finally:
             bar.close()
-        click.echo(f"Fourier baseline ({len(res.directions) * design.interval:g} s, {fstep.x.size} variables): "
-                   f"κ = {fstep.condition_number:.4g}, C = {fstep.objective:.4g} "
-                   f"(cycloids, {2 * design.n_arm} variables: " f"κ = {res.step3.condition_number:.4g}, C = {res.step3.objective:.4g})")
+        click.echo(
+            f"Fourier baseline ({len(res.directions) * design.interval:g} s, {fstep.x.size} variables): "
+            f"κ = {fstep.condition_number:.4g}, C = {fstep.objective:.4g} "
+            f"(cycloids, {2 * design.n_arm} variables: "
+            f"κ = {res.step3.condition_number:.4g}, C = {res.step3.objective:.4g})"
+        )
         exc.save_trajectory(Path(out) / "fourier_trajectory.json", ftraj, design.joints, g.name)
-        summary["fourier"] = {"condition_number": fstep.condition_number, "objective": fstep.objective,
-                              "variables": int(fstep.x.size), "iterations": fstep.iterations}
+        summary["fourier"] = {
+            "condition_number": fstep.condition_number,
+            "objective": fstep.objective,
+            "variables": int(fstep.x.size),
+            "iterations": fstep.iterations,
+        }
         extra["Fourier baseline (same duration)"] = ftraj
         Path(out, "results.json").write_text(json.dumps(summary, indent=2))
     if compare:

@@ -23,38 +23,86 @@ def identify_group():
 
 @identify_group.command("minimal")
 @click.argument("model")
-@click.option("--data", type=click.Path(), help="Telemetry file (.parquet or .csv) with columns t, q.<label>, v.<label> "
-                                                  "(labels as in a `freefloat simulate` output) and optionally momentum.px ... momentum.Lz "
-                                                  "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).")
-@click.option("--simulate", "n_sim", type=int, help="Instead of --data: simulate N one-second excitation intervals of the "
-                                                     "Naveen, Shah, Misra robot (cycloids from the paper's Table 3 seeds) with the paper's rate noise.")
-@click.option("--trajectory", "traj_file", type=click.Path(exists=True, dir_okay=False),
-              help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
-                   "`freefloat excite`) with the paper's rate noise, and identify from that.")
-@click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="closed-form", show_default=True,
-              help="Minimal-parameter set: Naveen, Shah, Misra's closed form (revolute trees in modified-DH frames) "
-                   "or numeric (any robot).")
-@click.option("--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel').")
-@click.option("--h0", help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns "
-                              "(default: those, else zero).")
-@click.option("--weights", help="Weighted least squares: 'auto' (two steps: each momentum component weighted by the inverse "
-                                "of its residual variance) or six inverse variances for px,py,pz,Lx,Ly,Lz (default: unweighted).")
-@click.option("--rate-noise", help="Standard deviations of the white noise on the measured rates, 'base linear, base "
-                                   "angular, joint' (e.g. 50e-6,80e-6,50e-6, or 'paper' for those): removes the "
-                                   "errors-in-variables bias of least squares (with --simulate, 'paper' is the default).")
-@click.option("--full/--no-full", default=False, show_default=True,
-              help="Also compute a full, physically consistent set of standard parameters that reproduces the identified "
-                   "minimal ones (a convex program) and write it as OUT/identified.urdf.")
-@click.option("--prior", help="With --full/--validate: the model (built-in name or file) whose parameters choose the "
-                              "parts the data cannot see (default: MODEL itself; for naveen_dual_arm try naveen_dual_arm_offset).")
-@click.option("--validate/--no-validate", default=False, show_default=True,
-              help="Predict base twist and joint torques of the true (MODEL) and identified robots along the paper's "
-                   "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to Naveen, Shah, Misra "
-                   "Table 6. Implies --full.")
-@click.option("--truth/--no-truth", default=True, show_default=True,
-              help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).")
-@click.option("--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf).")
-def identify_minimal_cmd(model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, out):
+@click.option(
+    "--data",
+    type=click.Path(),
+    help="Telemetry file (.parquet or .csv) with columns t, q.<label>, v.<label> "
+    "(labels as in a `freefloat simulate` output) and optionally momentum.px ... momentum.Lz "
+    "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).",
+)
+@click.option(
+    "--simulate",
+    "n_sim",
+    type=int,
+    help="Instead of --data: simulate N one-second excitation intervals of the "
+    "Naveen, Shah, Misra robot (cycloids from the paper's Table 3 seeds) with the paper's rate noise.",
+)
+@click.option(
+    "--trajectory",
+    "traj_file",
+    type=click.Path(exists=True, dir_okay=False),
+    help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
+    "`freefloat excite`) with the paper's rate noise, and identify from that.",
+)
+@click.option(
+    "--method",
+    type=click.Choice(["closed-form", "numeric"]),
+    default="closed-form",
+    show_default=True,
+    help="Minimal-parameter set: Naveen, Shah, Misra's closed form (revolute trees in modified-DH frames) "
+    "or numeric (any robot).",
+)
+@click.option(
+    "--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel')."
+)
+@click.option(
+    "--h0",
+    help="Conserved total momentum [px,py,pz,Lx,Ly,Lz]; overrides the data's momentum columns "
+    "(default: those, else zero).",
+)
+@click.option(
+    "--weights",
+    help="Weighted least squares: 'auto' (two steps: each momentum component weighted by the inverse "
+    "of its residual variance) or six inverse variances for px,py,pz,Lx,Ly,Lz (default: unweighted).",
+)
+@click.option(
+    "--rate-noise",
+    help="Standard deviations of the white noise on the measured rates, 'base linear, base "
+    "angular, joint' (e.g. 50e-6,80e-6,50e-6, or 'paper' for those): removes the "
+    "errors-in-variables bias of least squares (with --simulate, 'paper' is the default).",
+)
+@click.option(
+    "--full/--no-full",
+    default=False,
+    show_default=True,
+    help="Also compute a full, physically consistent set of standard parameters that reproduces the identified "
+    "minimal ones (a convex program) and write it as OUT/identified.urdf.",
+)
+@click.option(
+    "--prior",
+    help="With --full/--validate: the model (built-in name or file) whose parameters choose the "
+    "parts the data cannot see (default: MODEL itself; for naveen_dual_arm try naveen_dual_arm_offset).",
+)
+@click.option(
+    "--validate/--no-validate",
+    default=False,
+    show_default=True,
+    help="Predict base twist and joint torques of the true (MODEL) and identified robots along the paper's "
+    "Fourier trajectory (Sec. VI.D, 40 s) and print the RMS errors next to Naveen, Shah, Misra "
+    "Table 6. Implies --full.",
+)
+@click.option(
+    "--truth/--no-truth",
+    default=True,
+    show_default=True,
+    help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).",
+)
+@click.option(
+    "--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf)."
+)
+def identify_minimal_cmd(
+    model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, out
+):
     """Estimate the minimal inertial parameters of MODEL from motion data.
 
     The robot floats freely, so its total momentum is conserved (zero when released at rest) or changes by the
@@ -72,7 +120,11 @@ def identify_minimal_cmd(model, data, n_sim, traj_file, method, known, h0, weigh
         raise click.UsageError("give exactly one of --data FILE, --simulate N and --trajectory FILE")
     known_list = None if known is None else [k for k in known.split(",") if k]
     h = None if h0 is None else parse_vector(h0, 6, "--h0", np.zeros(6))
-    w = None if weights is None else ("auto" if weights.strip() == "auto" else parse_vector(weights, 6, "--weights", None))
+    w = (
+        None
+        if weights is None
+        else ("auto" if weights.strip() == "auto" else parse_vector(weights, 6, "--weights", None))
+    )
     if rate_noise is None and (n_sim is not None or traj_file is not None) and w is None:
         rate_noise = "paper"  # the simulated data carries the paper's noise, so its levels are known
     if rate_noise is not None and rate_noise.strip() == "paper":
@@ -111,16 +163,26 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
     prior_model = None if prior is None else load_model(prior)
     click.echo("\nphysically consistent standard parameters (convex program) ...")
     ident, c, how = identified_model(m, res, prior_model)
-    click.echo(f"  reproduces the identified minimal parameters to {c.max_rel_deviation:.3g} relative "
-               f"(whitened misfit {c.misfit:.3g}); smallest pseudo-inertia eigenvalue {c.min_eigenvalue.min():.3g}; "
-               f"solver {c.solver}")
-    extra = {"consistent": {"parameters": c.parameters.tolist(), "max_rel_deviation": c.max_rel_deviation,
-                            "misfit": c.misfit, "solver": c.solver}}
+    click.echo(
+        f"  reproduces the identified minimal parameters to {c.max_rel_deviation:.3g} relative "
+        f"(whitened misfit {c.misfit:.3g}); smallest pseudo-inertia eigenvalue {c.min_eigenvalue.min():.3g}; "
+        f"solver {c.solver}"
+    )
+    extra = {
+        "consistent": {
+            "parameters": c.parameters.tolist(),
+            "max_rel_deviation": c.max_rel_deviation,
+            "misfit": c.misfit,
+            "solver": c.solver,
+        }
+    }
     if out:
         c.model(m).to_urdf(Path(out) / "identified.urdf")
         click.echo(f"  wrote {out}/identified.urdf")
     if validate:
-        click.echo(f"prediction along the Fourier trajectory of Sec. VI.D (40 s, both robots); identified robot: {how} ...")
+        click.echo(
+            f"prediction along the Fourier trajectory of Sec. VI.D (40 s, both robots); identified robot: {how} ..."
+        )
         pred = predict(m, ident, progress=True)
         click.echo(pred.table())
         extra["prediction"] = pred.to_dict() | {"identified_robot": how}

@@ -6,6 +6,7 @@ import click
 
 from .. import models
 
+
 @click.command("models")
 @click.option("--show", metavar="NAME", help="Print the YAML description of one built-in robot.")
 def models_cmd(show):

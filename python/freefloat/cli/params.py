@@ -21,11 +21,19 @@ def params_group():
 
 @params_group.command("minimal")
 @click.argument("model")
-@click.option("--method", type=click.Choice(["closed-form", "numeric"]), default="numeric", show_default=True,
-              help="'numeric': QR of the momentum regressor over random states (any robot). 'closed-form': seed "
-                   "001's grouping rules (revolute joints in modified-DH frames only), numbered like its Table 4.")
-@click.option("--known", help="Comma-separated body names whose parameters are known and not identified "
-                              "(default: bodies tagged 'known' or 'wheel'); pass '' for none.")
+@click.option(
+    "--method",
+    type=click.Choice(["closed-form", "numeric"]),
+    default="numeric",
+    show_default=True,
+    help="'numeric': QR of the momentum regressor over random states (any robot). 'closed-form': seed "
+    "001's grouping rules (revolute joints in modified-DH frames only), numbered like its Table 4.",
+)
+@click.option(
+    "--known",
+    help="Comma-separated body names whose parameters are known and not identified "
+    "(default: bodies tagged 'known' or 'wheel'); pass '' for none.",
+)
 @click.option("--out", help="Directory; gets results.json with names, expressions, values and rank.")
 def minimal_cmd(model, method, known, out):
     """Print the minimal (identifiable) inertial parameters of MODEL.
@@ -45,16 +53,26 @@ def minimal_cmd(model, method, known, out):
     values = mp.from_standard(m.parameters())
     ex = mp.expressions()
     known_names = [m.body_names[i] for i in mp.known]
-    click.echo(f"{m.name}: {mp.n_min} minimal parameters ({method}; rank {mp.rank} of {mp.matrix.shape[1]} "
-               f"standard columns); known bodies: {', '.join(known_names) or 'none'}")
+    click.echo(
+        f"{m.name}: {mp.n_min} minimal parameters ({method}; rank {mp.rank} of {mp.matrix.shape[1]} "
+        f"standard columns); known bodies: {', '.join(known_names) or 'none'}"
+    )
     w = max(len(n) for n in mp.names)
     for n, e, x in zip(mp.names, ex, values):
         click.echo(f"  {n:{w}s} = {x:14.6g}   = {e}")
     if out:
         d = Path(out)
         d.mkdir(parents=True, exist_ok=True)
-        res = {"model": m.name, "method": method, "rank": mp.rank, "n_standard": int(mp.matrix.shape[1]),
-               "known_bodies": known_names, "unknown_bodies": [m.body_names[i] for i in mp.unknown],
-               "names": mp.names, "expressions": ex, "values": values.tolist()}
+        res = {
+            "model": m.name,
+            "method": method,
+            "rank": mp.rank,
+            "n_standard": int(mp.matrix.shape[1]),
+            "known_bodies": known_names,
+            "unknown_bodies": [m.body_names[i] for i in mp.unknown],
+            "names": mp.names,
+            "expressions": ex,
+            "values": values.tolist(),
+        }
         (d / "results.json").write_text(json.dumps(res, indent=2))
         click.echo(f"  wrote {d / 'results.json'}")

@@ -11,19 +11,39 @@ import click
 @click.command("postcapture")
 @click.argument("scenario")
 @click.option("--out", help="Directory for results.json, table.txt and the figures.")
-@click.option("--noise/--no-noise", default=None,
-              help="Force measurement noise on (the scenario's `noise`, or the default study levels) or off.")
+@click.option(
+    "--noise/--no-noise",
+    default=None,
+    help="Force measurement noise on (the scenario's `noise`, or the default study levels) or off.",
+)
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
-@click.option("--sweep/--no-sweep", default=True, show_default=True,
-              help="For a scenario with a `sweep` section: also run the initial-velocity sweep (Figs. 6-9).")
-@click.option("--forgetting", type=float, help="Forgetting factor of the standard-parameter RLS (default: the scenario's, 1 = none).")
-@click.option("--project/--no-project", default=None,
-              help="Report the standard-parameter estimate projected onto physically consistent parameters.")
-@click.option("--accelerations", type=click.Choice(["exact", "central_difference"]),
-              help="Accelerations for the force form: exact at the samples (default) "
-                   "or central differences of the sampled velocities.")
-@click.option("--impulses", type=click.Choice(["simpson", "trapezoid"]),
-              help="Thrust impulses for the momentum form: Simpson on the 1 kHz thrust (default) or trapezoid on the samples.")
+@click.option(
+    "--sweep/--no-sweep",
+    default=True,
+    show_default=True,
+    help="For a scenario with a `sweep` section: also run the initial-velocity sweep (Figs. 6-9).",
+)
+@click.option(
+    "--forgetting",
+    type=float,
+    help="Forgetting factor of the standard-parameter RLS (default: the scenario's, 1 = none).",
+)
+@click.option(
+    "--project/--no-project",
+    default=None,
+    help="Report the standard-parameter estimate projected onto physically consistent parameters.",
+)
+@click.option(
+    "--accelerations",
+    type=click.Choice(["exact", "central_difference"]),
+    help="Accelerations for the force form: exact at the samples (default) "
+    "or central differences of the sampled velocities.",
+)
+@click.option(
+    "--impulses",
+    type=click.Choice(["simpson", "trapezoid"]),
+    help="Thrust impulses for the momentum form: Simpson on the 1 kHz thrust (default) or trapezoid on the samples.",
+)
 def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses):
     """Zhang, Yue, Yuan 2020: identify base and captured target online, in one step (momentum- and force-based).
 
@@ -59,12 +79,16 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
     wall = _time.perf_counter() - t0
     click.echo(res.table())
     r = res.residuals
-    click.echo(f"equations at the true parameters: momentum form max residual {r['momentum']['paper_angular']:.2e} "
-               f"(rhs up to {r['momentum']['paper_angular_scale']:.2e}), force form {r['force']['paper_angular']:.2e} "
-               f"(rhs up to {r['force']['paper_angular_scale']:.2e})")
-    click.echo(f"simulation + measurements + 4 estimators: {wall:.2f} s (simulation {res.timings['simulation']:.2f} s)"
-               + (f"; noise {sc.noise}" if sc.noise else "; noise-free")
-               + (f"; measurement {sc.measurement}" if sc.measurement else ""))
+    click.echo(
+        f"equations at the true parameters: momentum form max residual {r['momentum']['paper_angular']:.2e} "
+        f"(rhs up to {r['momentum']['paper_angular_scale']:.2e}), force form {r['force']['paper_angular']:.2e} "
+        f"(rhs up to {r['force']['paper_angular_scale']:.2e})"
+    )
+    click.echo(
+        f"simulation + measurements + 4 estimators: {wall:.2f} s (simulation {res.timings['simulation']:.2f} s)"
+        + (f"; noise {sc.noise}" if sc.noise else "; noise-free")
+        + (f"; measurement {sc.measurement}" if sc.measurement else "")
+    )
     sw = None
     if sweep and sc.sweep:
         vels = sc.sweep["velocities"]

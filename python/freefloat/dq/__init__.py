@@ -26,7 +26,20 @@ from .algebra import (
 )
 
 __all__ = [
-    "DualQuaternion", "from_pose", "identity", "vector", "exp", "screw", "dh", "dh_chain",
-    "line_of_sight", "approach_slope", "attitude", "distance_bound", "body_poses",
-    "condition_number", "algebra", "reactions",
+    "DualQuaternion",
+    "from_pose",
+    "identity",
+    "vector",
+    "exp",
+    "screw",
+    "dh",
+    "dh_chain",
+    "line_of_sight",
+    "approach_slope",
+    "attitude",
+    "distance_bound",
+    "body_poses",
+    "condition_number",
+    "algebra",
+    "reactions",
 ]

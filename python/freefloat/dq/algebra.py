@@ -24,8 +24,19 @@ from .. import _core
 from .._core import DualQuaternion
 
 __all__ = [
-    "DualQuaternion", "from_pose", "identity", "vector", "exp", "screw", "dh", "dh_chain",
-    "line_of_sight", "approach_slope", "attitude", "distance_bound", "body_poses",
+    "DualQuaternion",
+    "from_pose",
+    "identity",
+    "vector",
+    "exp",
+    "screw",
+    "dh",
+    "dh_chain",
+    "line_of_sight",
+    "approach_slope",
+    "attitude",
+    "distance_bound",
+    "body_poses",
     "condition_number",
 ]
 
@@ -111,4 +122,3 @@ def condition_number(model, q):
     """2-norm condition number of the dissertation's system matrix S (6.17) of the dual-quaternion dynamics at
     configuration ``q`` (or each row of a (T, nq) array): the quantity of its Figs. 5.5 and 7.x."""
     return _core.dq_condition_number(model, q)
-

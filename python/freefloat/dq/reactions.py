@@ -26,8 +26,8 @@ class Reactions:
     t: np.ndarray
     joint_names: list[str]
     joint_types: list[str]
-    wrench: np.ndarray     # (T, nbodies, 6)
-    reaction: np.ndarray   # (T, nbodies, 6)
+    wrench: np.ndarray  # (T, nbodies, 6)
+    reaction: np.ndarray  # (T, nbodies, 6)
     max_acceleration_mismatch: float  # max |a_dq - traj.ddq| / max(1, |traj.ddq|), a consistency check
 
     def peaks(self) -> list[dict]:
@@ -36,9 +36,16 @@ class Reactions:
             f = np.linalg.norm(self.reaction[:, i, :3], axis=1)
             tq = np.linalg.norm(self.reaction[:, i, 3:], axis=1)
             kf, kt = int(np.argmax(f)), int(np.argmax(tq))
-            out.append({"joint": name, "type": self.joint_types[i], "peak_force": float(f[kf]),
-                        "t_peak_force": float(self.t[kf]), "peak_torque": float(tq[kt]),
-                        "t_peak_torque": float(self.t[kt])})
+            out.append(
+                {
+                    "joint": name,
+                    "type": self.joint_types[i],
+                    "peak_force": float(f[kf]),
+                    "t_peak_force": float(self.t[kf]),
+                    "peak_torque": float(tq[kt]),
+                    "t_peak_torque": float(self.t[kt]),
+                }
+            )
         return out
 
 
@@ -49,8 +56,9 @@ def reaction_part(model, W: np.ndarray, q: np.ndarray | None = None) -> np.ndarr
     axes = np.asarray(model.joint_axes, float)
     if "universal" in model.joint_types:
         if q is None:
-            raise ValueError("reaction_part: the model has universal joints, whose motion directions depend on q; "
-                             "pass q")
+            raise ValueError(
+                "reaction_part: the model has universal joints, whose motion directions depend on q; pass q"
+            )
         q = np.asarray(q, float)
         axes2 = np.asarray(model.joint_axes2, float)
     for i, kind in enumerate(model.joint_types):
@@ -85,8 +93,14 @@ def along(model, traj, fext=None) -> Reactions:
     a, W = dq_dynamics(model, traj.q, traj.v, traj.tau, fext)
     scale = max(1.0, float(np.abs(traj.ddq).max())) if traj.ddq.size else 1.0
     mismatch = float(np.abs(a - traj.ddq).max()) / scale if a.size else 0.0
-    return Reactions(np.asarray(traj.t), list(model.joint_names), list(model.joint_types), W,
-                     reaction_part(model, W, traj.q), mismatch)
+    return Reactions(
+        np.asarray(traj.t),
+        list(model.joint_names),
+        list(model.joint_types),
+        W,
+        reaction_part(model, W, traj.q),
+        mismatch,
+    )
 
 
 def plot(r: Reactions, path, title: str | None = None):

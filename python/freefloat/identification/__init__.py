@@ -30,7 +30,18 @@ from .identify import IdentificationResult, identify_minimal
 from .minimal import MinimalParameters, minimal_parameters
 
 __all__ = [
-    "IdentificationResult", "MinimalParameters", "comparison", "consistent", "estimation", "excitation",
-    "excitation_results", "identify",
-    "identify_minimal", "minimal", "minimal_parameters", "online", "pruning", "validation",
+    "IdentificationResult",
+    "MinimalParameters",
+    "comparison",
+    "consistent",
+    "estimation",
+    "excitation",
+    "excitation_results",
+    "identify",
+    "identify_minimal",
+    "minimal",
+    "minimal_parameters",
+    "online",
+    "pruning",
+    "validation",
 ]

@@ -9,8 +9,9 @@ from .._core import NumericalError
 from ..constants import PAPER_RATE_NOISE
 
 
-def compare(true_model, result, seeds=(0,), rate_noise=PAPER_RATE_NOISE, progress: bool = False,
-            extra: dict | None = None) -> dict:
+def compare(
+    true_model, result, seeds=(0,), rate_noise=PAPER_RATE_NOISE, progress: bool = False, extra: dict | None = None
+) -> dict:
     """Identify `true_model`'s minimal parameters with the paper's rate noise along (a) the designed trajectory,
     (b) the same number of un-designed intervals — the first K direction combinations with arbitrary seeds
     (mid-range start, half the maximal range, scaled into the limits) — and (c) the un-pruned step-1 trajectory
@@ -38,23 +39,41 @@ def compare(true_model, result, seeds=(0,), rate_noise=PAPER_RATE_NOISE, progres
                 try:
                     r = identify_minimal(true_model, telem, **kw)
                     e = r.errors(true_model)
-                    row.update({f"{label}_median_pct": e["median_rel_error_pct"], f"{label}_max_pct": e["max_rel_error_pct"],
-                                "condition_number": r.fit.condition_number})
+                    row.update(
+                        {
+                            f"{label}_median_pct": e["median_rel_error_pct"],
+                            f"{label}_max_pct": e["max_rel_error_pct"],
+                            "condition_number": r.fit.condition_number,
+                        }
+                    )
                 except NumericalError as err:  # unexcited parameters: say so instead of a number
-                    row.update({f"{label}_median_pct": float("nan"), f"{label}_max_pct": float("nan"),
-                                "error": str(err).splitlines()[0]})
+                    row.update(
+                        {
+                            f"{label}_median_pct": float("nan"),
+                            f"{label}_max_pct": float("nan"),
+                            "error": str(err).splitlines()[0],
+                        }
+                    )
             rows.append(row)
-        out[name] = {k: float(np.mean([r[k] for r in rows])) if isinstance(rows[0][k], float) else rows[0][k]
-                     for k in rows[0]}
+        out[name] = {
+            k: float(np.mean([r[k] for r in rows])) if isinstance(rows[0][k], float) else rows[0][k] for k in rows[0]
+        }
     return out
 
 
 def comparison_table(cmp: dict) -> str:
-    lines = [f"{'trajectory':40s} {'duration':>9s} {'κ(true)':>9s} {'LS median':>10s} {'LS max':>10s} " f"{'BC median':>10s} {'BC max':>10s}"]
+    lines = [
+        f"{'trajectory':40s} {'duration':>9s} {'κ(true)':>9s} {'LS median':>10s} {'LS max':>10s} "
+        f"{'BC median':>10s} {'BC max':>10s}"
+    ]
     for name, r in cmp.items():
-        lines.append(f"{name:40s} {r['duration_s']:8.0f}s {r.get('condition_number', float('nan')):9.4g} "
-                     f"{r['ls_median_pct']:9.4g}% {r['ls_max_pct']:9.4g}% {r['bias_compensated_median_pct']:9.4g}% "
-                     f"{r['bias_compensated_max_pct']:9.4g}%")
-    lines.append("LS: least squares; BC: with the errors-in-variables bias removed (docs/identification.md); "
-                 "paper Table 5 Case 1: 2.08 % / 174 %")
+        lines.append(
+            f"{name:40s} {r['duration_s']:8.0f}s {r.get('condition_number', float('nan')):9.4g} "
+            f"{r['ls_median_pct']:9.4g}% {r['ls_max_pct']:9.4g}% {r['bias_compensated_median_pct']:9.4g}% "
+            f"{r['bias_compensated_max_pct']:9.4g}%"
+        )
+    lines.append(
+        "LS: least squares; BC: with the errors-in-variables bias removed (docs/identification.md); "
+        "paper Table 5 Case 1: 2.08 % / 174 %"
+    )
     return "\n".join(lines)

@@ -41,11 +41,11 @@ FEASIBLE_MISFIT, MISFIT_SLACK_REL = 1e-6, 1e-6
 class ConsistentEstimate:
     """Physically consistent standard parameters reproducing (as nearly as possible) identified minimal ones."""
 
-    parameters: np.ndarray     # (nbodies, 10) in the model's body order; known bodies unchanged
-    minimal: np.ndarray        # (n_min,) the minimal parameters these standard parameters map to
-    target: np.ndarray         # (n_min,) the identified minimal parameters they were fitted to
-    misfit: float              # whitened residual norm ‖L (B P − φ̂)‖ (≈ number of standard deviations)
-    max_rel_deviation: float   # max_i |(B P − φ̂)_i| / |φ̂_i| over nonzero φ̂_i
+    parameters: np.ndarray  # (nbodies, 10) in the model's body order; known bodies unchanged
+    minimal: np.ndarray  # (n_min,) the minimal parameters these standard parameters map to
+    target: np.ndarray  # (n_min,) the identified minimal parameters they were fitted to
+    misfit: float  # whitened residual norm ‖L (B P − φ̂)‖ (≈ number of standard deviations)
+    max_rel_deviation: float  # max_i |(B P − φ̂)_i| / |φ̂_i| over nonzero φ̂_i
     min_eigenvalue: np.ndarray  # (n_unknown,) smallest eigenvalue of each unknown body's pseudo-inertia
     solver: str
 
@@ -121,7 +121,9 @@ def consistent_parameters(mp, phi, covariance=None, prior=None, solver: str | No
     minimal = mp.from_standard(P)
     nz = phi != 0
     return ConsistentEstimate(
-        parameters=P, minimal=minimal, target=phi,
+        parameters=P,
+        minimal=minimal,
+        target=phi,
         misfit=float(np.linalg.norm(L @ (minimal - phi))),
         max_rel_deviation=float(np.max(np.abs((minimal - phi)[nz] / phi[nz]))) if nz.any() else 0.0,
         min_eigenvalue=np.array([np.linalg.eigvalsh(pseudo_inertia(P[b]))[0] for b in mp.unknown]),

@@ -24,14 +24,14 @@ from .._core import InputError, NumericalError
 class LeastSquaresResult:
     """Estimate of the minimal parameters with its statistics (order and names as `mp.names`)."""
 
-    estimate: np.ndarray          # (n_min,)  phi_m hat
-    std: np.ndarray               # (n_min,)  sqrt(diag(covariance))
-    covariance: np.ndarray        # (n_min, n_min)  sigma^2 (G^T W G)^-1
-    rss: float                    # weighted residual sum of squares
-    dof: int                      # rows - n_min
-    condition_number: float       # 2-norm condition number of the weighted regressor G_m
-    rows: int                     # 6 x samples
-    method: str                   # "normal equations + refinement" or "streaming QR"
+    estimate: np.ndarray  # (n_min,)  phi_m hat
+    std: np.ndarray  # (n_min,)  sqrt(diag(covariance))
+    covariance: np.ndarray  # (n_min, n_min)  sigma^2 (G^T W G)^-1
+    rss: float  # weighted residual sum of squares
+    dof: int  # rows - n_min
+    condition_number: float  # 2-norm condition number of the weighted regressor G_m
+    rows: int  # 6 x samples
+    method: str  # "normal equations + refinement" or "streaming QR"
     names: list = field(default_factory=list)
 
     @property
@@ -71,15 +71,27 @@ def least_squares(model, Q, V, H, mp, P_known=None, weights=None, method: str = 
     w = None if weights is None else np.ascontiguousarray(weights, dtype=float)
     try:
         out = _core.identify_momentum(
-            model, np.ascontiguousarray(Q, dtype=float), np.ascontiguousarray(V, dtype=float),
-            np.ascontiguousarray(H, dtype=float), absolute_columns(mp).tolist(), known_parameters(mp, P_known), w,
+            model,
+            np.ascontiguousarray(Q, dtype=float),
+            np.ascontiguousarray(V, dtype=float),
+            np.ascontiguousarray(H, dtype=float),
+            absolute_columns(mp).tolist(),
+            known_parameters(mp, P_known),
+            w,
             method,
         )
     except NumericalError as e:  # name the unexcited parameters: x[k] -> x[k](base.Ixx)
         raise NumericalError(re.sub(r"x\[(\d+)\]", lambda g: f"{g[0]}({mp.names[int(g[1])]})", str(e))) from None
     return LeastSquaresResult(
-        estimate=out["x"], std=out["std"], covariance=out["covariance"], rss=out["rss"], dof=out["dof"],
-        condition_number=out["condition_number"], rows=out["rows"], method=out["method"], names=list(mp.names),
+        estimate=out["x"],
+        std=out["std"],
+        covariance=out["covariance"],
+        rss=out["rss"],
+        dof=out["dof"],
+        condition_number=out["condition_number"],
+        rows=out["rows"],
+        method=out["method"],
+        names=list(mp.names),
     )
 
 

@@ -46,9 +46,26 @@ from .minimal import minimal_parameters
 from .pruning import MIN_GAIN, PruneResult, plot_fig4, prune_intervals, significant
 
 __all__ = [
-    "PAPER_KAPPA", "PAPER_KEPT", "DELTA", "KAPPA_UNEXCITED", "MIN_GAIN", "PAPER_RATE_NOISE", "U_MAX", "WEIGHT", "DesignResult", "ExcitationDesign",
-    "Limits", "PruneResult", "StepResult", "compare", "comparison_table", "load_trajectory", "plot_fig4",
-    "prune_intervals", "save_trajectory", "significant",
+    "PAPER_KAPPA",
+    "PAPER_KEPT",
+    "DELTA",
+    "KAPPA_UNEXCITED",
+    "MIN_GAIN",
+    "PAPER_RATE_NOISE",
+    "U_MAX",
+    "WEIGHT",
+    "DesignResult",
+    "ExcitationDesign",
+    "Limits",
+    "PruneResult",
+    "StepResult",
+    "compare",
+    "comparison_table",
+    "load_trajectory",
+    "plot_fig4",
+    "prune_intervals",
+    "save_trajectory",
+    "significant",
 ]
 
 #: Algorithm 1 settings (U_MAX, DELTA: the paper's Sec. VI.B) and our MIN_GAIN are in `pruning`.
@@ -58,6 +75,7 @@ WEIGHT = 1000.0
 #: uses cannot resolve singular values below ~1e-8 of the largest)
 KAPPA_UNEXCITED = 1e8
 
+
 class ExcitationDesign:
     """The design problem for a robot with guessed parameters `guess` (a Model).
 
@@ -65,8 +83,18 @@ class ExcitationDesign:
     predetermined wheel seeds (default: tagged wheel).  grid: points per interval for the base response;
     samples: regressor samples per interval (grid must be a multiple)."""
 
-    def __init__(self, guess, arm=None, wheels=None, limits: Limits | None = None, interval: float = 1.0,
-                 grid: int = 10, samples: int = 5, weight: float = WEIGHT, threads: int = 2):
+    def __init__(
+        self,
+        guess,
+        arm=None,
+        wheels=None,
+        limits: Limits | None = None,
+        interval: float = 1.0,
+        grid: int = 10,
+        samples: int = 5,
+        weight: float = WEIGHT,
+        threads: int = 2,
+    ):
         self.guess = guess
         self.arm = guess.joints_tagged("arm_") if arm is None else list(arm)
         self.wheels = guess.joints_tagged("wheel") if wheels is None else list(wheels)
@@ -81,7 +109,13 @@ class ExcitationDesign:
         self.limits.check(self.n_arm)
         if grid % samples != 0 or samples < 1:
             raise InputError(f"ExcitationDesign: grid ({grid}) must be a multiple of samples ({samples})")
-        self.interval, self.grid, self.samples, self.weight, self.threads = float(interval), grid, samples, float(weight), threads
+        self.interval, self.grid, self.samples, self.weight, self.threads = (
+            float(interval),
+            grid,
+            samples,
+            float(weight),
+            threads,
+        )
         self.stride = grid // samples
         self.offset = self.stride // 2
         _check_physical(guess)
@@ -126,15 +160,39 @@ class ExcitationDesign:
         return self._objective(np.array(Q), np.array(QD))
 
     def _objective(self, Q, QD) -> dict:
-        return _core.excitation_objective(self.guess, self.q0, self.iq, self.iv, self.interval / self.grid, Q, QD,
-                                          self.stride, self.offset, self.columns, self.weight, self.n_arm, self.threads)
+        return _core.excitation_objective(
+            self.guess,
+            self.q0,
+            self.iq,
+            self.iv,
+            self.interval / self.grid,
+            Q,
+            QD,
+            self.stride,
+            self.offset,
+            self.columns,
+            self.weight,
+            self.n_arm,
+            self.threads,
+        )
 
     def rows(self, x, directions=None) -> np.ndarray:
         """Minimal-regressor rows along the trajectory, (intervals, 6·samples, n_min)."""
         dirs = self.all_directions if directions is None else np.asarray(directions)
         q, qd, _ = self.cycloid(x, dirs).evaluate(self._grid(len(dirs)))
-        r = _core.excitation_rows(self.guess, self.q0, self.iq, self.iv, self.interval / self.grid, q, qd,
-                                  self.stride, self.offset, self.columns, self.n_arm)["rows"]
+        r = _core.excitation_rows(
+            self.guess,
+            self.q0,
+            self.iq,
+            self.iv,
+            self.interval / self.grid,
+            q,
+            qd,
+            self.stride,
+            self.offset,
+            self.columns,
+            self.n_arm,
+        )["rows"]
         return r.reshape(len(dirs), 6 * self.samples, self.n_min)
 
     # -- constraints (eqs. 33-37) -----------------------------------------------------------------------
@@ -147,11 +205,11 @@ class ExcitationDesign:
         A, b = [], []
         for j in range(n):
             up = np.zeros(2 * n)
-            up[j], up[n + j] = -1.0, -cmax[j]          # q_max − θ_s − cmax θ_d >= 0
+            up[j], up[n + j] = -1.0, -cmax[j]  # q_max − θ_s − cmax θ_d >= 0
             A.append(up)
             b.append(-self.limits.q_max[j])
             lo = np.zeros(2 * n)
-            lo[j], lo[n + j] = 1.0, cmin[j]            # θ_s + cmin θ_d − q_min >= 0
+            lo[j], lo[n + j] = 1.0, cmin[j]  # θ_s + cmin θ_d − q_min >= 0
             A.append(lo)
             b.append(self.limits.q_min[j])
         return np.array(A), np.array(b)
@@ -159,8 +217,7 @@ class ExcitationDesign:
     def bounds(self) -> list:
         """θ_s within the position limits; 0 < θ_d <= θ_d^max (eqs. 36-37)."""
         rmax = self.limits.range_max(self.interval)
-        return ([(lo, hi) for lo, hi in zip(self.limits.q_min, self.limits.q_max)]
-                + [(1e-3 * r, r) for r in rmax])
+        return [(lo, hi) for lo, hi in zip(self.limits.q_min, self.limits.q_max)] + [(1e-3 * r, r) for r in rmax]
 
     def feasible_start(self, directions, x0=None) -> np.ndarray:
         """A feasible seed vector: x0 (default mid-range start, half the maximal range) with the ranges scaled down
@@ -194,11 +251,20 @@ class ExcitationDesign:
         lo, hi = np.array(self.bounds()).T
         x = self.feasible_start(dirs, np.clip(x, lo, hi))
         r = self.evaluate(x, dirs)
-        return StepResult(x=x, objective=float(r["objective"][0]), condition_number=float(r["condition_number"][0]),
-                          mean_square=float(r["mean_square"][0]), iterations=int(res.nit), evaluations=count,
-                          message=str(res.message), significant=significant(r["singular_values"][0], DELTA))
+        return StepResult(
+            x=x,
+            objective=float(r["objective"][0]),
+            condition_number=float(r["condition_number"][0]),
+            mean_square=float(r["mean_square"][0]),
+            iterations=int(res.nit),
+            evaluations=count,
+            message=str(res.message),
+            significant=significant(r["singular_values"][0], DELTA),
+        )
 
-    def prune(self, x, directions=None, u_max: int = U_MAX, delta: float = DELTA, min_gain: float = MIN_GAIN) -> PruneResult:
+    def prune(
+        self, x, directions=None, u_max: int = U_MAX, delta: float = DELTA, min_gain: float = MIN_GAIN
+    ) -> PruneResult:
         """Algorithm 1 with the reference rank and condition number updated on acceptance."""
         dirs = self.all_directions if directions is None else np.asarray(directions)
         blocks = self.rows(x, dirs)
@@ -220,9 +286,11 @@ class ExcitationDesign:
         s3 = self._run_step("step 3/3: SQP on the kept intervals", kept_dirs, s1.x, maxiter, progress)
         timings["step3"] = time.perf_counter() - t0
         if not s3.condition_number < KAPPA_UNEXCITED:
-            raise NumericalError(f"the designed trajectory does not excite every minimal parameter of '{self.guess.name}' "
-                                 f"(κ = {s3.condition_number:.3g} after step 3, {self.n_min} parameters): drive more joints, "
-                                 "widen the joint limits, or declare the unreachable bodies known")
+            raise NumericalError(
+                f"the designed trajectory does not excite every minimal parameter of '{self.guess.name}' "
+                f"(κ = {s3.condition_number:.3g} after step 3, {self.n_min} parameters): drive more joints, "
+                "widen the joint limits, or declare the unreachable bodies known"
+            )
         return DesignResult(design=self, step1=s1, prune=pr, step3=s3, directions=kept_dirs, timings=timings)
 
     # -- the paper's baseline: a 5-term Fourier series per arm joint ------------------------------------------
@@ -234,13 +302,19 @@ class ExcitationDesign:
         n, k = self.n_arm, 2 * n_terms + 1
         c = np.asarray(c, dtype=float).reshape(n, k)
         duration = len(directions) * self.interval
-        arm = Fourier(c[:, 1:1 + n_terms], c[:, 1 + n_terms:], c[:, 0], omega_f=2 * np.pi / duration, n_h=n_terms)
+        arm = Fourier(c[:, 1 : 1 + n_terms], c[:, 1 + n_terms :], c[:, 0], omega_f=2 * np.pi / duration, n_h=n_terms)
         nw = len(self.wheels)
-        wheels = Cycloidal(np.full(nw, WHEEL_START), np.full(nw, WHEEL_RANGE), np.asarray(directions)[:, self.n_arm:],
-                           interval=self.interval)
+        wheels = Cycloidal(
+            np.full(nw, WHEEL_START),
+            np.full(nw, WHEEL_RANGE),
+            np.asarray(directions)[:, self.n_arm :],
+            interval=self.interval,
+        )
         return Stacked(arm, wheels)
 
-    def fourier_baseline(self, directions, n_terms: int = 5, maxiter: int = 60, grid: int = 200, progress=None) -> tuple:
+    def fourier_baseline(
+        self, directions, n_terms: int = 5, maxiter: int = 60, grid: int = 200, progress=None
+    ) -> tuple:
         """Optimise a 5-term Fourier series per arm joint (11 variables each, 5.5× the cycloid's 2) on the same
         objective (eq. 32) over the same duration; limits enforced on `grid` time points (linear in the
         coefficients).  Returns (StepResult with x = coefficients, trajectory)."""
@@ -251,19 +325,27 @@ class ExcitationDesign:
         tg = np.linspace(0.0, duration, grid)
         i = np.arange(1, n_terms + 1)
         S, C = np.sin(np.outer(tg, i * w)), np.cos(np.outer(tg, i * w))
-        rows_q = np.hstack([np.ones((grid, 1)), S, C])                    # q  = rows_q  @ c_j
+        rows_q = np.hstack([np.ones((grid, 1)), S, C])  # q  = rows_q  @ c_j
         rows_v = np.hstack([np.zeros((grid, 1)), C * (i * w), -S * (i * w)])
         rows_a = np.hstack([np.zeros((grid, 1)), -S * (i * w) ** 2, -C * (i * w) ** 2])
         L = self.limits
         A, b = [], []
         for j in range(n):
+
             def blk(rows, j=j):
                 M = np.zeros((grid, n * k))
-                M[:, j * k:(j + 1) * k] = rows
+                M[:, j * k : (j + 1) * k] = rows
                 return M
+
             A += [blk(rows_q), -blk(rows_q), blk(rows_v), -blk(rows_v), blk(rows_a), -blk(rows_a)]
-            b += [np.full(grid, L.q_min[j]), np.full(grid, -L.q_max[j]), np.full(grid, -L.qd_max[j]),
-                  np.full(grid, -L.qd_max[j]), np.full(grid, -L.qdd_max[j]), np.full(grid, -L.qdd_max[j])]
+            b += [
+                np.full(grid, L.q_min[j]),
+                np.full(grid, -L.q_max[j]),
+                np.full(grid, -L.qd_max[j]),
+                np.full(grid, -L.qd_max[j]),
+                np.full(grid, -L.qdd_max[j]),
+                np.full(grid, -L.qdd_max[j]),
+            ]
         A, b = np.vstack(A), np.concatenate(b)
         # Start: mid-range offsets; joint j gets a sine on harmonic (j mod N) + 1 and a cosine on the next, at a
         # quarter of what the limits allow, so the joints do not move in lockstep.
@@ -271,8 +353,9 @@ class ExcitationDesign:
         c0[:, 0] = 0.5 * (L.q_min + L.q_max)
         for j in range(n):
             hs, hc = j % n_terms, (j + 1) % n_terms
-            amp = lambda h, j=j: min(0.5 * (L.q_max[j] - L.q_min[j]), L.qd_max[j] / ((h + 1) * w),
-                                L.qdd_max[j] / ((h + 1) * w) ** 2) / 4
+            amp = lambda h, j=j: (
+                min(0.5 * (L.q_max[j] - L.q_min[j]), L.qd_max[j] / ((h + 1) * w), L.qdd_max[j] / ((h + 1) * w) ** 2) / 4
+            )
             c0[j, 1 + hs] = amp(hs)
             c0[j, 1 + n_terms + hc] = amp(hc)
         t = self._grid(len(dirs))
@@ -284,9 +367,16 @@ class ExcitationDesign:
         res, count = _slsqp(evaluate, c0.ravel(), A, b, None, maxiter, progress)
         x = np.asarray(res.x)
         r = evaluate(x[None])
-        step = StepResult(x=x, objective=float(r["objective"][0]), condition_number=float(r["condition_number"][0]),
-                          mean_square=float(r["mean_square"][0]), iterations=int(res.nit), evaluations=count,
-                          message=str(res.message), significant=significant(r["singular_values"][0], DELTA))
+        step = StepResult(
+            x=x,
+            objective=float(r["objective"][0]),
+            condition_number=float(r["condition_number"][0]),
+            mean_square=float(r["mean_square"][0]),
+            iterations=int(res.nit),
+            evaluations=count,
+            message=str(res.message),
+            significant=significant(r["singular_values"][0], DELTA),
+        )
         return step, self.fourier(x, dirs, n_terms)
 
     def _run_step(self, desc, dirs, x0, maxiter, progress):
@@ -332,9 +422,16 @@ def _slsqp(evaluate, x0, A, b, bounds, maxiter: int, progress):
         if progress is not None:
             progress(it[0], float(np.exp(fun_and_grad(xk)[0])))
 
-    res = minimize(lambda x: fun_and_grad(x)[0], x0, jac=lambda x: fun_and_grad(x)[1], method="SLSQP", bounds=bounds,
-                   constraints=[{"type": "ineq", "fun": lambda x: A @ x - b, "jac": lambda x: A}],
-                   options={"maxiter": maxiter, "ftol": 1e-9}, callback=callback)
+    res = minimize(
+        lambda x: fun_and_grad(x)[0],
+        x0,
+        jac=lambda x: fun_and_grad(x)[1],
+        method="SLSQP",
+        bounds=bounds,
+        constraints=[{"type": "ineq", "fun": lambda x: A @ x - b, "jac": lambda x: A}],
+        options={"maxiter": maxiter, "ftol": 1e-9},
+        callback=callback,
+    )
     return res, count[0]
 
 
@@ -349,7 +446,7 @@ def _check_physical(guess) -> None:
     P = guess.parameters()
     bad = [guess.body_names[b] for b in range(guess.nbodies) if not is_consistent(P[b])]
     if bad:
-        raise InputError(f"guess '{guess.name}': non-physical inertias for {', '.join(bad)}; the base response "
-                         "would be meaningless. Use a physically consistent guess (e.g. naveen_dual_arm_offset)")
-
-
+        raise InputError(
+            f"guess '{guess.name}': non-physical inertias for {', '.join(bad)}; the base response "
+            "would be meaningless. Use a physically consistent guess (e.g. naveen_dual_arm_offset)"
+        )

@@ -30,12 +30,14 @@ class Limits:
     qdd_max: np.ndarray
 
     @classmethod
-    def naveen(cls, n: int = 6) -> "Limits":
+    def naveen(cls, n: int = 6) -> Limits:
         """Our documented choice for the Naveen, Shah, Misra arms (the paper gives none)."""
-        return cls(np.full(n, -1.5 * np.pi), np.full(n, 1.5 * np.pi), np.full(n, 1.6 * np.pi), np.full(n, 1.6 * np.pi**2))
+        return cls(
+            np.full(n, -1.5 * np.pi), np.full(n, 1.5 * np.pi), np.full(n, 1.6 * np.pi), np.full(n, 1.6 * np.pi**2)
+        )
 
     @classmethod
-    def seed001(cls, n: int = 6) -> "Limits":
+    def seed001(cls, n: int = 6) -> Limits:
         """Earlier name of `naveen` (kept as an alias)."""
         return cls.naveen(n)
 
@@ -51,10 +53,15 @@ class Limits:
             setattr(self, name, a)
         bad = np.flatnonzero(self.q_max <= self.q_min)
         if bad.size:
-            raise InputError(f"Limits: joint {bad[0]} has no feasible position range " f"(q_max {self.q_max[bad[0]]} <= q_min {self.q_min[bad[0]]}); widen it")
+            raise InputError(
+                f"Limits: joint {bad[0]} has no feasible position range "
+                f"(q_max {self.q_max[bad[0]]} <= q_min {self.q_min[bad[0]]}); widen it"
+            )
         bad = np.flatnonzero((self.qd_max <= 0) | (self.qdd_max <= 0))
         if bad.size:
-            raise InputError(f"Limits: joint {bad[0]} has a non-positive rate or acceleration limit; no motion is feasible")
+            raise InputError(
+                f"Limits: joint {bad[0]} has a non-positive rate or acceleration limit; no motion is feasible"
+            )
 
 
 @dataclass
@@ -73,11 +80,11 @@ class StepResult:
 
 @dataclass
 class DesignResult:
-    design: "ExcitationDesign"
+    design: ExcitationDesign
     step1: StepResult
     prune: PruneResult
     step3: StepResult
-    directions: np.ndarray          # surviving direction combinations (K, n_arm + n_wheels)
+    directions: np.ndarray  # surviving direction combinations (K, n_arm + n_wheels)
     timings: dict = field(default_factory=dict)
 
     def trajectory(self) -> Cycloidal:
@@ -90,31 +97,44 @@ class DesignResult:
         n = d.n_arm
         s, r = self.step3.x[:n], self.step3.x[n:]
         head = f"{'seed':10s}" + "".join(f"{j:>10s}" for j in d.arm)
-        lines = ["optimal seed parameters (Naveen, Shah, Misra Table 3 format)", head,
-                 f"{'start deg':10s}" + "".join(f"{np.rad2deg(v):10.3f}" for v in s),
-                 f"{'range rad':10s}" + "".join(f"{v:10.3f}" for v in r),
-                 f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_START_DEG),
-                 f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_RANGE_RAD)]
+        lines = [
+            "optimal seed parameters (Naveen, Shah, Misra Table 3 format)",
+            head,
+            f"{'start deg':10s}" + "".join(f"{np.rad2deg(v):10.3f}" for v in s),
+            f"{'range rad':10s}" + "".join(f"{v:10.3f}" for v in r),
+            f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_START_DEG),
+            f"{'paper':10s}" + "".join(f"{v:10.3f}" for v in TABLE3_RANGE_RAD),
+        ]
         return "\n".join(lines)
 
     def summary(self) -> str:
         k = len(self.prune.kept)
-        return (f"step 1: {self.design.n_intervals} intervals, κ = {self.step1.condition_number:.4g} "
-                f"({self.step1.iterations} SQP iterations)\n"
-                f"step 2: pruning kept {k} of {self.design.n_intervals} intervals (paper: {PAPER_KEPT} of 256)\n"
-                f"step 3: κ = {self.step3.condition_number:.4g} on the kept intervals (paper: {PAPER_KAPPA}); "
-                f"significant singular values {self.step3.significant} of {self.design.n_min}; "
-                f"duration {k * self.design.interval:g} s")
+        return (
+            f"step 1: {self.design.n_intervals} intervals, κ = {self.step1.condition_number:.4g} "
+            f"({self.step1.iterations} SQP iterations)\n"
+            f"step 2: pruning kept {k} of {self.design.n_intervals} intervals (paper: {PAPER_KEPT} of 256)\n"
+            f"step 3: κ = {self.step3.condition_number:.4g} on the kept intervals (paper: {PAPER_KAPPA}); "
+            f"significant singular values {self.step3.significant} of {self.design.n_min}; "
+            f"duration {k * self.design.interval:g} s"
+        )
 
     def to_dict(self) -> dict:
         d = self.design
         return {
-            "model": d.guess.name, "arm_joints": d.arm, "wheels": d.wheels, "interval": d.interval,
-            "step1": _step_dict(self.step1, d.n_arm), "step3": _step_dict(self.step3, d.n_arm),
-            "kept_intervals": self.prune.kept.tolist(), "n_kept": int(len(self.prune.kept)),
-            "n_candidates": d.n_intervals, "significant_singular_values": self.step3.significant,
-            "n_min": d.n_min, "paper": {"condition_number": PAPER_KAPPA, "kept": PAPER_KEPT},
-            "weight": d.weight, "limits": {k: np.asarray(v).tolist() for k, v in d.limits.__dict__.items()},
+            "model": d.guess.name,
+            "arm_joints": d.arm,
+            "wheels": d.wheels,
+            "interval": d.interval,
+            "step1": _step_dict(self.step1, d.n_arm),
+            "step3": _step_dict(self.step3, d.n_arm),
+            "kept_intervals": self.prune.kept.tolist(),
+            "n_kept": int(len(self.prune.kept)),
+            "n_candidates": d.n_intervals,
+            "significant_singular_values": self.step3.significant,
+            "n_min": d.n_min,
+            "paper": {"condition_number": PAPER_KAPPA, "kept": PAPER_KEPT},
+            "weight": d.weight,
+            "limits": {k: np.asarray(v).tolist() for k, v in d.limits.__dict__.items()},
             "timings_s": self.timings,
         }
 
@@ -129,6 +149,13 @@ class DesignResult:
 
 
 def _step_dict(s: StepResult, n: int) -> dict:
-    return {"start_rad": s.x[:n].tolist(), "range_rad": s.x[n:].tolist(), "objective": s.objective,
-            "condition_number": s.condition_number, "mean_square": s.mean_square, "iterations": s.iterations,
-            "evaluations": s.evaluations, "message": s.message}
+    return {
+        "start_rad": s.x[:n].tolist(),
+        "range_rad": s.x[n:].tolist(),
+        "objective": s.objective,
+        "condition_number": s.condition_number,
+        "mean_square": s.mean_square,
+        "iterations": s.iterations,
+        "evaluations": s.evaluations,
+        "message": s.message,
+    }

@@ -71,20 +71,30 @@ class IdentificationResult:
                 rel = abs((tv[k] - self.estimate[k]) / tv[k]) * 100 if tv[k] != 0 else float("nan")
                 row += f" {rel:10.3g}%"
             lines.append(row)
-        lines.append(f"{len(self.names)} minimal parameters from {self.samples} samples ({self.fit.rows} rows); "
-                     f"condition number {self.fit.condition_number:.4g}; residual sigma {self.fit.sigma:.3g}; "
-                     f"solver: {self.fit.method}")
+        lines.append(
+            f"{len(self.names)} minimal parameters from {self.samples} samples ({self.fit.rows} rows); "
+            f"condition number {self.fit.condition_number:.4g}; residual sigma {self.fit.sigma:.3g}; "
+            f"solver: {self.fit.method}"
+        )
         if tv is not None:
             e = self.errors(truth)
-            lines.append(f"relative error (Naveen, Shah, Misra eqs. 38-39): median {e['median_rel_error_pct']:.3g} %, "
-                         f"max {e['max_rel_error_pct']:.3g} %")
+            lines.append(
+                f"relative error (Naveen, Shah, Misra eqs. 38-39): median {e['median_rel_error_pct']:.3g} %, "
+                f"max {e['max_rel_error_pct']:.3g} %"
+            )
         return "\n".join(lines)
 
     def to_dict(self, truth=None) -> dict:
         d = {
-            "names": self.names, "expressions": self.mp.expressions(), "estimate": self.estimate.tolist(),
-            "std": self.std.tolist(), "condition_number": self.fit.condition_number, "rows": self.fit.rows,
-            "samples": self.samples, "residual_sigma": self.fit.sigma, "solver": self.fit.method,
+            "names": self.names,
+            "expressions": self.mp.expressions(),
+            "estimate": self.estimate.tolist(),
+            "std": self.std.tolist(),
+            "condition_number": self.fit.condition_number,
+            "rows": self.fit.rows,
+            "samples": self.samples,
+            "residual_sigma": self.fit.sigma,
+            "solver": self.fit.method,
             "known_bodies": [self.mp.model.body_names[i] for i in self.mp.known],
         }
         if truth is not None:
@@ -102,8 +112,9 @@ class IdentificationResult:
         return out
 
 
-def identify_minimal(model, data, known=None, method: str = "closed-form", h0=None, weights=None,
-                     rate_noise=None) -> IdentificationResult:
+def identify_minimal(
+    model, data, known=None, method: str = "closed-form", h0=None, weights=None, rate_noise=None
+) -> IdentificationResult:
     """Identify the minimal parameters of `model` from motion data.
 
     data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
@@ -134,7 +145,9 @@ def identify_minimal(model, data, known=None, method: str = "closed-form", h0=No
     fit = least_squares(model, q, v, h, mp, weights=weights)
     if rate_noise is not None:
         if weights is not None:
-            raise InputError("arguments `weights` and `rate_noise`: the bias compensation is for unweighted least squares")
+            raise InputError(
+                "arguments `weights` and `rate_noise`: the bias compensation is for unweighted least squares"
+            )
         fit = bias_compensated(mp, q, v, fit, _rate_sigmas(model, rate_noise))
     return IdentificationResult(mp=mp, fit=fit, samples=len(t))
 
@@ -161,39 +174,49 @@ def bias_compensated(mp, q, v, fit, sigma, stride: int = 10, chunk: int = 512):
     sigma = np.asarray(sigma, dtype=float)
     n, nv = fit.estimate.size, mp.model.nv
     if sigma.shape != (nv,) or np.any(sigma < 0) or not np.all(np.isfinite(sigma)):
-        raise InputError(f"argument `rate_noise`: expected {nv} non-negative standard deviations, got shape {sigma.shape}")
+        raise InputError(
+            f"argument `rate_noise`: expected {nv} non-negative standard deviations, got shape {sigma.shape}"
+        )
     active = np.flatnonzero(sigma > 0)
     N_G, N_y = np.zeros((n, n)), np.zeros(n)
     idx = np.arange(0, len(q), stride)
     kept = absolute_columns(mp)
     known_P = known_parameters(mp)
     for k in range(0, len(idx), chunk):
-        qs = q[idx[k:k + chunk]]
+        qs = q[idx[k : k + chunk]]
         E = np.zeros((len(qs), len(active), nv))
         E[:, np.arange(len(active)), active] = 1.0
         from ..algorithms import momentum_regressor
 
         K = momentum_regressor(mp.model, np.repeat(qs, len(active), axis=0), E.reshape(-1, nv))  # (T·J, 6, 10·nb)
-        A, b = K[..., kept], K @ known_P                       # (T·J, 6, n), (T·J, 6)
+        A, b = K[..., kept], K @ known_P  # (T·J, 6, n), (T·J, 6)
         w = np.tile(sigma[active] ** 2, len(qs))[:, None, None]
         N_G += np.einsum("rki,rkj->ij", w * A, A)
         N_y += np.einsum("rki,rk->i", w * A, b)
     N_G *= len(q) / len(idx)
     N_y *= len(q) / len(idx)
-    GtG = fit.sigma ** 2 * np.linalg.inv(fit.covariance)
+    GtG = fit.sigma**2 * np.linalg.inv(fit.covariance)
     share = _noise_share(N_G, GtG)
     if share > MAX_NOISE_SHARE:
         what = "is numerically singular" if not np.isfinite(share) else f"is {share:.2g} rate noise by energy"
-        warnings.warn(f"rate_noise: the regressor's least-excited direction {what} (limit {MAX_NOISE_SHARE}); " f"the first-order bias compensation would be unreliable there, so "
-                      "the plain least-squares estimate is returned. Excite the robot more (more or designed intervals).",
-                      stacklevel=3)
+        warnings.warn(
+            f"rate_noise: the regressor's least-excited direction {what} (limit {MAX_NOISE_SHARE}); "
+            f"the first-order bias compensation would be unreliable there, so "
+            "the plain least-squares estimate is returned. Excite the robot more (more or designed intervals).",
+            stacklevel=3,
+        )
         return replace(fit, method=fit.method + " (bias compensation skipped: noise-dominated direction)")
     M = GtG - N_G
     delta = np.linalg.solve(M, N_G @ fit.estimate + N_y)
     est = fit.estimate + delta
-    cov = fit.sigma ** 2 * np.linalg.inv(M)
-    return replace(fit, estimate=est, covariance=cov, std=np.sqrt(np.abs(np.diag(cov))),
-                   method=fit.method + " + errors-in-variables bias compensation")
+    cov = fit.sigma**2 * np.linalg.inv(M)
+    return replace(
+        fit,
+        estimate=est,
+        covariance=cov,
+        std=np.sqrt(np.abs(np.diag(cov))),
+        method=fit.method + " + errors-in-variables bias compensation",
+    )
 
 
 def _noise_share(N_G, GtG) -> float:
@@ -216,7 +239,10 @@ def _rate_sigmas(model, rate_noise) -> np.ndarray:
         return r
     if r.shape == (3,) and model.joint_types[0] == "free":
         return np.concatenate([np.full(3, r[0]), np.full(3, r[1]), np.full(model.nv - 6, r[2])])
-    raise InputError(f"argument `rate_noise`: expected {model.nv} standard deviations or " f"(base linear, base angular, joint), got shape {r.shape}")
+    raise InputError(
+        f"argument `rate_noise`: expected {model.nv} standard deviations or "
+        f"(base linear, base angular, joint), got shape {r.shape}"
+    )
 
 
 def component_variances(mp, q, v, h, phi, chunk: int = 4096) -> np.ndarray:
@@ -224,9 +250,9 @@ def component_variances(mp, q, v, h, phi, chunk: int = 4096) -> np.ndarray:
     (computed in chunks so the stacked regressor is never formed whole)."""
     ss = np.zeros(6)
     for k in range(0, len(q), chunk):
-        qs, vs = q[k:k + chunk], v[k:k + chunk]
+        qs, vs = q[k : k + chunk], v[k : k + chunk]
         K, h_known = mp.regressor_and_known_momentum(qs, vs)
-        r = h[k:k + chunk] - K @ phi - h_known
+        r = h[k : k + chunk] - K @ phi - h_known
         ss += np.sum(r * r, axis=0)
     return ss / max(len(q), 1)
 
@@ -235,10 +261,15 @@ def _read(model, data, h0):
     if isinstance(data, (str, Path)):
         data = Telemetry.from_file(data, model)
     if not hasattr(data, "q") or not hasattr(data, "v"):
-        raise InputError(f"argument `data`: expected a Trajectory, a Telemetry or a file path, got {type(data).__name__}")
+        raise InputError(
+            f"argument `data`: expected a Trajectory, a Telemetry or a file path, got {type(data).__name__}"
+        )
     q, v = np.asarray(data.q, dtype=float), np.asarray(data.v, dtype=float)
     if q.ndim != 2 or q.shape[1] != model.nq or v.shape != (len(q), model.nv):
-        raise InputError(f"argument `data`: q/v have shapes {q.shape}/{v.shape}, " f"model '{model.name}' needs (T, {model.nq})/(T, {model.nv})")
+        raise InputError(
+            f"argument `data`: q/v have shapes {q.shape}/{v.shape}, "
+            f"model '{model.name}' needs (T, {model.nq})/(T, {model.nv})"
+        )
     h = getattr(data, "momentum", None)
     if h0 is not None:
         h0 = np.asarray(h0, dtype=float)
@@ -273,8 +304,16 @@ def _plot_errors(res: IdentificationResult, truth: np.ndarray, path: Path) -> No
     plt.close(fig)
 
 
-def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every: int = 1, noise: bool = True,
-                    seed: int = 0, progress: bool = False, spread: bool = True):
+def excitation_data(
+    model,
+    n_intervals: int = 64,
+    dt: float = 1e-3,
+    record_every: int = 1,
+    noise: bool = True,
+    seed: int = 0,
+    progress: bool = False,
+    spread: bool = True,
+):
     """Simulated identification data for the Naveen, Shah, Misra robot, as the paper produces it (Sec. VI.A-C).
 
     The six arm joints and three wheels follow multi-interval cycloids (eqs. 28-31) from Table 3's seeds (wheels:
@@ -288,19 +327,31 @@ def excitation_data(model, n_intervals: int = 64, dt: float = 1e-3, record_every
 
     arm, wheels = model.joints_tagged("arm_"), model.joints_tagged("wheel")
     if len(arm) != 6 or len(wheels) != 3:
-        raise InputError(f"excitation_data needs the Naveen, Shah, Misra robot (6 arm joints tagged arm_*, 3 wheels); " f"'{model.name}' has {len(arm)} and {len(wheels)}")
+        raise InputError(
+            f"excitation_data needs the Naveen, Shah, Misra robot (6 arm joints tagged arm_*, 3 wheels); "
+            f"'{model.name}' has {len(arm)} and {len(wheels)}"
+        )
     start, range_ = tr.with_wheels(np.deg2rad(TABLE3_START_DEG), TABLE3_RANGE_RAD)
     all_dirs = tr.direction_combinations(9)
     if not 1 <= n_intervals <= len(all_dirs):
         raise InputError(f"n_intervals must be between 1 and {len(all_dirs)}, got {n_intervals}")
     pick = np.linspace(0, len(all_dirs) - 1, n_intervals).round().astype(int) if spread else np.arange(n_intervals)
     cyc = tr.Cycloidal(start, range_, all_dirs[pick])
-    return trajectory_data(model, cyc, arm + wheels, dt=dt, record_every=record_every, noise=noise, seed=seed,
-                           progress=progress)
+    return trajectory_data(
+        model, cyc, arm + wheels, dt=dt, record_every=record_every, noise=noise, seed=seed, progress=progress
+    )
 
 
-def trajectory_data(model, trajectory, joints, dt: float = 1e-3, record_every: int = 1, noise: bool = True,
-                    seed: int = 0, progress: bool = False):
+def trajectory_data(
+    model,
+    trajectory,
+    joints,
+    dt: float = 1e-3,
+    record_every: int = 1,
+    noise: bool = True,
+    seed: int = 0,
+    progress: bool = False,
+):
     """Simulated identification data along any joint trajectory (e.g. a designed one, `freefloat excite`): the
     named joints follow it, the base floats with zero total momentum (its initial twist solved from the
     momentum model when the trajectory starts moving), the other joints rest.  With `noise`, Naveen, Shah, Misra's rate

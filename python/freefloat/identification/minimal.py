@@ -43,8 +43,8 @@ class MinimalParameters:
 
     def __init__(self, model, unknown, known, matrix, columns, names, method, rank):
         self.model = model
-        self.unknown = list(unknown)      # body indices identified, in model order
-        self.known = list(known)          # body indices on the right-hand side
+        self.unknown = list(unknown)  # body indices identified, in model order
+        self.known = list(known)  # body indices on the right-hand side
         self.matrix = np.asarray(matrix)  # B: (n_min, 10 * len(unknown))
         self.columns = np.asarray(columns, dtype=int)  # columns of K_unknown forming K_min; B[:, columns] == I
         self.names = list(names)
@@ -97,7 +97,10 @@ class MinimalParameters:
         return _body_columns(self.unknown)
 
     def __repr__(self) -> str:
-        return f"MinimalParameters({self.model.name!r}, method={self.method!r}, " f"n_min={self.n_min}, unknown={len(self.unknown)} bodies)"
+        return (
+            f"MinimalParameters({self.model.name!r}, method={self.method!r}, "
+            f"n_min={self.n_min}, unknown={len(self.unknown)} bodies)"
+        )
 
 
 def minimal_parameters(model, method: str = "numeric", known=None) -> MinimalParameters:
@@ -199,9 +202,13 @@ def _check_closed_form_model(model, unknown):
     for j in unknown[1:]:
         name, parent = model.body_names[j], model.parents[j]
         if model.joint_types[j] != "revolute":
-            raise ModelError(f"closed-form: body '{name}' has a {model.joint_types[j]} joint (only revolute is covered); {hint}")
+            raise ModelError(
+                f"closed-form: body '{name}' has a {model.joint_types[j]} joint (only revolute is covered); {hint}"
+            )
         if parent not in unknown:
-            raise ModelError(f"closed-form: body '{name}' hangs from the known body '{model.body_names[parent]}'; {hint}")
+            raise ModelError(
+                f"closed-form: body '{name}' hangs from the known body '{model.body_names[parent]}'; {hint}"
+            )
         if not np.allclose(model.joint_axes[j], [0, 0, 1], atol=1e-12):
             raise ModelError(f"closed-form: joint of '{name}' is not about its frame's z axis (modified DH); {hint}")
         R = model.placements[j][:3, :3]
@@ -220,7 +227,7 @@ def _k_vectors(b, alpha):
     [Ixx Iyy Izz Ixy Iyz Izx m mx my mz]."""
     C, S = np.cos(alpha), np.sin(alpha)
     b1, b2, b3 = b
-    t1 = [1, C * C, S * S, 0, C * S, 0]                                             # eq. (18)
+    t1 = [1, C * C, S * S, 0, C * S, 0]  # eq. (18)
     t2 = [2 * b3 * C - 2 * b2 * S, 2 * b3 * C, -2 * b2 * S, b1 * S, b3 * S - b2 * C, -b1 * C]  # eq. (20)
     t3 = [0, -S, C]
     # −[•(b̃)²] (eq. 19; the printed k_2 lacks the square)
@@ -241,15 +248,15 @@ def _group(phi, parents, geometry):
     """Naveen, Shah, Misra's recursion on paper-ordered parameters phi (nb, 10) of the unknown tree (local indices,
     parents[j] < j).  Returns φ_m (10 + 7 n).  Linear in phi."""
     ph = np.array(phi, dtype=float)
-    for j in range(len(ph) - 1, 0, -1):               # children first: eqs. (21)-(23)
+    for j in range(len(ph) - 1, 0, -1):  # children first: eqs. (21)-(23)
         k1, k2, k3 = geometry[j]
         ph[parents[j]] += ph[j, 1] * k1 + ph[j, 6] * k2 + ph[j, 9] * k3
-    out = [ph[0]]                                     # base keeps all 10 (eq. 23)
+    out = [ph[0]]  # base keeps all 10 (eq. 23)
     for j in range(1, len(ph)):
         d = ph[j, KEPT_PAPER].copy()
-        d[0] -= ph[j, 1]                              # XX ← XX − YY after the children were added (eq. 22)
+        d[0] -= ph[j, 1]  # XX ← XX − YY after the children were added (eq. 22)
         out.append(d)
-    return np.concatenate(out)                        # eq. (25)
+    return np.concatenate(out)  # eq. (25)
 
 
 def _closed_form(model, unknown, known) -> MinimalParameters:

@@ -48,20 +48,32 @@ class RecursiveLS:
 
 class ModifiedRLS:
     def __init__(self, coupling: str, mu0, p_mu0, theta0, p_theta0):
-        self._core = _core.ModifiedRLS(coupling, as_f64(mu0, "mu0").ravel(), as_f64(p_mu0, "p_mu0"),
-                                       as_f64(theta0, "theta0").ravel(), as_f64(p_theta0, "p_theta0"))
+        self._core = _core.ModifiedRLS(
+            coupling,
+            as_f64(mu0, "mu0").ravel(),
+            as_f64(p_mu0, "p_mu0"),
+            as_f64(theta0, "theta0").ravel(),
+            as_f64(p_theta0, "p_theta0"),
+        )
 
     def update(self, t: float, a, b, phi, y, psi):
         """One sample: a (r_mu, n_mu), b (r_mu,), phi (r_th, n_th), y (r_th,), psi (r_th, n_D). Returns (mu, theta)."""
         b, y = np.atleast_1d(as_f64(b, "b")), np.atleast_1d(as_f64(y, "y"))
-        self._core.update(float(t), as_f64(a, "a").reshape(len(b), -1), b, as_f64(phi, "phi").reshape(len(y), -1), y,
-                          as_f64(psi, "psi").reshape(len(y), -1))
+        self._core.update(
+            float(t),
+            as_f64(a, "a").reshape(len(b), -1),
+            b,
+            as_f64(phi, "phi").reshape(len(y), -1),
+            y,
+            as_f64(psi, "psi").reshape(len(y), -1),
+        )
         return self.mu, self.theta
 
     def run(self, t, a, b, phi, y, psi):
         """Many samples (leading axis N). Returns (mu (N, n_mu), theta (N, n_th))."""
-        return self._core.run(as_f64(t, "t"), as_f64(a, "a"), as_f64(b, "b"), as_f64(phi, "phi"), as_f64(y, "y"),
-                              as_f64(psi, "psi"))
+        return self._core.run(
+            as_f64(t, "t"), as_f64(a, "a"), as_f64(b, "b"), as_f64(phi, "phi"), as_f64(y, "y"), as_f64(psi, "psi")
+        )
 
     @property
     def mu(self) -> np.ndarray:

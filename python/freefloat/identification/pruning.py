@@ -27,7 +27,6 @@ class PruneResult:
     concat_significant: np.ndarray
 
 
-
 def significant(sv, delta: float) -> int:
     """Number of singular values above delta·σ_max (Algorithm 1's numSignificantSingularVals)."""
     sv = np.asarray(sv)
@@ -80,8 +79,13 @@ def prune_intervals(blocks, u_max: int = U_MAX, delta: float = DELTA, min_gain: 
             s_prev, cn_prev = s_now, cn_now
         concat_k[i], concat_s[i] = cn_prev, s_prev
         i += 1
-    return PruneResult(kept=np.array(kept), single_kappa=single_k, single_significant=single_s,
-                       concat_kappa=concat_k, concat_significant=concat_s)
+    return PruneResult(
+        kept=np.array(kept),
+        single_kappa=single_k,
+        single_significant=single_s,
+        concat_kappa=concat_k,
+        concat_significant=concat_s,
+    )
 
 
 def _stack(R, block):
@@ -99,7 +103,9 @@ def plot_fig4(pr: PruneResult, path) -> None:
     plt = pyplot()
     k = np.arange(1, len(pr.single_kappa) + 1)
     fig, ax = plt.subplots(2, 1, figsize=(10, 7), sharex=True, constrained_layout=True)
-    ax[0].semilogy(k, np.minimum(pr.single_kappa, 1e20), ".", ms=3, label="single interval (rank-deficient: shown at the cap)")
+    ax[0].semilogy(
+        k, np.minimum(pr.single_kappa, 1e20), ".", ms=3, label="single interval (rank-deficient: shown at the cap)"
+    )
     ax[0].semilogy(k, np.minimum(pr.concat_kappa, 1e20), "-", label="accepted concatenation")
     ax[0].set_ylabel("condition number (capped at 1e20)")
     ax[1].plot(k, pr.single_significant, ".", ms=3, label="single interval")

@@ -53,9 +53,9 @@ class PredictionResult:
     """Base twists (inertial frame) and joint torques of the true and the identified robot along one motion."""
 
     t: np.ndarray
-    twist_true: np.ndarray   # (T, 6) [v0; ω0] of the base in the inertial frame
+    twist_true: np.ndarray  # (T, 6) [v0; ω0] of the base in the inertial frame
     twist_pred: np.ndarray
-    tau_true: np.ndarray     # (T, n) torques of the driven joints
+    tau_true: np.ndarray  # (T, n) torques of the driven joints
     tau_pred: np.ndarray
     joints: list
 
@@ -72,18 +72,26 @@ class PredictionResult:
     def table(self) -> str:
         """Table 6 of Naveen, Shah, Misra, ours beside the paper's, with the ratio to the paper's noise references."""
         sig = [NOISE_LIN] * 3 + [NOISE_ANG] * 3
-        lines = ["prediction RMS error (Naveen, Shah, Misra eq. 42, Table 6)",
-                 f"{'':10s} {'ours':>11s} {'paper':>11s} {'ours/noise':>11s} {'paper/noise':>12s}"]
+        lines = [
+            "prediction RMS error (Naveen, Shah, Misra eq. 42, Table 6)",
+            f"{'':10s} {'ours':>11s} {'paper':>11s} {'ours/noise':>11s} {'paper/noise':>12s}",
+        ]
         for k, name in enumerate(TWIST_NAMES):
             unit = "m/s" if k < 3 else "rad/s"
-            lines.append(f"{name + ' ' + unit:10s} {self.rms_twist[k]:11.3g} {PAPER_TABLE6_TWIST[k]:11.3g} "
-                         f"{self.rms_twist[k] / sig[k]:11.3g} {PAPER_TABLE6_TWIST[k] / sig[k]:12.3g}")
+            lines.append(
+                f"{name + ' ' + unit:10s} {self.rms_twist[k]:11.3g} {PAPER_TABLE6_TWIST[k]:11.3g} "
+                f"{self.rms_twist[k] / sig[k]:11.3g} {PAPER_TABLE6_TWIST[k] / sig[k]:12.3g}"
+            )
         for k, name in enumerate(self.joints):
             paper = PAPER_TABLE6_TORQUE[k] if k < len(PAPER_TABLE6_TORQUE) else float("nan")
-            lines.append(f"{'τ ' + name:10s} {self.rms_torque[k]:11.3g} {paper:11.3g} "
-                         f"{self.rms_torque[k] / NOISE_TORQUE:11.3g} {paper / NOISE_TORQUE:12.3g}")
-        lines.append(f"noise references: base rates {NOISE_LIN:g} m/s, {NOISE_ANG:g} rad/s (Sec. VI.C); "
-                     f"torque sensor {NOISE_TORQUE:g} N·m (the paper's ref. [33])")
+            lines.append(
+                f"{'τ ' + name:10s} {self.rms_torque[k]:11.3g} {paper:11.3g} "
+                f"{self.rms_torque[k] / NOISE_TORQUE:11.3g} {paper / NOISE_TORQUE:12.3g}"
+            )
+        lines.append(
+            f"noise references: base rates {NOISE_LIN:g} m/s, {NOISE_ANG:g} rad/s (Sec. VI.C); "
+            f"torque sensor {NOISE_TORQUE:g} N·m (the paper's ref. [33])"
+        )
         return "\n".join(lines)
 
     def to_dict(self) -> dict:
@@ -92,7 +100,8 @@ class PredictionResult:
             "rms_torque": dict(zip(self.joints, self.rms_torque.tolist())),
             "paper_rms_twist": dict(zip(TWIST_NAMES, PAPER_TABLE6_TWIST)),
             "paper_rms_torque": dict(zip(self.joints, PAPER_TABLE6_TORQUE)),
-            "duration": float(self.t[-1] - self.t[0]), "samples": int(len(self.t)),
+            "duration": float(self.t[-1] - self.t[0]),
+            "samples": int(len(self.t)),
         }
 
     def save(self, directory) -> Path:
@@ -147,14 +156,34 @@ def identified_model(model, result, prior=None):
     try:
         rep = model.with_parameters(representative_parameters(result.mp, result.estimate, prior))
     except ModelError:
-        return c.model(model), c, (f"physically consistent estimate (misses the identified minimal parameters by "
-                                   f"{c.misfit:.3g} standard deviations; the model does not admit non-physical bodies)")
-    return rep, c, (f"exact representative of the identified minimal parameters (no physically consistent robot "
-                    f"reproduces them: the nearest is {c.misfit:.3g} standard deviations away)")
+        return (
+            c.model(model),
+            c,
+            (
+                f"physically consistent estimate (misses the identified minimal parameters by "
+                f"{c.misfit:.3g} standard deviations; the model does not admit non-physical bodies)"
+            ),
+        )
+    return (
+        rep,
+        c,
+        (
+            f"exact representative of the identified minimal parameters (no physically consistent robot "
+            f"reproduces them: the nearest is {c.misfit:.3g} standard deviations away)"
+        ),
+    )
 
 
-def predict(true_model, identified_model, joints=None, trajectory=None, dt: float = 1e-3,
-            record_every: int = 10, locked=None, progress: bool = False) -> PredictionResult:
+def predict(
+    true_model,
+    identified_model,
+    joints=None,
+    trajectory=None,
+    dt: float = 1e-3,
+    record_every: int = 10,
+    locked=None,
+    progress: bool = False,
+) -> PredictionResult:
     """Drive both models along `trajectory` (default: `default_fourier` around the neutral angles of `joints`)
     and compare their base twists and joint torques.
 
@@ -172,8 +201,10 @@ def predict(true_model, identified_model, joints=None, trajectory=None, dt: floa
         trajectory = default_fourier(true_model.neutral()[iq])
     if trajectory.n != len(joints):
         raise InputError(f"predict: the trajectory drives {trajectory.n} joints, {len(joints)} are named")
-    runs = [simulate_driven(mod, trajectory, joints, dt, held=locked, record_every=record_every, progress=progress)
-            for mod in (true_model, identified_model)]
+    runs = [
+        simulate_driven(mod, trajectory, joints, dt, held=locked, record_every=record_every, progress=progress)
+        for mod in (true_model, identified_model)
+    ]
     iv = [true_model.idx_v[true_model.joint_names.index(j)] for j in joints]
     (t, tw_t, tau_t), (_, tw_p, tau_p) = ((r.t, _world_twist(r), r.tau[:, iv]) for r in runs)
     return PredictionResult(t=t, twist_true=tw_t, twist_pred=tw_p, tau_true=tau_t, tau_pred=tau_p, joints=joints)

@@ -15,9 +15,9 @@ Earlier names (`ALIASES`) are still accepted everywhere a name is; listings show
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Iterator
 from importlib import resources
 from pathlib import Path
-from typing import Iterator
 
 from .._core import InputError
 

@@ -25,25 +25,37 @@ def summarize(traj, wall: float) -> dict:
     d = traj.momentum_drift()
     e = traj.energy_balance()
     return {
-        "samples": len(traj), "t_final": float(traj.t[-1]), "wall_time_s": wall, **traj.stats,
-        "momentum_initial": traj.momentum[0].tolist(), "momentum_final": traj.momentum[-1].tolist(),
-        "momentum_drift_linear_abs": d["linear_abs"], "momentum_drift_angular_abs": d["angular_abs"],
-        "momentum_drift_linear_rel": d["linear_rel"], "momentum_drift_angular_rel": d["angular_rel"],
-        "kinetic_energy_initial": float(traj.kinetic_energy[0]), "kinetic_energy_final": float(traj.kinetic_energy[-1]),
-        "energy_minus_work_abs": e["abs"], "energy_minus_work_rel": e["rel"],
+        "samples": len(traj),
+        "t_final": float(traj.t[-1]),
+        "wall_time_s": wall,
+        **traj.stats,
+        "momentum_initial": traj.momentum[0].tolist(),
+        "momentum_final": traj.momentum[-1].tolist(),
+        "momentum_drift_linear_abs": d["linear_abs"],
+        "momentum_drift_angular_abs": d["angular_abs"],
+        "momentum_drift_linear_rel": d["linear_rel"],
+        "momentum_drift_angular_rel": d["angular_rel"],
+        "kinetic_energy_initial": float(traj.kinetic_energy[0]),
+        "kinetic_energy_final": float(traj.kinetic_energy[-1]),
+        "energy_minus_work_abs": e["abs"],
+        "energy_minus_work_rel": e["rel"],
     }
 
 
 def summary_text(title: str, s: dict) -> str:
     """The summary of `summarize` as the lines the command line prints (a blank line, then the title)."""
-    return "\n".join([
-        f"\n{title}",
-        f"  simulated {s['t_final']:.3f} s in {s['wall_time_s']:.3f} s wall ({s['steps']} steps, {s['method']})",
-        f"  momentum drift   linear  {s['momentum_drift_linear_abs']:.3e} kg m/s   " f"(relative {s['momentum_drift_linear_rel']:.2e})",
-        f"                   angular {s['momentum_drift_angular_abs']:.3e} kg m²/s  " f"(relative {s['momentum_drift_angular_rel']:.2e})",
-        f"  kinetic energy   {s['kinetic_energy_initial']:.6g} J -> {s['kinetic_energy_final']:.6g} J",
-        f"  |ΔE − work|      {s['energy_minus_work_abs']:.3e} J   (relative {s['energy_minus_work_rel']:.2e})",
-    ])
+    return "\n".join(
+        [
+            f"\n{title}",
+            f"  simulated {s['t_final']:.3f} s in {s['wall_time_s']:.3f} s wall ({s['steps']} steps, {s['method']})",
+            f"  momentum drift   linear  {s['momentum_drift_linear_abs']:.3e} kg m/s   "
+            f"(relative {s['momentum_drift_linear_rel']:.2e})",
+            f"                   angular {s['momentum_drift_angular_abs']:.3e} kg m²/s  "
+            f"(relative {s['momentum_drift_angular_rel']:.2e})",
+            f"  kinetic energy   {s['kinetic_energy_initial']:.6g} J -> {s['kinetic_energy_final']:.6g} J",
+            f"  |ΔE − work|      {s['energy_minus_work_abs']:.3e} J   (relative {s['energy_minus_work_rel']:.2e})",
+        ]
+    )
 
 
 def write_run(traj, summary: dict, out, stem: str, title: str) -> list[Path]:

@@ -89,8 +89,15 @@ class Telemetry:
     @classmethod
     def from_trajectory(cls, traj) -> Telemetry:
         """The true (noise-free) telemetry of a simulated `Trajectory`."""
-        return cls(t=traj.t.copy(), q=traj.q.copy(), v=traj.v.copy(), model_name=traj.model_name,
-                   q_labels=list(traj.q_labels), v_labels=list(traj.v_labels), momentum=traj.momentum.copy())
+        return cls(
+            t=traj.t.copy(),
+            q=traj.q.copy(),
+            v=traj.v.copy(),
+            model_name=traj.model_name,
+            q_labels=list(traj.q_labels),
+            v_labels=list(traj.v_labels),
+            momentum=traj.momentum.copy(),
+        )
 
     # -- files ---------------------------------------------------------------------------------------
     def columns(self) -> dict:
@@ -161,7 +168,9 @@ def _read_csv(p: Path) -> dict:
             rows.append([float(x) for x in fields])
         except ValueError:
             bad = next(k for k, x in enumerate(fields) if not _is_float(x))
-            raise InputError(f"{p}: column '{names[bad]}' row {r} (line {i + 1}): '{fields[bad].strip()}' is not a number") from None
+            raise InputError(
+                f"{p}: column '{names[bad]}' row {r} (line {i + 1}): '{fields[bad].strip()}' is not a number"
+            ) from None
     data = np.array(rows, dtype=float).reshape(len(rows), len(names))
     return {n: data[:, k] for k, n in enumerate(names)}
 
@@ -182,14 +191,21 @@ def _from_columns(cols: dict, model, where: str) -> Telemetry:
         raise InputError(f"{where}: missing columns for model '{model.name}': {', '.join(missing)}")
     has_h = _optional_block(cols, "momentum", MOMENTUM_NAMES, where)
     has_w = _optional_block(cols, "wrench", WRENCH_NAMES, where)
-    used = need + ([f"momentum.{n}" for n in MOMENTUM_NAMES] if has_h else []) + \
-        ([f"wrench.{n}" for n in WRENCH_NAMES] if has_w else [])
+    used = (
+        need
+        + ([f"momentum.{n}" for n in MOMENTUM_NAMES] if has_h else [])
+        + ([f"wrench.{n}" for n in WRENCH_NAMES] if has_w else [])
+    )
     _check_finite(cols, used, where)
     t = cols["t"]
     _check_time(t, where)
     return Telemetry(
-        t=t.copy(), q=np.column_stack([cols[f"q.{n}"] for n in ql]), v=np.column_stack([cols[f"v.{n}"] for n in vl]),
-        model_name=model.name, q_labels=ql, v_labels=vl,
+        t=t.copy(),
+        q=np.column_stack([cols[f"q.{n}"] for n in ql]),
+        v=np.column_stack([cols[f"v.{n}"] for n in vl]),
+        model_name=model.name,
+        q_labels=ql,
+        v_labels=vl,
         momentum=np.column_stack([cols[f"momentum.{n}"] for n in MOMENTUM_NAMES]) if has_h else None,
         wrench=np.column_stack([cols[f"wrench.{n}"] for n in WRENCH_NAMES]) if has_w else None,
     )
@@ -209,8 +225,10 @@ def _check_finite(cols: dict, names: list, where: str) -> None:
         bad = ~np.isfinite(cols[c])
         if bad.any():
             r = int(np.argmax(bad))
-            raise InputError(f"{where}: column '{c}' row {r} is {cols[c][r]} (not finite); "
-                             f"{int(bad.sum())} such value(s) in this column")
+            raise InputError(
+                f"{where}: column '{c}' row {r} is {cols[c][r]} (not finite); "
+                f"{int(bad.sum())} such value(s) in this column"
+            )
 
 
 def _check_time(t: np.ndarray, where: str) -> None:
@@ -224,13 +242,22 @@ def _check_time(t: np.ndarray, where: str) -> None:
     gap = dt > GAP_FACTOR * med
     if gap.any():
         r = int(np.argmax(gap)) + 1
-        raise InputError(f"{where}: gap in time before row {r}: step {dt[r - 1]:.6g} s from t = {t[r - 1]!r} to {t[r]!r} "
-                         f"is more than {GAP_FACTOR}× the median step {med:.6g} s ({int(gap.sum())} gap(s))")
+        raise InputError(
+            f"{where}: gap in time before row {r}: step {dt[r - 1]:.6g} s from t = {t[r - 1]!r} to {t[r]!r} "
+            f"is more than {GAP_FACTOR}× the median step {med:.6g} s ({int(gap.sum())} gap(s))"
+        )
 
 
 # -- measurement model (Naveen, Shah, Misra Sec. VI.C, Appendix C) -------------------------------------------------
-def add_noise(telem: Telemetry, model, rng, sigma_lin: float = SIGMA_LIN, sigma_ang: float = SIGMA_ANG,
-              sigma_joint: float = SIGMA_JOINT, reconstruct_poses: bool = True) -> Telemetry:
+def add_noise(
+    telem: Telemetry,
+    model,
+    rng,
+    sigma_lin: float = SIGMA_LIN,
+    sigma_ang: float = SIGMA_ANG,
+    sigma_joint: float = SIGMA_JOINT,
+    reconstruct_poses: bool = True,
+) -> Telemetry:
     """Noisy telemetry as in Naveen, Shah, Misra Sec. VI.C (`rng`: a numpy Generator or a seed): zero-mean white
     Gaussian noise, independent per sample and component, added to the measured rates with standard deviations
     sigma_lin on the base linear velocity (m/s), sigma_ang on the base angular velocity (rad/s) and sigma_joint on every
@@ -247,7 +274,9 @@ def add_noise(telem: Telemetry, model, rng, sigma_lin: float = SIGMA_LIN, sigma_
     Otherwise q is left exact. The momentum column, if any, is left unchanged (it is a known quantity)."""
     rng = np.random.default_rng(rng)  # accepts a Generator (used as is) or a seed
     if telem.v.shape[1] != model.nv:
-        raise InputError(f"add_noise: telemetry has {telem.v.shape[1]} velocity columns, model '{model.name}' has nv = {model.nv}")
+        raise InputError(
+            f"add_noise: telemetry has {telem.v.shape[1]} velocity columns, model '{model.name}' has nv = {model.nv}"
+        )
     v = telem.v.copy()
     nb = _base_dofs(model)
     if nb == 6:
@@ -310,8 +339,10 @@ def _joint_slices(model):
     iq, iv = [], []
     for b in range(1, model.nbodies):
         if model.nqs[b] != model.nvs[b]:
-            raise InputError(f"model '{model.name}': joint '{model.joint_names[b]}' ({model.joint_types[b]}) has nq != nv; "
-                             "only revolute/prismatic joints are supported by pose reconstruction")
+            raise InputError(
+                f"model '{model.name}': joint '{model.joint_names[b]}' ({model.joint_types[b]}) has nq != nv; "
+                "only revolute/prismatic joints are supported by pose reconstruction"
+            )
         iq += range(model.idx_q[b], model.idx_q[b] + model.nqs[b])
         iv += range(model.idx_v[b], model.idx_v[b] + model.nvs[b])
     return np.array(iq, dtype=int), np.array(iv, dtype=int)

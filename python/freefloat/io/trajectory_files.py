@@ -21,11 +21,23 @@ def save_trajectory(path, traj, joints, model_name: str = "") -> None:
 
 def _traj_to_dict(traj) -> dict:
     if isinstance(traj, Cycloidal):
-        return {"kind": "cycloidal", "start": traj.start.tolist(), "range": traj.range_.tolist(),
-                "directions": traj.directions.astype(int).tolist(), "interval": traj.interval}
+        return {
+            "kind": "cycloidal",
+            "start": traj.start.tolist(),
+            "range": traj.range_.tolist(),
+            "directions": traj.directions.astype(int).tolist(),
+            "interval": traj.interval,
+        }
     if isinstance(traj, Fourier):
-        return {"kind": "fourier", "q0": traj.q0.tolist(), "a": traj.a.tolist(), "b": traj.b.tolist(),
-                "omega_f": traj.omega_f, "n_h": traj.n_h, "duration": traj.duration}
+        return {
+            "kind": "fourier",
+            "q0": traj.q0.tolist(),
+            "a": traj.a.tolist(),
+            "b": traj.b.tolist(),
+            "omega_f": traj.omega_f,
+            "n_h": traj.n_h,
+            "duration": traj.duration,
+        }
     if isinstance(traj, Stacked):
         return {"kind": "stacked", "parts": [_traj_to_dict(p) for p in traj.parts]}
     raise InputError(f"save_trajectory: cannot write a {type(traj).__name__}")

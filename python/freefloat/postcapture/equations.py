@@ -84,9 +84,9 @@ class Measurements:
     q: np.ndarray
     v: np.ndarray
     ddq: np.ndarray
-    base_wrench: np.ndarray   # (T, nb) thruster generalized force [f; τ] in the base frame at the sensor
-    impulse_F: np.ndarray     # (T, 3) ∫ F dτ, inertial
-    impulse_M: np.ndarray     # (T, 3) ∫ (M + x_F × F) dτ about the inertial origin
+    base_wrench: np.ndarray  # (T, nb) thruster generalized force [f; τ] in the base frame at the sensor
+    impulse_F: np.ndarray  # (T, 3) ∫ F dτ, inertial
+    impulse_M: np.ndarray  # (T, 3) ∫ (M + x_F × F) dτ about the inertial origin
 
 
 @dataclass
@@ -109,8 +109,20 @@ class StandardRows:
 
 
 def _rows(model, meas: Measurements, form: str, solver: str, base: int, target: int) -> dict:
-    return _core.postcapture_rows(model, form, solver, meas.t, meas.q, meas.v, meas.ddq, meas.base_wrench,
-                                  meas.impulse_F, meas.impulse_M, int(base), int(target))
+    return _core.postcapture_rows(
+        model,
+        form,
+        solver,
+        meas.t,
+        meas.q,
+        meas.v,
+        meas.ddq,
+        meas.base_wrench,
+        meas.impulse_F,
+        meas.impulse_M,
+        int(base),
+        int(target),
+    )
 
 
 def paper_momentum_rows(model, meas: Measurements, base: int, target: int) -> PaperRows:

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..identification import online
 from .._core import InputError
+from ..identification import online
 from . import equations as eq
 from .scenario import Scenario
 
@@ -18,7 +18,18 @@ SOLVERS = ("modified_rls", "standard_rls")
 def parameter_names(planar: bool) -> list[str]:
     if planar:
         return ["m1", "b1x", "b1y", "I1", "mn", "bnx", "bny", "In"]
-    body = lambda s: [f"m{s}", f"b{s}x", f"b{s}y", f"b{s}z", f"I{s}xx", f"I{s}xy", f"I{s}xz", f"I{s}yy", f"I{s}yz", f"I{s}zz"]  # noqa: E731
+    body = lambda s: [
+        f"m{s}",
+        f"b{s}x",
+        f"b{s}y",
+        f"b{s}z",
+        f"I{s}xx",
+        f"I{s}xy",
+        f"I{s}xz",
+        f"I{s}yy",
+        f"I{s}yz",
+        f"I{s}zz",
+    ]  # noqa: E731
     return body("1") + body("n")
 
 
@@ -26,13 +37,30 @@ def _physical(planar, m1, b1, I1, mn, bn, In) -> np.ndarray:
     """Histories → (N, P) in parameter_names order. b: (N, 3); I: (N, 3, 3)."""
     if planar:
         return np.stack([m1, b1[:, 0], b1[:, 1], I1[:, 2, 2], mn, bn[:, 0], bn[:, 1], In[:, 2, 2]], -1)
-    f = lambda m, b, I: [m, b[:, 0], b[:, 1], b[:, 2], I[:, 0, 0], I[:, 0, 1], I[:, 0, 2], I[:, 1, 1], I[:, 1, 2], I[:, 2, 2]]  # noqa: E731
+    f = lambda m, b, I: [
+        m,
+        b[:, 0],
+        b[:, 1],
+        b[:, 2],
+        I[:, 0, 0],
+        I[:, 0, 1],
+        I[:, 0, 2],
+        I[:, 1, 1],
+        I[:, 1, 2],
+        I[:, 2, 2],
+    ]  # noqa: E731
     return np.stack(f(m1, b1, I1) + f(mn, bn, In), -1)
 
 
 def _sharp_to_matrix(s):
-    return np.stack([np.stack([s[:, 0], s[:, 1], s[:, 2]], -1), np.stack([s[:, 1], s[:, 3], s[:, 4]], -1),
-                     np.stack([s[:, 2], s[:, 4], s[:, 5]], -1)], -2)
+    return np.stack(
+        [
+            np.stack([s[:, 0], s[:, 1], s[:, 2]], -1),
+            np.stack([s[:, 1], s[:, 3], s[:, 4]], -1),
+            np.stack([s[:, 2], s[:, 4], s[:, 5]], -1),
+        ],
+        -2,
+    )
 
 
 def _guess(sc: Scenario, planar: bool):
@@ -61,18 +89,19 @@ def identify_modified(model, rows: eq.PaperRows, sc: Scenario, planar: bool) -> 
     for body in range(2):
         m = mu[:, body * k]
         b = np.zeros((len(m), 3))
-        b[:, : k - 1] = mu[:, body * k + 1:(body + 1) * k] / m[:, None]
+        b[:, : k - 1] = mu[:, body * k + 1 : (body + 1) * k] / m[:, None]
         if planar:
             I = np.zeros((len(m), 3, 3))
             I[:, 2, 2] = th[:, body]
         else:
-            I = _sharp_to_matrix(th[:, 6 * body:6 * body + 6])
+            I = _sharp_to_matrix(th[:, 6 * body : 6 * body + 6])
         hist += [m, b, I]
     return _physical(planar, *hist)
 
 
-def identify_standard(model, rows: eq.StandardRows, sc: Scenario, planar: bool, forgetting: float | None = None,
-                      project: bool = False) -> np.ndarray:
+def identify_standard(
+    model, rows: eq.StandardRows, sc: Scenario, planar: bool, forgetting: float | None = None, project: bool = False
+) -> np.ndarray:
     """Ordinary RLS on the standard parameters; returns (N, P) physical parameters."""
     L = eq.Layout(planar)
     x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in _guess(sc, planar)])
@@ -82,15 +111,18 @@ def identify_standard(model, rows: eq.StandardRows, sc: Scenario, planar: bool, 
     hist = []
     for body in range(2):
         full = np.zeros((len(x), 10))
-        full[:, L.std_cols] = x[:, body * k:(body + 1) * k]
+        full[:, L.std_cols] = x[:, body * k : (body + 1) * k]
         if planar:
             # Out-of-plane inertia is not identifiable in planar motion. Complete it as an isotropic CoM
             # inertia (as the model files do) so the projection sees a body: I_ref = I_czz 1 + (|h|²1 − hhᵀ)/m,
             # which keeps the identified I_ref,zz.
             m_, h = full[:, 0], full[:, 1:4]
             iczz = full[:, 9] - (h[:, 0] ** 2 + h[:, 1] ** 2) / m_
-            Io = iczz[:, None, None] * np.eye(3) + (np.einsum("ti,ti->t", h, h)[:, None, None] * np.eye(3)
-                                                    - np.einsum("ti,tj->tij", h, h)) / m_[:, None, None]
+            Io = (
+                iczz[:, None, None] * np.eye(3)
+                + (np.einsum("ti,ti->t", h, h)[:, None, None] * np.eye(3) - np.einsum("ti,tj->tij", h, h))
+                / m_[:, None, None]
+            )
             full[:, 4:] = np.stack([Io[:, 0, 0], Io[:, 0, 1], Io[:, 1, 1], Io[:, 0, 2], Io[:, 1, 2], Io[:, 2, 2]], -1)
         if project:
             full = eq.project_consistent(full)
@@ -113,8 +145,9 @@ def _target_index(model) -> int:
     i = idx[0]
     # The paper's target is rigidly grasped: a fixed joint on the end-effector link.
     if model.joint_types[i] != "fixed" or any(model.parents[j] == i for j in range(model.nbodies)):
-        raise InputError(f"the target '{model.body_names[i]}' must be welded to the end effector "
-                         "(a leaf body on a fixed joint)")
+        raise InputError(
+            f"the target '{model.body_names[i]}' must be welded to the end effector (a leaf body on a fixed joint)"
+        )
     return i
 
 
@@ -134,6 +167,11 @@ def equation_residuals(model, pr: eq.PaperRows, sr: eq.StandardRows, planar, bas
     lin = np.abs(eq.mv(pr.A, mu) - pr.b).max()
     ang = np.abs(eq.mv(pr.Phi, th) - pr.y - eq.mv(pr.Psi, D)).max()
     std = np.abs(eq.mv(sr.Phi, x) - sr.y).max()
-    return {"paper_linear": float(lin), "paper_linear_scale": float(np.abs(pr.b).max()),
-            "paper_angular": float(ang), "paper_angular_scale": float(np.abs(pr.y).max()),
-            "standard": float(std), "standard_scale": float(np.abs(sr.y).max())}
+    return {
+        "paper_linear": float(lin),
+        "paper_linear_scale": float(np.abs(pr.b).max()),
+        "paper_angular": float(ang),
+        "paper_angular_scale": float(np.abs(pr.y).max()),
+        "standard": float(std),
+        "standard_scale": float(np.abs(sr.y).max()),
+    }

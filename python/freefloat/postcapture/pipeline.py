@@ -9,7 +9,16 @@ import numpy as np
 
 from .. import models
 from . import equations as eq
-from .estimators import METHODS, SOLVERS, _target_index, equation_residuals, identify_modified, identify_standard, parameter_names, truth_vector
+from .estimators import (
+    METHODS,
+    SOLVERS,
+    _target_index,
+    equation_residuals,
+    identify_modified,
+    identify_standard,
+    parameter_names,
+    truth_vector,
+)
 from .results import PostcaptureResult
 from .scenario import DEFAULT_NOISE, Scenario, load_scenario
 from .simulation import measure, simulate
@@ -32,7 +41,10 @@ def identify(model, meas: eq.Measurements, sc: Scenario, methods=METHODS, timing
         res[method] = equation_residuals(model, paper_rows, std_rows, planar, base, target)
         t0 = time.perf_counter()
         hist[(method, "modified_rls")] = (paper_rows.t, identify_modified(model, paper_rows, sc, planar))
-        hist[(method, "standard_rls")] = (std_rows.t, identify_standard(model, std_rows, sc, planar, project=sc.project))
+        hist[(method, "standard_rls")] = (
+            std_rows.t,
+            identify_standard(model, std_rows, sc, planar, project=sc.project),
+        )
         timings[f"{method}_estimators"] = time.perf_counter() - t0
     return PostcaptureResult(sc, parameter_names(planar), truth, hist, timings, res)
 
@@ -88,12 +100,13 @@ def noise_study(sc: Scenario, scales=(0.0, 0.01, 0.1, 1.0), seeds=(0, 1, 2)) -> 
         s = copy.deepcopy(sc)
         s.noise = {k: v * scale for k, v in DEFAULT_NOISE.items()} if scale > 0 else None
         errs = {}
-        for seed in (seeds if scale > 0 else seeds[:1]):
+        for seed in seeds if scale > 0 else seeds[:1]:
             res = run(s, seed=seed)
             out["names"] = res.names
             for method in METHODS:
                 for solver in SOLVERS:
                     errs.setdefault(f"{method}/{solver}", []).append(res.rel_error(method, solver))
-        out["levels"].append({"scale": scale, "noise": s.noise,
-                              "median_error": {k: np.median(v, 0).tolist() for k, v in errs.items()}})
+        out["levels"].append(
+            {"scale": scale, "noise": s.noise, "median_error": {k: np.median(v, 0).tolist() for k, v in errs.items()}}
+        )
     return out

@@ -35,7 +35,7 @@ def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
             ax.grid(alpha=0.3)
         for ax in axes[-1]:
             ax.set_xlabel("t [s]")
-        for ax in axes.ravel()[len(show):]:
+        for ax in axes.ravel()[len(show) :]:
             ax.axis("off")
         axes[0, 0].legend(fontsize=7)
         fig.suptitle(f"{res.scenario.name}: {method}-based identification (estimate / truth)")

@@ -34,7 +34,7 @@ class PostcaptureResult:
     scenario: Scenario
     names: list
     truth: np.ndarray
-    histories: dict          # (method, solver) -> (t (N,), params (N, P))
+    histories: dict  # (method, solver) -> (t (N,), params (N, P))
     timings: dict
     residuals: dict = field(default_factory=dict)
 
@@ -51,32 +51,51 @@ class PostcaptureResult:
         return transit_times(t, h, self.truth, self.scenario.tolerance)
 
     def to_dict(self) -> dict:
-        out = {"scenario": self.scenario.name, "model": self.scenario.model, "tolerance": self.scenario.tolerance,
-               "P0": self.scenario.P0, "forgetting": self.scenario.forgetting, "projected": self.scenario.project,
-               "duration": self.scenario.duration, "timings_s": self.timings, "equation_residuals_at_truth": self.residuals,
-               "noise": self.scenario.noise, "measurement": self.scenario.measurement, "methods": {}}
+        out = {
+            "scenario": self.scenario.name,
+            "model": self.scenario.model,
+            "tolerance": self.scenario.tolerance,
+            "P0": self.scenario.P0,
+            "forgetting": self.scenario.forgetting,
+            "projected": self.scenario.project,
+            "duration": self.scenario.duration,
+            "timings_s": self.timings,
+            "equation_residuals_at_truth": self.residuals,
+            "noise": self.scenario.noise,
+            "measurement": self.scenario.measurement,
+            "methods": {},
+        }
         for (method, solver), (_t, h) in self.histories.items():
             tt = self.transits(method, solver)
             err = self.rel_error(method, solver)
             out["methods"].setdefault(method, {})[solver] = {
-                n: {"truth": float(self.truth[j]), "estimate": float(h[-1, j]),
-                    "error": float(err[j]), "error_kind": "relative" if self.truth[j] != 0 else "absolute",
-                    "transit_time": tt[j][1], "first_within": tt[j][0],
-                    "paper": self.scenario.paper.get(method, {}).get(n)}
-                for j, n in enumerate(self.names)}
+                n: {
+                    "truth": float(self.truth[j]),
+                    "estimate": float(h[-1, j]),
+                    "error": float(err[j]),
+                    "error_kind": "relative" if self.truth[j] != 0 else "absolute",
+                    "transit_time": tt[j][1],
+                    "first_within": tt[j][0],
+                    "paper": self.scenario.paper.get(method, {}).get(n),
+                }
+                for j, n in enumerate(self.names)
+            }
         return out
 
     def table(self) -> str:
         """Our final estimates (transit time to the scenario's tolerance, 'stays' reading) beside the paper's."""
         tol = self.scenario.tolerance
-        lines = [f"{self.scenario.name}: final estimates at t = {self.scenario.duration:g} s, "
-                 f"(transit time to {tol * 100:g} %, after which the estimate stays within)"]
+        lines = [
+            f"{self.scenario.name}: final estimates at t = {self.scenario.duration:g} s, "
+            f"(transit time to {tol * 100:g} %, after which the estimate stays within)"
+        ]
         for method in METHODS:
             if (method, "modified_rls") not in self.histories:
                 continue
             paper = self.scenario.paper.get(method, {})
             hdr = f"{'param':>6} {'truth':>12} | {'paper ' + method:>22} | " + " | ".join(
-                f"{SOLVER_TITLES[s]:>30}" for s in SOLVERS)
+                f"{SOLVER_TITLES[s]:>30}" for s in SOLVERS
+            )
             lines += ["", f"{method}-based", hdr, "-" * len(hdr)]
             tr = {s: self.transits(method, s) for s in SOLVERS}
             err = {s: self.rel_error(method, s) for s in SOLVERS}
@@ -84,7 +103,11 @@ class PostcaptureResult:
                 if n not in paper and paper and _is_product(n):
                     continue
                 p = paper.get(n)
-                ptxt = "" if p is None or p[0] is None else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (-)"))
+                ptxt = (
+                    ""
+                    if p is None or p[0] is None
+                    else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (-)"))
+                )
                 cells = []
                 for s in SOLVERS:
                     e = self.final(method, s)[j]
@@ -92,7 +115,9 @@ class PostcaptureResult:
                     cells.append(f"{e:>13.6g} ({'-' if tt is None else f'{tt:.1f}'} s, {err[s][j]:.1e})")
                 lines.append(f"{n:>6} {self.truth[j]:>12.6g} | {ptxt:>22} | " + " | ".join(f"{c:>30}" for c in cells))
         lines.append("")
-        lines.append("(error in brackets: relative, absolute for a zero true value; '-' = not within tolerance at the end)")
+        lines.append(
+            "(error in brackets: relative, absolute for a zero true value; '-' = not within tolerance at the end)"
+        )
         return "\n".join(lines)
 
     def save(self, out) -> Path:
@@ -113,15 +138,21 @@ def _is_product(n):
 def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx"), paper: dict | None = None) -> str:
     names = sw["names"]
     cols = [names.index(p) for p in params]
-    lines = ["relative error (%) at the end of the run vs initial base velocity [m/s]",
-             f"{'velocity':>14} {'method/solver':>26} " + " ".join(f"{p:>10}" for p in params)]
+    lines = [
+        "relative error (%) at the end of the run vs initial base velocity [m/s]",
+        f"{'velocity':>14} {'method/solver':>26} " + " ".join(f"{p:>10}" for p in params),
+    ]
     for k, v in enumerate(sw["velocities"]):
         for key, errs in sw["errors"].items():
-            lines.append(f"{str([round(x, 1) for x in v]):>14} {key:>26} " + " ".join(f"{100 * errs[k][c]:>10.4f}" for c in cols))
+            lines.append(
+                f"{str([round(x, 1) for x in v]):>14} {key:>26} " + " ".join(f"{100 * errs[k][c]:>10.4f}" for c in cols)
+            )
     if paper:
-        lines.append("paper (text of Sec. V-A-3): momentum-based I'n " + ", ".join(
-            f"{p['error_percent']} % at {p['velocity']}" for p in paper.get("momentum_In", []))
-            + f"; force-based: {paper.get('force_In', '')}")
+        lines.append(
+            "paper (text of Sec. V-A-3): momentum-based I'n "
+            + ", ".join(f"{p['error_percent']} % at {p['velocity']}" for p in paper.get("momentum_In", []))
+            + f"; force-based: {paper.get('force_In', '')}"
+        )
     return "\n".join(lines)
 
 

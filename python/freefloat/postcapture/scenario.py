@@ -44,7 +44,7 @@ class Scenario:
     paper_sweep: dict | None = None
     source: str = ""
 
-    def with_base_velocity(self, vel) -> "Scenario":
+    def with_base_velocity(self, vel) -> Scenario:
         """Copy with the initial base (sensor) linear velocity replaced (inertial frame)."""
         import copy
 
@@ -101,17 +101,36 @@ def _parse(d: dict, source: str) -> Scenario:
         vel, rate = np.asarray(ini["base_velocity"], float), np.asarray(ini["base_rate"], float)
         v0 = np.concatenate([vel, rate, np.zeros(nj)])  # attitude identity: body = inertial
     ex = d["excitation"]
-    exc = {"damping": float(ex.get("damping", 0.0)), "amp": list(map(float, ex["amplitude"])),
-           "freq": list(map(float, ex["frequency"])), "phase": [float(x) * deg for x in ex.get("phase_deg", [0] * nj)]}
+    exc = {
+        "damping": float(ex.get("damping", 0.0)),
+        "amp": list(map(float, ex["amplitude"])),
+        "freq": list(map(float, ex["frequency"])),
+        "phase": [float(x) * deg for x in ex.get("phase_deg", [0] * nj)],
+    }
     ident = d["identification"]
     return Scenario(
-        name=d["name"], description=str(d.get("description", "")).strip(), model=d["model"],
-        duration=float(d["duration"]), dt=float(d.get("dt", 1e-3)), sample_period=float(d.get("sample_period", 0.1)),
-        q0=q0, v0=v0, control=dict(d["control"]), excitation=exc, tolerance=float(ident["transit_tolerance"]),
-        P0=float(ident.get("P0", 1e6)), forgetting=float(ident.get("forgetting", 1.0)), guess=ident["guess"],
-        project=bool(ident.get("project", False)), measurement=dict(d.get("measurement") or {}),
-        noise=d.get("noise"), paper=d.get("paper", {}) or {}, sweep=d.get("sweep"), paper_sweep=d.get("paper_sweep"),
-        source=source)
+        name=d["name"],
+        description=str(d.get("description", "")).strip(),
+        model=d["model"],
+        duration=float(d["duration"]),
+        dt=float(d.get("dt", 1e-3)),
+        sample_period=float(d.get("sample_period", 0.1)),
+        q0=q0,
+        v0=v0,
+        control=dict(d["control"]),
+        excitation=exc,
+        tolerance=float(ident["transit_tolerance"]),
+        P0=float(ident.get("P0", 1e6)),
+        forgetting=float(ident.get("forgetting", 1.0)),
+        guess=ident["guess"],
+        project=bool(ident.get("project", False)),
+        measurement=dict(d.get("measurement") or {}),
+        noise=d.get("noise"),
+        paper=d.get("paper", {}) or {},
+        sweep=d.get("sweep"),
+        paper_sweep=d.get("paper_sweep"),
+        source=source,
+    )
 
 
 def _base_attitude(m, q) -> np.ndarray:

@@ -18,9 +18,24 @@ def simulate(sc: Scenario, model=None) -> dict:
     m = model or models.load(sc.model)
     c, e = sc.control, sc.excitation
     return _core.postcapture_simulate(
-        m._core, np.asarray(sc.q0, float), np.asarray(sc.v0, float), sc.duration, sc.dt,
-        float(c["F_max"]), float(c["K_F"]), float(c["M_max"]), float(c["K_M"]), list(np.atleast_1d(np.asarray(c["K_D"], float))), list(np.atleast_1d(np.asarray(c["K_P"], float))),
-        list(map(float, c.get("jet", [0, 0, 0]))), e["damping"], e["amp"], e["freq"], e["phase"], 1)
+        m._core,
+        np.asarray(sc.q0, float),
+        np.asarray(sc.v0, float),
+        sc.duration,
+        sc.dt,
+        float(c["F_max"]),
+        float(c["K_F"]),
+        float(c["M_max"]),
+        float(c["K_M"]),
+        list(np.atleast_1d(np.asarray(c["K_D"], float))),
+        list(np.atleast_1d(np.asarray(c["K_P"], float))),
+        list(map(float, c.get("jet", [0, 0, 0]))),
+        e["damping"],
+        e["amp"],
+        e["freq"],
+        e["phase"],
+        1,
+    )
 
 
 def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = None) -> eq.Measurements:
@@ -74,9 +89,12 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         as_ = np.gradient(vs, sc.sample_period, axis=0)
         keep = slice(1, -1)
     elif mode.get("accelerations", "exact") != "exact":
-        raise InputError(f"measurement.accelerations: expected 'exact' or 'central_difference', got {mode['accelerations']!r}")
+        raise InputError(
+            f"measurement.accelerations: expected 'exact' or 'central_difference', got {mode['accelerations']!r}"
+        )
     integ = {"simpson": simpson, "trapezoid": trapezoid}.get(mode.get("impulses", "simpson"))
     if integ is None:
         raise InputError(f"measurement.impulses: expected 'simpson' or 'trapezoid', got {mode['impulses']!r}")
-    return eq.Measurements(t[idx][keep], q[idx][keep], vs[keep], as_[keep], wrench[idx][keep], integ(F)[keep],
-                           integ(M)[keep])
+    return eq.Measurements(
+        t[idx][keep], q[idx][keep], vs[keep], as_[keep], wrench[idx][keep], integ(F)[keep], integ(M)[keep]
+    )
