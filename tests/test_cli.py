@@ -149,3 +149,24 @@ def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
     assert ident["median_rel_error_pct"] < 1.0 and "bias compensation" in ident["solver"]
     bad = run("excite", "naveen_dual_arm", "--out", str(tmp_path / "bad"), ok=False)  # Table 2 is non-physical
     assert bad.returncode != 0 and "non-physical" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_scenarios_lists_postcapture_scenarios_and_shipped_trajectories():
+    out = run("scenarios").stdout.splitlines()
+    names = [ln.split()[0] for ln in out if ln.strip()]
+    assert {
+        "zhang2020_2d_small",
+        "zhang2020_2d_medium",
+        "zhang2020_2d_large",
+        "zhang2020_2d_sweep",
+        "zhang2020_3d",
+    } <= set(names)
+    assert "naveen_exciting_trajectory" in names and len(names) >= 6
+    line = next(ln for ln in out if ln.startswith("naveen_exciting_trajectory"))
+    assert "63 intervals" in line and "naveen_dual_arm_offset" in line
+
+
+def test_identify_minimal_trajectory_by_unknown_name_is_a_clear_error():
+    r = run("identify", "minimal", "naveen_dual_arm", "--trajectory", "no_such_trajectory", ok=False)
+    assert r.returncode == 2 and "Traceback" not in r.stderr
+    assert "neither a file nor a built-in trajectory" in r.stderr and "naveen_exciting_trajectory" in r.stderr

@@ -40,9 +40,9 @@ def identify_group():
 @click.option(
     "--trajectory",
     "traj_file",
-    type=click.Path(exists=True, dir_okay=False),
-    help="Instead of --data: simulate MODEL along this joint trajectory (e.g. DIR/trajectory.json from "
-    "`freefloat excite`) with the paper's rate noise, and identify from that.",
+    help="Instead of --data: simulate MODEL along this joint trajectory (a file such as DIR/trajectory.json from "
+    "`freefloat excite`, or a built-in trajectory name listed by `freefloat scenarios`, e.g. "
+    "naveen_exciting_trajectory) with the paper's rate noise, and identify from that.",
 )
 @click.option(
     "--method",
@@ -136,9 +136,20 @@ def identify_minimal_cmd(
         click.echo(f"simulating {n_sim} excitation intervals of {m.name} with the paper's rate noise ...")
         data, _ = idf.excitation_data(m, n_intervals=n_sim, progress=True)
     if traj_file is not None:
+        from ..io import data as shipped
         from ..io.trajectory_files import load_trajectory
 
-        trajectory, joints = load_trajectory(traj_file)
+        if Path(traj_file).is_file():
+            trajectory, joints = load_trajectory(traj_file)
+        elif shipped.exists("trajectories", traj_file):
+            with shipped.path("trajectories", traj_file) as p:
+                trajectory, joints = load_trajectory(p)
+        else:
+            raise click.BadParameter(
+                f"'{traj_file}' is neither a file nor a built-in trajectory "
+                f"(built-in: {', '.join(shipped.names('trajectories'))})",
+                param_hint="--trajectory",
+            )
         click.echo(f"simulating {m.name} along {traj_file} ({trajectory.duration:g} s) with the paper's rate noise ...")
         data, _ = idf.trajectory_data(m, trajectory, joints, progress=True)
     if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results

@@ -107,12 +107,27 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
 
 @click.command("scenarios")
 def scenarios_cmd():
-    """List the built-in post-capture scenarios (Zhang, Yue, Yuan 2020), one per line with what it reproduces.
+    """List the built-in scenarios, one per line with what it reproduces: the post-capture scenarios (Zhang, Yue,
+    Yuan 2020) and the shipped joint trajectories (the exciting trajectory designed for Naveen, Shah, Misra's robot).
 
     A scenario file (YAML; the built-in ones ship inside the package) names the robot, the captured target, the
     controller gains, the initial velocities and the identification settings. Run one with
-    `freefloat identify postcapture NAME --out DIR`."""
+    `freefloat identify postcapture NAME --out DIR`; identify along a trajectory with
+    `freefloat identify minimal naveen_dual_arm --trajectory NAME`."""
     from .. import postcapture as pc
+    from ..io import data as shipped
 
     for name, desc in pc.list_scenarios():
-        click.echo(f"{name:<22} {desc}")
+        click.echo(f"{name:<28} {desc}")
+    for name in shipped.names("trajectories"):
+        click.echo(f"{name:<28} {_trajectory_summary(shipped, name)}")
+
+
+def _trajectory_summary(shipped, name: str) -> str:
+    import json
+
+    d = json.loads(shipped.read_text("trajectories", name))
+    return (
+        f"joint trajectory ({d.get('kind', '?')}, {len(d.get('directions', []))} intervals, designed on "
+        f"{d.get('model', '?')}): `identify minimal --trajectory {name}`"
+    )
