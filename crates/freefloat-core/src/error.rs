@@ -34,13 +34,4 @@ impl FfError {
     }
 }
 
-/// Check a slice has the expected length and only finite entries.
-pub fn check_vec(name: &str, x: &[f64], expected: usize) -> Result<()> {
-    if x.len() != expected {
-        return Err(FfError::arg(name, format!("expected {expected} entries, got {}", x.len())));
-    }
-    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-        return Err(FfError::arg(name, format!("entry {i} is {} (must be finite)", x[i])));
-    }
-    Ok(())
-}
+pub use crate::check::check_vec;

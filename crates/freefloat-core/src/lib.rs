@@ -8,6 +8,7 @@
 // joint-aligned arrays at once, which reads better than zipping them.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 
+pub mod check;
 pub mod config;
 pub mod data;
 pub mod dqdynamics;

@@ -3,9 +3,9 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::forward_velocities;
+use crate::kinematics::forward_velocities_unchecked;
 use crate::model::{JointType, Model};
-use crate::regressors::momentum_regressor_from_data;
+use crate::regressors::momentum_regressor_from_data_unchecked;
 use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, Force, Inertia, Motion, Se3, V3};
 use nalgebra::{DMatrix, Vector6};
 
@@ -58,9 +58,13 @@ impl JointPath<'_> {
 /// momentum of the joint motion alone, both about the base origin in base axes. Zero momentum is zero in
 /// every frame, so `q`'s base pose is irrelevant; it is evaluated at the identity (`q` is used as scratch).
 pub fn base_twist_zero_momentum(m: &Model, d: &mut Data, q: &mut [f64], v: &mut [f64]) -> Result<Vector6<f64>> {
+    if m.joint_types.first() != Some(&JointType::Free) {
+        return Err(FfError::arg("model", "the zero-momentum base twist needs a free-floating base"));
+    }
+    crate::check::check_args(m, Some(d), &crate::check::Args::qv(q, v))?;
     q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
     v[..6].fill(0.0);
-    forward_velocities(m, d, q, v);
+    forward_velocities_unchecked(m, d, q, v);
     // One pass: the joint motion's momentum and the whole robot's inertia, both about the base origin.
     let (mut h, mut ic) = (Force::ZERO, Inertia::zero());
     for i in 0..m.nbodies() {
@@ -158,6 +162,7 @@ pub(crate) fn sample_blocks(
     if q0.len() != m.nq {
         return Err(FfError::arg("q0", format!("expected {} numbers, got {}", m.nq, q0.len())));
     }
+    crate::check::check_finite("q0", q0)?;
     if stride == 0 || offset >= stride {
         return Err(FfError::arg("stride", format!("need stride ≥ 1 and offset < stride, got {stride}, {offset}")));
     }
@@ -237,9 +242,9 @@ pub(crate) fn sample_blocks(
                     let mut sumsq = 0.0;
                     for (r, &i) in idx.iter().enumerate() {
                         set_joints(i, &mut q, &mut v);
-                        forward_velocities(m, &mut d, &q, &v); // identity base, joint-only twists
+                        forward_velocities_unchecked(m, &mut d, &q, &v); // identity base, joint-only twists
                         place_base(m, &mut d, &twists[i], &poses[i]);
-                        momentum_regressor_from_data(m, &d, &mut full);
+                        momentum_regressor_from_data_unchecked(m, &d, &mut full);
                         for (c, &col) in columns.iter().enumerate() {
                             for k in 0..6 {
                                 rows[(6 * r + k, c)] = full[(k, col)];

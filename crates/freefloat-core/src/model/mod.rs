@@ -72,7 +72,18 @@ pub struct Model {
     /// Motion subspace of each joint in the child frame at q = 0 (constant for every joint but the
     /// universal one, whose current subspace is `Data::s`).
     pub subspaces: Vec<M6>,
+    /// Children of each body, in increasing index order.
     pub children: Vec<Vec<usize>>,
+    /// Identity stamped by `ModelBuilder::build` (and by `with_parameters`/`with_gravity`), kept by
+    /// `clone`; `Data::new` copies it so that `check::check_data` can tell a `Data` of another model.
+    id: u64,
+}
+
+/// A fresh model identity (process-wide counter; 0 is never handed out).
+fn next_model_id() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
 }
 
 pub struct ModelBuilder {
@@ -112,6 +123,7 @@ impl ModelBuilder {
             nv: 0,
             subspaces: vec![],
             children: vec![],
+            id: 0,
         };
         Ok(ModelBuilder { model })
     }
@@ -212,7 +224,14 @@ impl Model {
         self.body_names.len()
     }
 
+    /// This model's identity (see `check::check_data`): equal for clones, distinct for every built or
+    /// re-parameterised model.
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
     fn finalize(&mut self) -> Result<()> {
+        self.id = next_model_id();
         let n = self.nbodies();
         check_unique("body", &self.body_names)?;
         check_unique("joint", &self.joint_names)?;
@@ -346,42 +365,15 @@ impl Model {
         q
     }
 
-    /// Check `q` (size, finiteness) and return it with every quaternion normalised.
+    /// Check `q` (size, finiteness, unit quaternions: `check::check_q`) and return it with every
+    /// quaternion normalised (a copy in `buf` only when one was off by round-off).
     /// Policy: a quaternion whose norm is off by more than 1e-6 is rejected, not silently fixed,
     /// because such an input almost always means a wrong layout (e.g. w first) rather than round-off.
     pub fn checked_q<'a>(&self, q: &'a [f64], buf: &'a mut Vec<f64>) -> Result<&'a [f64]> {
-        crate::error::check_vec("q", q, self.nq)?;
-        let mut needs_fix = false;
-        for i in 0..self.nbodies() {
-            if let Some(k) = self.joint_types[i].quaternion_offset() {
-                let s = self.idx_q[i] + k;
-                let n2: f64 = q[s..s + 4].iter().map(|x| x * x).sum();
-                let n = n2.sqrt();
-                if (n - 1.0).abs() > 1e-6 {
-                    return Err(FfError::arg(
-                        "q",
-                        format!(
-                            "the quaternion of joint '{}' (q[{}..{}], order x y z w) has norm {n:.6}; it must be a unit quaternion",
-                            self.joint_names[i],
-                            s,
-                            s + 4
-                        ),
-                    ));
-                }
-                if n != 1.0 {
-                    needs_fix = true;
-                }
-            }
-        }
-        if !needs_fix {
+        if !crate::check::check_q(self, q)? {
             return Ok(q);
         }
-        buf.clear();
-        buf.extend_from_slice(q);
-        for i in 0..self.nbodies() {
-            let s = self.idx_q[i];
-            self.joint_types[i].normalize(&mut buf[s..s + self.nqs[i]]);
-        }
+        crate::check::normalized_into(self, q, buf);
         Ok(&buf[..])
     }
 }
