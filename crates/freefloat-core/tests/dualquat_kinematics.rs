@@ -37,7 +37,7 @@ fn chain_and_poe_match_engine_fk_on_random_trees() {
             let m = random_model(&mut r, base, 8, false);
             let q = random_q(&m, &mut r);
             let mut d = Data::new(&m);
-            forward_kinematics(&m, &mut d, &q);
+            forward_kinematics(&m, &mut d, &q).unwrap();
             let chain = body_poses(&m, &q).expect("valid q");
             let poe = ProductOfExponentials::new(&m).expect("supported joints");
             let pp = poe.body_poses(&m, &q).expect("valid q");
@@ -123,7 +123,7 @@ fn dh_chain_matches_engine_model() {
     let mut d = Data::new(&m);
     for _ in 0..50 {
         let q: Vec<f64> = (0..4).map(|_| r.gen_range(-3.0..3.0)).collect();
-        forward_kinematics(&m, &mut d, &q);
+        forward_kinematics(&m, &mut d, &q).unwrap();
         let mut rr = rows;
         for (k, row) in rr.iter_mut().enumerate() {
             row[1] = q[k];

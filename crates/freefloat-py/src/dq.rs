@@ -382,11 +382,9 @@ pub fn dq_body_poses<'py>(
     let m = &mb.get().inner;
     let qv = floats(q, "q", m.nq)?;
     let poses = guard(|| {
-        let mut buf = Vec::new();
-        let qc = m.checked_q(&qv, &mut buf)?;
         match method {
-            "chain" => freefloat_core::dualquat::kinematics::body_poses(m, qc),
-            "poe" => freefloat_core::dualquat::kinematics::ProductOfExponentials::new(m)?.body_poses(m, qc),
+            "chain" => freefloat_core::dualquat::kinematics::body_poses(m, &qv),
+            "poe" => freefloat_core::dualquat::kinematics::ProductOfExponentials::new(m)?.body_poses(m, &qv),
             other => Err(freefloat_core::FfError::arg("method", format!("must be 'chain' or 'poe', got '{other}'"))),
         }
     })?;

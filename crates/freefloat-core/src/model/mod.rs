@@ -74,8 +74,9 @@ pub struct Model {
     pub subspaces: Vec<M6>,
     /// Children of each body, in increasing index order.
     pub children: Vec<Vec<usize>>,
-    /// Identity stamped by `ModelBuilder::build` (and by `with_parameters`/`with_gravity`), kept by
-    /// `clone`; `Data::new` copies it so that `check::check_data` can tell a `Data` of another model.
+    /// Layout identity stamped by `ModelBuilder::build`, kept by `clone`, `with_parameters` and
+    /// `with_gravity` (which change neither the topology nor the joints, hence no buffer size);
+    /// `Data::new` copies it so that `check::check_data` can tell a `Data` of another model.
     id: u64,
 }
 
@@ -215,6 +216,7 @@ impl ModelBuilder {
     pub fn build(self) -> Result<Model> {
         let mut m = self.model;
         m.finalize()?;
+        m.id = next_model_id();
         Ok(m)
     }
 }
@@ -224,14 +226,14 @@ impl Model {
         self.body_names.len()
     }
 
-    /// This model's identity (see `check::check_data`): equal for clones, distinct for every built or
-    /// re-parameterised model.
+    /// This model's layout identity (see `check::check_data`): shared by clones and by the models
+    /// `with_parameters`/`with_gravity` derive from it, distinct for every model `ModelBuilder::build`
+    /// makes (even from the same description).
     pub fn id(&self) -> u64 {
         self.id
     }
 
     fn finalize(&mut self) -> Result<()> {
-        self.id = next_model_id();
         let n = self.nbodies();
         check_unique("body", &self.body_names)?;
         check_unique("joint", &self.joint_names)?;
