@@ -12,18 +12,25 @@ use nalgebra::{DMatrix, Vector6};
 /// Joint angles and rates of the driven joints on a uniform time grid: `q`, `qd` are (samples × n)
 /// row-major; `iq`/`iv` are the driven joints' indices into the model's q and v.
 pub struct JointPath<'a> {
+    /// Grid step (s).
     pub step: f64,
+    /// Indices of the driven joints in q.
     pub iq: &'a [usize],
+    /// Indices of the driven joints in v (6 or more: after the free base).
     pub iv: &'a [usize],
+    /// Joint angles, samples × n, row-major (rad).
     pub q: &'a [f64],
+    /// Joint rates, samples × n, row-major (rad/s).
     pub qd: &'a [f64],
 }
 
 impl JointPath<'_> {
+    /// Number of driven joints.
     pub fn n(&self) -> usize {
         self.iq.len()
     }
 
+    /// Number of grid points.
     pub fn samples(&self) -> usize {
         if self.iq.is_empty() {
             0

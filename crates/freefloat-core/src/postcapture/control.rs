@@ -23,22 +23,28 @@ pub fn saturate(gain: f64, x: f64, max: f64) -> f64 {
 pub struct PostcaptureControl {
     /// eq. (40): thrust `F = clip(K_F P, ±F_max)` per inertial axis, P = total linear momentum
     pub f_max: f64,
+    /// Gain K_F of the thrust law, eq. (40).
     pub k_f: f64,
     /// eq. (40): couple `M = clip(K_M L_G, ±M_max)` per inertial axis, L_G = angular momentum about
     /// the system CoM (digest §11: about the CoM, so that translation does not feed the couple)
     pub m_max: f64,
+    /// Gain K_M of the couple law, eq. (40).
     pub k_m: f64,
     /// eq. (39): base angular acceleration `−K_D ω − K_P φ` per axis of the base frame (φ: yaw in 2D,
     /// rotation vector in 3D; the paper's gains are diagonal, its 3D values are not printed)
     pub k_d: V3,
+    /// Attitude gains K_P, eq. (39).
     pub k_p: V3,
     /// thruster point in the base frame (r'_jet, eq. 15); the thrust's moment about the base origin
     /// is `r'_jet × f`
     pub jet: V3,
     /// null-space motion of the arm: `−damping q̇ + amp sin(freq t + phase)` per arm joint
     pub damping: f64,
+    /// Excitation amplitudes per arm joint (rad/s²).
     pub amp: Vec<f64>,
+    /// Excitation angular frequencies per arm joint (rad/s).
     pub freq: Vec<f64>,
+    /// Excitation phases per arm joint (rad).
     pub phase: Vec<f64>,
 }
 

@@ -19,19 +19,30 @@ use crate::error::{check_vec, FfError, Result};
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
 
+/// Integration method.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
     /// Classical RK4 with fixed step `dt`.
     Rk4,
     /// Dormand-Prince 5(4) with error control; `dt` is then the output interval.
-    Rk45 { rtol: f64, atol: f64, max_step: f64 },
+    Rk45 {
+        /// Relative tolerance of the local error.
+        rtol: f64,
+        /// Absolute tolerance of the local error.
+        atol: f64,
+        /// Largest step (s).
+        max_step: f64,
+    },
 }
 
+/// Options of a simulation.
 #[derive(Clone, Copy, Debug)]
 pub struct SimOptions {
+    /// Simulated duration (s), from t = 0.
     pub t_final: f64,
     /// RK4: the step. RK45: the interval between recorded samples.
     pub dt: f64,
+    /// Integration method.
     pub method: Method,
     /// RK4 only: record every n-th step (1 = every step).
     pub record_every: usize,
@@ -52,8 +63,11 @@ pub enum Formulation {
 
 /// Everything that acts on the robot during a simulation.
 pub struct Inputs<'a> {
+    /// Generalized forces (joint torques, base thrusters).
     pub torques: TorqueSource<'a>,
+    /// A sampled controller whose held output is added to `torques`.
     pub controller: Option<Controller<'a>>,
+    /// Joints that follow a prescribed motion (hybrid dynamics).
     pub prescription: Option<Prescription<'a>>,
 }
 
