@@ -124,10 +124,7 @@ pub fn check_body(m: &Model, name: &str, body: usize) -> Result<()> {
 /// Check the shape of an output matrix.
 pub fn check_shape(name: &str, rows: usize, cols: usize, expected: (usize, usize)) -> Result<()> {
     if (rows, cols) != expected {
-        return Err(FfError::arg(
-            name,
-            format!("output must be {} × {}, got {rows} × {cols}", expected.0, expected.1),
-        ));
+        return Err(FfError::arg(name, format!("output must be {} × {}, got {rows} × {cols}", expected.0, expected.1)));
     }
     Ok(())
 }
@@ -202,7 +199,13 @@ pub fn check_args(m: &Model, d: Option<&Data>, args: &Args) -> Result<bool> {
 /// else a normalised copy in `d.qbuf` (no allocation once `d.qbuf` has nq capacity, as `Data::new`
 /// gives it).
 #[inline]
-pub(crate) fn with_unit_q<T>(m: &Model, d: &mut Data, q: &[f64], needs_fix: bool, f: impl FnOnce(&mut Data, &[f64]) -> T) -> T {
+pub(crate) fn with_unit_q<T>(
+    m: &Model,
+    d: &mut Data,
+    q: &[f64],
+    needs_fix: bool,
+    f: impl FnOnce(&mut Data, &[f64]) -> T,
+) -> T {
     if !needs_fix {
         return f(d, q);
     }

@@ -45,6 +45,9 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
+/// One state: (q, v, tau).
+type State = (Vec<f64>, Vec<f64>, Vec<f64>);
+
 fn allocations() -> usize {
     COUNT.with(|c| c.get())
 }
@@ -63,7 +66,7 @@ fn hot_paths_allocate_nothing() {
         let m = builtin::load(name).expect("built-in");
         let mut d = Data::new(&m);
         // states whose quaternion is off by round-off, so the normalised copy (d.qbuf) is exercised
-        let states: Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> = (0..16)
+        let states: Vec<State> = (0..16)
             .map(|k| {
                 let mut q = m.neutral();
                 for i in 1..m.nbodies() {
@@ -82,7 +85,7 @@ fn hot_paths_allocate_nothing() {
         let fext = vec![0.01; 6 * m.nbodies()];
         let mask: Vec<bool> = (0..m.nbodies()).map(|i| i == 2).collect();
         let ddq = vec![0.1; m.nv];
-        let mut run = |what: &str, d: &mut Data, f: &dyn Fn(&mut Data, &(Vec<f64>, Vec<f64>, Vec<f64>))| {
+        let mut run = |what: &str, d: &mut Data, f: &dyn Fn(&mut Data, &State)| {
             f(d, &states[0]); // warm-up
             let n = count(|| {
                 for _ in 0..8 {

@@ -70,8 +70,8 @@ fn bad_q(m: &Model, q: &[f64]) -> Vec<(&'static str, Vec<f64>)> {
     let mut out = bad(q);
     if m.joint_types[0] == JointType::Free {
         let mut x = q.to_vec();
-        for k in 3..7 {
-            x[k] *= 2.0;
+        for xk in &mut x[3..7] {
+            *xk *= 2.0;
         }
         out.push(("quaternion norm 2", x));
     }
@@ -102,6 +102,7 @@ fn good(m: &Model) -> Good {
     Good { q, v, a, fext }
 }
 
+#[allow(clippy::too_many_arguments)] // a test helper: one argument per engine argument it varies
 /// Every state-taking entry point, with the configuration, velocity, nv-vector and external forces
 /// given (each may be bad), and the `Data` to use.
 fn state_calls(
@@ -145,10 +146,16 @@ fn state_calls(
     run("aba", "q,v,a", failures, &mut || aba(m, d, q, v, a, fx));
     let mask: Vec<bool> = (0..nb).map(|i| i == 2).collect();
     let ddq = vec![0.0; m.nv];
-    run("hybrid_aba", "q,v,a", failures, &mut || hybrid_aba(m, d, q, v, a, fx, Some(Prescribed { mask: &mask, ddq: &ddq })));
-    run("hybrid_aba (ddq)", "q,v,a", failures, &mut || hybrid_aba(m, d, q, v, &ddq, fx, Some(Prescribed { mask: &mask, ddq: a })));
+    run("hybrid_aba", "q,v,a", failures, &mut || {
+        hybrid_aba(m, d, q, v, a, fx, Some(Prescribed { mask: &mask, ddq: &ddq }))
+    });
+    run("hybrid_aba (ddq)", "q,v,a", failures, &mut || {
+        hybrid_aba(m, d, q, v, &ddq, fx, Some(Prescribed { mask: &mask, ddq: a }))
+    });
     let mut j = DMatrix::zeros(6, m.nv);
-    run("frame_jacobian", "q", failures, &mut || frame_jacobian(m, d, q, nb - 1, &Se3::identity(), Reference::World, &mut j));
+    run("frame_jacobian", "q", failures, &mut || {
+        frame_jacobian(m, d, q, nb - 1, &Se3::identity(), Reference::World, &mut j)
+    });
     run("generalized_jacobian", "q", failures, &mut || {
         generalized_jacobian(m, d, q, nb - 1, &Se3::identity(), Reference::World, &[0.0; 6]).map(|_| ())
     });
@@ -157,14 +164,22 @@ fn state_calls(
     let mut y = DMatrix::zeros(m.nv, 10 * nb);
     run("dynamics_regressor", "q,v,a", failures, &mut || dynamics_regressor(m, d, q, v, a, &mut y));
     run("dq_dynamics", "q,v,a", failures, &mut || dq_dynamics(m, d, q, v, a, fx, None).map(|_| ()));
-    run("dq_dynamics_with dense", "q,v,a", failures, &mut || dq_dynamics_with(m, d, q, v, a, fx, None, Solver::Dense).map(|_| ()));
+    run("dq_dynamics_with dense", "q,v,a", failures, &mut || {
+        dq_dynamics_with(m, d, q, v, a, fx, None, Solver::Dense).map(|_| ())
+    });
     let lock: Vec<bool> = (0..nb).map(|i| i == 3).collect();
     run("dq_dynamics locked", "q,v,a", failures, &mut || dq_dynamics(m, d, q, v, a, fx, Some(&lock)).map(|_| ()));
-    run("dq_hybrid_dynamics", "q,v,a", failures, &mut || dq_hybrid_dynamics(m, d, q, v, a, fx, &lock, &ddq).map(|_| ()));
-    run("dq_hybrid_dynamics (ddq)", "q,v,a", failures, &mut || dq_hybrid_dynamics(m, d, q, v, &ddq, fx, &lock, a).map(|_| ()));
+    run("dq_hybrid_dynamics", "q,v,a", failures, &mut || {
+        dq_hybrid_dynamics(m, d, q, v, a, fx, &lock, &ddq).map(|_| ())
+    });
+    run("dq_hybrid_dynamics (ddq)", "q,v,a", failures, &mut || {
+        dq_hybrid_dynamics(m, d, q, v, &ddq, fx, &lock, a).map(|_| ())
+    });
     run("decoupled_dynamics", "q,v,a", failures, &mut || decoupled_dynamics(m, d, q, v, a, fx).map(|_| ()));
     let (mut qs, mut vs) = (q.to_vec(), v.to_vec());
-    run("base_twist_zero_momentum", "q,v", failures, &mut || base_twist_zero_momentum(m, d, &mut qs, &mut vs).map(|_| ()));
+    run("base_twist_zero_momentum", "q,v", failures, &mut || {
+        base_twist_zero_momentum(m, d, &mut qs, &mut vs).map(|_| ())
+    });
 }
 
 #[test]
@@ -192,19 +207,27 @@ fn every_entry_point_refuses_bad_slices_without_panicking() {
         must_err(&format!("rnea ({tag})"), &mut failures, || rnea(&m, &mut d, q, v, a, fx));
         must_err(&format!("aba ({tag})"), &mut failures, || aba(&m, &mut d, q, v, a, fx));
         must_err(&format!("hybrid_aba ({tag})"), &mut failures, || hybrid_aba(&m, &mut d, q, v, a, fx, None));
-        must_err(&format!("dq_dynamics ({tag})"), &mut failures, || dq_dynamics(&m, &mut d, q, v, a, fx, None).map(|_| ()));
+        must_err(&format!("dq_dynamics ({tag})"), &mut failures, || {
+            dq_dynamics(&m, &mut d, q, v, a, fx, None).map(|_| ())
+        });
         must_err(&format!("decoupled_dynamics ({tag})"), &mut failures, || {
             decoupled_dynamics(&m, &mut d, q, v, a, fx).map(|_| ())
         });
     }
     for (label, x) in bad(a) {
         let tag = format!("a/tau {label}");
-        must_err(&format!("forward_accelerations ({tag})"), &mut failures, || forward_accelerations(&m, &mut d, q, v, &x));
+        must_err(&format!("forward_accelerations ({tag})"), &mut failures, || {
+            forward_accelerations(&m, &mut d, q, v, &x)
+        });
         must_err(&format!("rnea ({tag})"), &mut failures, || rnea(&m, &mut d, q, v, &x, None));
         must_err(&format!("aba ({tag})"), &mut failures, || aba(&m, &mut d, q, v, &x, None));
         let mut y = DMatrix::zeros(m.nv, 10 * m.nbodies());
-        must_err(&format!("dynamics_regressor ({tag})"), &mut failures, || dynamics_regressor(&m, &mut d, q, v, &x, &mut y));
-        must_err(&format!("dq_dynamics ({tag})"), &mut failures, || dq_dynamics(&m, &mut d, q, v, &x, None, None).map(|_| ()));
+        must_err(&format!("dynamics_regressor ({tag})"), &mut failures, || {
+            dynamics_regressor(&m, &mut d, q, v, &x, &mut y)
+        });
+        must_err(&format!("dq_dynamics ({tag})"), &mut failures, || {
+            dq_dynamics(&m, &mut d, q, v, &x, None, None).map(|_| ())
+        });
         must_err(&format!("decoupled_dynamics ({tag})"), &mut failures, || {
             decoupled_dynamics(&m, &mut d, q, v, &x, None).map(|_| ())
         });
@@ -240,7 +263,8 @@ fn a_data_of_another_model_is_refused() {
     // the same description built again is another model; so is a different robot
     let same_again = builtin::load(MODEL).expect("built-in");
     let other = builtin::load("thesis_ch5_single_arm").expect("built-in");
-    for (tag, mut d) in [("same description, built again", Data::new(&same_again)), ("other robot", Data::new(&other))] {
+    for (tag, mut d) in [("same description, built again", Data::new(&same_again)), ("other robot", Data::new(&other))]
+    {
         state_calls(&m, &mut d, &g.q, &g.v, &g.a, &g.fext, tag, Some("data"), &mut failures);
         must_err(&format!("momentum_from_data ({tag})"), &mut failures, || momentum_from_data(&m, &d));
         must_err(&format!("kinetic_energy_from_data ({tag})"), &mut failures, || kinetic_energy_from_data(&m, &d));
@@ -285,7 +309,9 @@ fn other_entry_points_refuse_bad_slices_and_indices() {
         let poe = ProductOfExponentials::new(&m).expect("poe");
         must_err(&format!("ProductOfExponentials::body_poses q {label}"), &mut failures, || poe.body_poses(&m, &x));
         let opts = SimOptions { t_final: 0.01, dt: 1e-3, method: Method::Rk4, record_every: 1, max_steps: 100 };
-        must_err(&format!("simulate q0 {label}"), &mut failures, || simulate(&m, &x, &g.v, &opts, Inputs::default(), None));
+        must_err(&format!("simulate q0 {label}"), &mut failures, || {
+            simulate(&m, &x, &g.v, &opts, Inputs::default(), None)
+        });
     }
     for (label, x) in bad(&g.v) {
         let mut k = x.clone();

@@ -2,6 +2,9 @@
 //! recursive algorithms: accelerations = ABA, joint wrenches = RNEA's transmitted forces (run at the ABA
 //! accelerations), locked joints = hybrid ABA, on random trees with every joint type the engine has.
 
+// as in the crate: loops index several joint-aligned arrays at once
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 
 use common::{random_model, random_model_of, random_q, random_vec, rel_err, rng, KINDS};
@@ -141,13 +144,22 @@ fn bad_input_is_reported() {
     let q = random_q(&m, &mut r);
     let v = random_vec(m.nv, &mut r);
     let tau = random_vec(m.nv, &mut r);
-    assert!(matches!(dq_dynamics(&m, &mut Data::new(&m), &q[1..], &v, &tau, None, None), Err(FfError::Argument { .. })));
-    assert!(matches!(dq_dynamics(&m, &mut Data::new(&m), &q, &v[1..], &tau, None, None), Err(FfError::Argument { .. })));
+    assert!(matches!(
+        dq_dynamics(&m, &mut Data::new(&m), &q[1..], &v, &tau, None, None),
+        Err(FfError::Argument { .. })
+    ));
+    assert!(matches!(
+        dq_dynamics(&m, &mut Data::new(&m), &q, &v[1..], &tau, None, None),
+        Err(FfError::Argument { .. })
+    ));
     let mut bad = tau.clone();
     bad[0] = f64::NAN;
     assert!(matches!(dq_dynamics(&m, &mut Data::new(&m), &q, &v, &bad, None, None), Err(FfError::Argument { .. })));
     let lock0 = vec![true; m.nbodies()];
-    assert!(matches!(dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, Some(&lock0)), Err(FfError::Argument { .. })));
+    assert!(matches!(
+        dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, Some(&lock0)),
+        Err(FfError::Argument { .. })
+    ));
     // planar base: not supported
     let mp = random_model(&mut r, JointType::Planar, 3, false);
     let qp = random_q(&mp, &mut r);
@@ -158,7 +170,8 @@ fn bad_input_is_reported() {
     b.add_body(body("a", 0, JointType::Revolute, V3::z(), Se3::identity(), Inertia::zero())).expect("a");
     b.add_body(body("b", 1, JointType::Revolute, V3::x(), Se3::new(M3::identity(), V3::x()), inr)).expect("b");
     if let Ok(m0) = b.build() {
-        let e = dq_dynamics(&m0, &mut Data::new(&m0), &m0.neutral(), &vec![0.0; m0.nv], &vec![0.0; m0.nv], None, None).cloned();
+        let e = dq_dynamics(&m0, &mut Data::new(&m0), &m0.neutral(), &vec![0.0; m0.nv], &vec![0.0; m0.nv], None, None)
+            .cloned();
         match e {
             Err(FfError::Model(msg)) => assert!(msg.contains("'a'"), "{msg}"),
             other => panic!("expected a model error naming body a, got {other:?}"),
@@ -180,7 +193,8 @@ fn tree_and_dense_schur_solves_agree() {
         let mask: Vec<bool> = (0..m.nbodies()).map(|i| i > 0 && (i + case) % 4 == 0).collect();
         let lk = if case % 2 == 0 { Some(&mask[..]) } else { None };
         let t = dq_dynamics_with(&m, &mut Data::new(&m), &q, &v, &tau, None, lk, Solver::Tree).cloned().expect("tree");
-        let d = dq_dynamics_with(&m, &mut Data::new(&m), &q, &v, &tau, None, lk, Solver::Dense).cloned().expect("dense");
+        let d =
+            dq_dynamics_with(&m, &mut Data::new(&m), &q, &v, &tau, None, lk, Solver::Dense).cloned().expect("dense");
         assert!(rel_err(&t.ddq, &d.ddq) < 1e-12, "case {case}");
         assert!(rel_err(&flat(&t.joint_wrenches), &flat(&d.joint_wrenches)) < 1e-12, "case {case}");
     }
@@ -229,7 +243,9 @@ fn decoupled_formulation_agrees_with_dq_and_aba() {
     }
     // a universal joint is refused with a clear error
     let m = random_model_of(&mut r, JointType::Free, 1, false, &[JointType::Universal]);
-    let err = decoupled_dynamics(&m, &mut Data::new(&m), &m.neutral(), &vec![0.0; m.nv], &vec![0.0; m.nv], None).cloned().err().expect("refused");
+    let err = decoupled_dynamics(&m, &mut Data::new(&m), &m.neutral(), &vec![0.0; m.nv], &vec![0.0; m.nv], None)
+        .cloned()
+        .expect_err("refused");
     assert!(err.to_string().contains("universal"), "{err}");
     // the chapter-5 robot
     let m = freefloat_core::model::builtin::load("thesis_ch5_single_arm").expect("built-in");

@@ -144,6 +144,7 @@ fn example_a_chain(l1: f64, l2: f64, a1: f64, a2: f64) -> [DualQuat; 3] {
 }
 
 #[test]
+#[allow(clippy::approx_constant)] // 0.70710678 is the digest's printed number, compared to 1e-8
 fn chapter3_example_a_planar_rr() {
     let (l1, l2) = (1.0, 0.5);
     let (a1, a2) = (std::f64::consts::FRAC_PI_6, std::f64::consts::FRAC_PI_4);

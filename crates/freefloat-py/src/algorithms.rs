@@ -440,7 +440,8 @@ pub fn aba<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, tb) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("tau", tau, &[m.nv])?);
+    let (qb, vb, tb) =
+        (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("tau", tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
     if let Some(f) = &fb {

@@ -48,7 +48,8 @@ impl Batch {
         let b = Batch::shape(name, obj, inner)?;
         if let Some(k) = b.data.iter().position(|x| !x.is_finite()) {
             let width = b.width.max(1);
-            let where_ = if b.stacked { format!("sample {}, entry {}", k / width, k % width) } else { format!("entry {k}") };
+            let where_ =
+                if b.stacked { format!("sample {}, entry {}", k / width, k % width) } else { format!("entry {k}") };
             return Err(input_err(format!("argument `{name}`: {where_} is {} (must be finite)", b.data[k])));
         }
         Ok(b)

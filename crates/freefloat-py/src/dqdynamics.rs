@@ -62,7 +62,8 @@ pub fn dq_dynamics<'py>(
     if decoupled && mask.as_ref().is_some_and(|k| k.iter().any(|&x| x)) {
         return Err(input_err("argument `locked`: locking joints is implemented in the 'dq' formulation only"));
     }
-    let (qb, vb, tb) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("tau", tau, &[m.nv])?);
+    let (qb, vb, tb) =
+        (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("tau", tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
     if let Some(f) = &fb {

@@ -5,8 +5,8 @@ mod aba;
 mod crba;
 mod rnea;
 
-pub use aba::{aba, hybrid_aba, Prescribed};
 pub(crate) use aba::hybrid_aba_unchecked;
+pub use aba::{aba, hybrid_aba, Prescribed};
 pub use crba::crba;
 pub(crate) use crba::crba_unchecked;
 pub use rnea::rnea;

@@ -5,8 +5,8 @@ use super::gram::{strided, GramLs};
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
-use crate::model::Model;
 use crate::kinematics::forward_velocities_unchecked;
+use crate::model::Model;
 use crate::regressors::momentum_regressor_from_data_unchecked;
 use nalgebra::{DMatrix, DVector};
 
@@ -116,7 +116,7 @@ impl<'a> BlockBuilder<'a> {
         let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
         let cols = 10 * m.nbodies();
         let mut k = nalgebra::DMatrixViewMut::from_slice(&mut self.k, 6, cols); // column-major, as the block
-        // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
+                                                                                // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
         forward_velocities_unchecked(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv]);
         momentum_regressor_from_data_unchecked(m, &self.d, &mut k);
         let n = p.unknown_cols.len();

@@ -6,8 +6,8 @@ mod dynamics;
 mod momentum;
 
 pub use dynamics::dynamics_regressor;
-pub use momentum::{momentum_regressor, momentum_regressor_from_data};
 pub(crate) use momentum::momentum_regressor_from_data_unchecked;
+pub use momentum::{momentum_regressor, momentum_regressor_from_data};
 
 use crate::error::Result;
 use crate::model::Model;

@@ -70,7 +70,10 @@ impl TorqueSource<'_> {
                 if values.len() != times.len() * nv {
                     return Err(FfError::arg(
                         "out",
-                        format!("the torque table has rows of {} entries, got an output of {nv}", values.len() / times.len().max(1)),
+                        format!(
+                            "the torque table has rows of {} entries, got an output of {nv}",
+                            values.len() / times.len().max(1)
+                        ),
                     ));
                 }
                 // Index of the last sample at or before t (binary search: tables can be long).
