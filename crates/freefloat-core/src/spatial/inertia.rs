@@ -26,6 +26,9 @@ impl Inertia {
     }
 
     /// From the 10 standard parameters `[m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`.
+    ///
+    /// # Panics
+    /// If `p` has fewer than 10 entries (callers pass checked slices, e.g. `Model::with_parameters`).
     pub fn from_params(p: &[f64]) -> Self {
         Inertia {
             mass: p[0],
