@@ -145,6 +145,10 @@ impl JointType {
 
     /// Placement of the child frame in the joint's rest frame for coordinates `q` (len nq).
     /// Quaternions are used as given: callers normalise `q` once on entry.
+    ///
+    /// # Panics
+    /// If the slice is shorter than this joint's nq (a per-joint helper of the hot loops; the algorithms
+    /// pass it the joint's sub-slice of a checked `q`).
     #[inline]
     pub fn transform(self, axis: &V3, axis2: &V3, q: &[f64]) -> Se3 {
         match self {
@@ -166,6 +170,10 @@ impl JointType {
     }
 
     /// Neutral coordinates (identity quaternions, zeros elsewhere).
+    ///
+    /// # Panics
+    /// If the slice is shorter than this joint's nq (a per-joint helper of the hot loops; the algorithms
+    /// pass it the joint's sub-slice of a checked `q`).
     pub fn neutral(self, out: &mut [f64]) {
         out.fill(0.0);
         if let Some(k) = self.quaternion_offset() {
@@ -174,6 +182,10 @@ impl JointType {
     }
 
     /// Normalise the quaternion part of this joint's q in place.
+    ///
+    /// # Panics
+    /// If the slice is shorter than this joint's nq (a per-joint helper of the hot loops; the algorithms
+    /// pass it the joint's sub-slice of a checked `q`).
     pub fn normalize(self, q: &mut [f64]) {
         if let Some(k) = self.quaternion_offset() {
             quat_normalize(&mut q[k..k + 4]);
