@@ -136,8 +136,8 @@ pub struct Args<'a> {
     pub q: Option<&'a [f64]>,
     /// Generalized velocity (nv).
     pub v: Option<&'a [f64]>,
-    /// Further nv-vectors with their argument names (`a`, `tau`, `ddq`).
-    pub nv_vectors: [Option<(&'static str, &'a [f64])>; 2],
+    /// Further nv-vectors with their argument names (`a`, `tau`, `ddq`; at most three).
+    pub nv_vectors: [Option<(&'static str, &'a [f64])>; 3],
     /// External forces (nbodies × 6).
     pub fext: Option<&'a [f64]>,
     /// A per-body mask with its argument name (`prescribed`, `locked`).
@@ -153,9 +153,9 @@ impl<'a> Args<'a> {
     pub fn qv(q: &'a [f64], v: &'a [f64]) -> Self {
         Args { q: Some(q), v: Some(v), ..Default::default() }
     }
-    /// Add an nv-vector named `name`.
+    /// Add an nv-vector named `name` (at most three; a fourth replaces the third).
     pub fn nv(mut self, name: &'static str, x: &'a [f64]) -> Self {
-        let slot = if self.nv_vectors[0].is_none() { 0 } else { 1 };
+        let slot = self.nv_vectors.iter().position(|s| s.is_none()).unwrap_or(self.nv_vectors.len() - 1);
         self.nv_vectors[slot] = Some((name, x));
         self
     }
