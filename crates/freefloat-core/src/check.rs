@@ -36,8 +36,20 @@ pub fn check_len(name: &str, len: usize, expected: usize) -> Result<()> {
 /// Check that every entry of a slice is finite (names the first entry that is not).
 #[inline]
 pub fn check_finite(name: &str, x: &[f64]) -> Result<()> {
-    // one branch-free pass (vectorises); the position is looked up only on failure
-    if x.iter().fold(true, |ok, v| ok & v.is_finite()) {
+    // one branch-free pass: `v * 0` is 0 for a finite v and NaN otherwise; four independent lanes
+    // so that the sums vectorise. The position is looked up only on failure.
+    let mut acc = [0.0f64; 4];
+    let chunks = x.chunks_exact(4);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for k in 0..4 {
+            acc[k] += c[k] * 0.0;
+        }
+    }
+    for (k, v) in rest.iter().enumerate() {
+        acc[k] += v * 0.0;
+    }
+    if (acc[0] + acc[1] + acc[2] + acc[3]) == 0.0 {
         return Ok(());
     }
     match x.iter().position(|v| !v.is_finite()) {
@@ -74,9 +86,8 @@ pub fn check_data(m: &Model, d: &Data) -> Result<()> {
 pub fn check_q(m: &Model, q: &[f64]) -> Result<bool> {
     check_vec("q", q, m.nq)?;
     let mut needs_fix = false;
-    for i in 0..m.nbodies() {
-        if let Some(k) = m.joint_types[i].quaternion_offset() {
-            let s = m.idx_q[i] + k;
+    for &(i, s) in m.quaternions() {
+        {
             let n = q[s..s + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
             if (n - 1.0).abs() > QUATERNION_TOLERANCE {
                 return Err(FfError::arg(
@@ -220,8 +231,7 @@ pub(crate) fn with_unit_q<T>(
 pub(crate) fn normalized_into(m: &Model, q: &[f64], buf: &mut Vec<f64>) {
     buf.clear();
     buf.extend_from_slice(q);
-    for i in 0..m.nbodies() {
-        let s = m.idx_q[i];
-        m.joint_types[i].normalize(&mut buf[s..s + m.nqs[i]]);
+    for &(_, s) in m.quaternions() {
+        crate::spatial::quat_normalize(&mut buf[s..s + 4]);
     }
 }

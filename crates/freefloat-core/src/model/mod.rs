@@ -109,6 +109,9 @@ pub struct Model {
     /// `with_gravity` (which change neither the topology nor the joints, hence no buffer size);
     /// `Data::new` copies it so that `check::check_data` can tell a `Data` of another model.
     id: u64,
+    /// (body, offset in q) of every quaternion in q, so that the argument check and the
+    /// normalisation visit only those (filled by `finalize`).
+    quaternions: Vec<(usize, usize)>,
 }
 
 /// A fresh model identity (process-wide counter; 0 is never handed out).
@@ -157,6 +160,7 @@ impl ModelBuilder {
             subspaces: vec![],
             children: vec![],
             id: 0,
+            quaternions: vec![],
         };
         Ok(ModelBuilder { model })
     }
@@ -272,6 +276,11 @@ impl Model {
         self.id
     }
 
+    /// (body, offset in q) of every unit quaternion in q (free base, spherical joints).
+    pub fn quaternions(&self) -> &[(usize, usize)] {
+        &self.quaternions
+    }
+
     fn finalize(&mut self) -> Result<()> {
         let n = self.nbodies();
         check_unique("body", &self.body_names)?;
@@ -316,6 +325,8 @@ impl Model {
         }
         self.nq = nq;
         self.nv = nv;
+        self.quaternions =
+            (0..n).filter_map(|i| self.joint_types[i].quaternion_offset().map(|k| (i, self.idx_q[i] + k))).collect();
         self.children = vec![vec![]; n];
         for i in 1..n {
             self.children[self.parents[i].unwrap()].push(i);
