@@ -8,7 +8,7 @@ import freefloat as ff
 from freefloat import identify as idf
 from freefloat import telemetry as tm
 from freefloat import trajectories as tr
-from freefloat._rotations import quat_to_matrix
+from freefloat import quat_to_matrix
 from freefloat.consistent import consistent_parameters, is_consistent, pseudo_inertia
 from freefloat.validation import default_fourier, predict
 

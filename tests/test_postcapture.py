@@ -16,6 +16,7 @@ import freefloat as ff
 from freefloat import _core
 from freefloat import postcapture as pc
 from freefloat import postcapture_equations as eq
+import postcapture_numpy_oracle as oracle
 from freefloat.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -50,7 +51,9 @@ def rot(rng):
 
 def test_closed_forms_match_definitions():
     """H, D, B (momentum) and G, S, Q (force) reproduce m v_c, m c×ċ, I_c ω, m a_c, m c×c̈, Iβ + ω×Iω
-    computed directly from a smooth random motion (derivatives by central differences)."""
+    computed directly from a smooth random motion (derivatives by central differences). Checked on the
+    numpy oracle (tests/postcapture_numpy_oracle.py), which tests/test_formulas.py checks the engine's rows
+    against; the engine's own blocks have the same check in `postcapture/equations.rs`."""
     rng = np.random.default_rng(4)
     r0, v0, a0 = rng.normal(size=(3, 3))
     w0, b0 = rng.normal(size=(2, 3)) * 0.7
@@ -61,7 +64,7 @@ def test_closed_forms_match_definitions():
 
     def expm(w):
         th = np.linalg.norm(w)
-        K = eq.skew(w[None])[0] / th
+        K = oracle.skew(w[None])[0] / th
         return np.eye(3) + np.sin(th) * K + (1 - np.cos(th)) * K @ K
 
     def motion(t):
@@ -79,21 +82,21 @@ def test_closed_forms_match_definitions():
 
     h, t = 1e-4, 0.3
     r, A, v, w = motion(t)
-    p = eq.PointMotion(r[None], A[None], v[None], w[None], a0[None], b0[None])
+    p = oracle.PointMotion(r[None], A[None], v[None], w[None], a0[None], b0[None])
     c, cd = c_of(t), (c_of(t + h) - c_of(t - h)) / (2 * h)
     cdd = (c_of(t + h) - 2 * c + c_of(t - h)) / h**2
-    mJ = eq.mJ(m, b)
-    np.testing.assert_allclose(eq.B_block(p)[0] @ np.r_[m, m * b], m * cd, rtol=1e-6)
-    np.testing.assert_allclose(eq.H_block(p)[0] @ mJ, m * np.cross(c, cd), rtol=1e-6)
+    mJ = oracle.mJ(m, b)
+    np.testing.assert_allclose(oracle.B_block(p)[0] @ np.r_[m, m * b], m * cd, rtol=1e-6)
+    np.testing.assert_allclose(oracle.H_block(p)[0] @ mJ, m * np.cross(c, cd), rtol=1e-6)
     Iw = A @ Ic @ A.T
-    np.testing.assert_allclose(eq.D_block(p)[0] @ eq.inertia_sharp(Ic), Iw @ w, rtol=1e-12)
-    np.testing.assert_allclose(eq.G_block(p)[0] @ np.r_[m, m * b], m * cdd, rtol=1e-5)
-    np.testing.assert_allclose(eq.S_block(p)[0] @ mJ, m * np.cross(c, cdd), rtol=1e-5)
-    np.testing.assert_allclose(eq.Q_block(p)[0] @ eq.inertia_sharp(Ic), Iw @ b0 + np.cross(w, Iw @ w), rtol=1e-12)
+    np.testing.assert_allclose(oracle.D_block(p)[0] @ oracle.inertia_sharp(Ic), Iw @ w, rtol=1e-12)
+    np.testing.assert_allclose(oracle.G_block(p)[0] @ np.r_[m, m * b], m * cdd, rtol=1e-5)
+    np.testing.assert_allclose(oracle.S_block(p)[0] @ mJ, m * np.cross(c, cdd), rtol=1e-5)
+    np.testing.assert_allclose(oracle.Q_block(p)[0] @ oracle.inertia_sharp(Ic), Iw @ b0 + np.cross(w, Iw @ w), rtol=1e-12)
     # planar reduction (digest §4.2): the bx² and by² columns of H coincide, the bx·by column vanishes
-    pz = eq.PointMotion(np.array([[1.0, 2, 0]]), np.eye(3)[None], np.array([[0.3, -1, 0]]),
+    pz = oracle.PointMotion(np.array([[1.0, 2, 0]]), np.eye(3)[None], np.array([[0.3, -1, 0]]),
                         np.array([[0, 0, 0.4]]), np.zeros((1, 3)), np.zeros((1, 3)))
-    H = eq.H_block(pz)[0]
+    H = oracle.H_block(pz)[0]
     assert H[2, 4] == pytest.approx(H[2, 7]) and H[2, 5] == 0
 
 

@@ -12,6 +12,7 @@ from . import dq, estimation, excitation, models, online, reactions, telemetry, 
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
+    base_twist_for_momentum,
     body_accelerations,
     body_velocities,
     center_of_mass,
@@ -24,10 +25,14 @@ from .algorithms import (
     frame_placement,
     generalized_jacobian,
     hybrid_dynamics,
+    integrate_base_poses,
     kinetic_energy,
+    matrix_to_quat,
     momentum,
     momentum_regressor,
+    quat_to_matrix,
     rnea,
+    skew,
 )
 from .minimal import MinimalParameters, minimal_parameters
 from .model import Model
@@ -43,6 +48,7 @@ __all__ = [
     "forward_kinematics", "frame_placement", "body_velocities", "body_accelerations", "frame_jacobian", "generalized_jacobian",
     "center_of_mass", "momentum", "kinetic_energy", "centroidal_momentum_matrix",
     "momentum_regressor", "dynamics_regressor",
+    "base_twist_for_momentum", "integrate_base_poses", "quat_to_matrix", "matrix_to_quat", "skew",
     "minimal_parameters", "MinimalParameters",
     "ModelError", "InputError", "NumericalError",
 ]

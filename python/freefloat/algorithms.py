@@ -28,12 +28,32 @@ from ._core import (
     momentum_regressor,
     rnea,
 )
+from ._core import matrix_to_quat, quat_to_matrix, skew
 
 __all__ = [
     "aba", "body_accelerations", "body_velocities", "center_of_mass", "centroidal_momentum_matrix", "crba",
     "dq_dynamics", "dynamics_regressor", "forward_kinematics", "frame_jacobian", "frame_placement", "generalized_jacobian",
     "hybrid_dynamics", "kinetic_energy", "momentum", "momentum_regressor", "rnea",
+    "base_twist_for_momentum", "integrate_base_poses", "matrix_to_quat", "quat_to_matrix", "skew",
 ]
+
+
+def base_twist_for_momentum(model, q, joint_rates, momentum=None):
+    """Base velocity that gives the total momentum `momentum` ([p; L about the inertial origin], inertial
+    frame; default zero) when the joints after the base move with `joint_rates` (nv - nv_base,) at `q`:
+    a free base's twist [v; ω] in the base frame (6,), a planar base's [vx, vy, yaw rate] (3,). One sample
+    or a leading time axis. The engine's one momentum solve (Naveen, Shah, Misra's momentum model; the base
+    part of the generalized Jacobian)."""
+    return _core.base_twist_for_momentum(model, q, joint_rates, momentum)
+
+
+def integrate_base_poses(t, twists, pose0):
+    """Base poses from sampled base twists by the trapezoidal rule on the group (the engine's
+    `sim::integrate_base_poses`). Free base: twists (T, 6) [v; ω] in the base frame, pose0 (7,) position and
+    quaternion x y z w, returns (T, 7). Planar base: twists (T, 3) [vx, vy, yaw rate], pose0 (3,)
+    [x, y, yaw], returns (T, 3). t (T,) increasing times (steps may be uneven)."""
+    return _core.integrate_base_poses(as_f64(t, "t"), as_f64(twists, "twists"), as_f64(pose0, "pose0"))
+
 
 
 def generalized_jacobian(model, q, name: str, reference: str = "world", h0=None):

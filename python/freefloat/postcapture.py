@@ -25,8 +25,8 @@ from . import algorithms as alg
 from . import models
 from . import online
 from . import postcapture_equations as eq
+from .algorithms import quat_to_matrix
 from ._core import InputError
-from ._rotations import quat_to_matrix
 
 METHODS = ("momentum", "force")
 SOLVERS = ("modified_rls", "standard_rls")

@@ -200,13 +200,14 @@ def simulate_driven(model: Model, trajectory, joints, dt: float, *, held=(), t_f
     """Simulate `model` while the named `joints` follow a joint `trajectory` (an object with `prescription`
     and `duration`, e.g. from `freefloat.trajectories`) and the joints in `held` stay at their neutral angle; the
     base floats with zero total momentum, its initial twist solved from the momentum model,
-    A_b v_b = −A_j q̇_j (seed 001, digest A.10). t_final: default the trajectory's duration."""
-    from .algorithms import centroidal_momentum_matrix
+    A_b v_b = −A_j q̇_j (seed 001, digest A.10; the engine's `base_twist_for_momentum`). t_final: default the
+    trajectory's duration."""
+    from .algorithms import base_twist_for_momentum
 
     presc = trajectory.prescription(model, joints)  # entries it does not drive: neutral angle, at rest
     q0, v0, _ = presc(0.0)
-    A = centroidal_momentum_matrix(model, q0)
-    v0[:6] = np.linalg.solve(A[:, :6], -A[:, 6:] @ v0[6:])
+    nb = model.nvs[0]
+    v0[:nb] = base_twist_for_momentum(model, q0, v0[nb:])
     t_final = trajectory.duration if t_final is None else t_final
     return simulate(model, q0, v0, t_final, dt, prescribed=list(joints) + list(held), prescription=presc,
                     record_every=record_every, progress=progress)
@@ -222,8 +223,7 @@ def _bar_callback(bar):
 
 def _radius(model: Model, q) -> float:
     """Largest distance of a body's centre of mass from the system's, at q (a length scale)."""
-    from ._rotations import quat_to_matrix
-    from .algorithms import center_of_mass, forward_kinematics
+    from .algorithms import center_of_mass, forward_kinematics, quat_to_matrix
 
     fk = forward_kinematics(model, q)
     P = model.parameters()

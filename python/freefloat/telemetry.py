@@ -18,7 +18,6 @@ from pathlib import Path
 import numpy as np
 
 from ._core import InputError
-from ._rotations import quat_to_matrix
 from .simulation import MOMENTUM_NAMES
 
 #: external wrench columns: force, then moment about the inertial origin, both in the inertial frame
@@ -274,7 +273,12 @@ def integrate_poses(model, t, v, q0) -> np.ndarray:
       attitude  Q_{k+1} = Q_k ⊗ exp((ω_k + ω_{k+1}) Δt/2)     (ω body-frame, so right multiplication)
       position  r_{k+1} = r_k + (R_k v_k + R_{k+1} v_{k+1}) Δt/2   (v body-frame, R_k from Q_k)
     A planar base integrates yaw like a joint and its position with R(yaw); a fixed base has no base
-    pose. Time steps may be uneven."""
+    pose. Time steps may be uneven.
+
+    The base pose is the engine's `integrate_base_poses` (one copy of the rule, shared with the exciting-
+    trajectory design); the joints' trapezoid is a cumulative sum here."""
+    from .algorithms import integrate_base_poses
+
     t = np.asarray(t, dtype=float)
     v = np.asarray(v, dtype=float)
     q = np.empty((len(t), model.nq))
@@ -285,15 +289,9 @@ def integrate_poses(model, t, v, q0) -> np.ndarray:
     # Joints: cumulative trapezoid, vectorised.
     q[1:, jq] = q0[jq] + np.cumsum((v[:-1, jv] + v[1:, jv]) * dt / 2, axis=0)
     if nb == 6:
-        quats = _integrate_attitude(q0[3:7], v[:, 3:6], dt[:, 0])
-        q[:, 3:7] = quats
-        lin = np.einsum("kij,kj->ki", quat_to_matrix(quats), v[:, 0:3])
-        q[1:, 0:3] = q0[0:3] + np.cumsum((lin[:-1] + lin[1:]) * dt / 2, axis=0)
+        q[:, 0:7] = integrate_base_poses(t, v[:, 0:6], q0[0:7])
     elif nb == 3:
-        q[1:, 2] = q0[2] + np.cumsum((v[:-1, 2] + v[1:, 2]) * dt[:, 0] / 2)
-        c, s = np.cos(q[:, 2]), np.sin(q[:, 2])
-        lin = np.column_stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]])
-        q[1:, 0:2] = q0[0:2] + np.cumsum((lin[:-1] + lin[1:]) * dt / 2, axis=0)
+        q[:, 0:3] = integrate_base_poses(t, v[:, 0:3], q0[0:3])
     return q
 
 
@@ -318,33 +316,6 @@ def _joint_slices(model):
         iq += range(model.idx_q[b], model.idx_q[b] + model.nqs[b])
         iv += range(model.idx_v[b], model.idx_v[b] + model.nvs[b])
     return np.array(iq, dtype=int), np.array(iv, dtype=int)
-
-
-def _integrate_attitude(quat0, omega, dt) -> np.ndarray:
-    """Quaternions (T, 4) xyzw from body angular velocities omega (T, 3): Q_{k+1} = Q_k ⊗ exp(ω̄ Δt),
-    ω̄ the trapezoidal mean. Sequential by nature; plain floats keep the loop fast."""
-    n = len(omega)
-    out = np.empty((n, 4))
-    x, y, z, w = (float(c) for c in quat0)
-    out[0] = x, y, z, w
-    half = (omega[:-1] + omega[1:]) * (dt[:, None] / 2)  # rotation vector of each step, ω̄ Δt
-    ang = np.linalg.norm(half, axis=1)
-    # exp of a rotation vector φ: (sin(|φ|/2) φ/|φ|, cos(|φ|/2)); series near 0 avoids 0/0.
-    small = ang < 1e-8
-    sc = np.where(small, 0.5 - ang**2 / 48, np.sin(ang / 2) / np.where(small, 1.0, ang))
-    ex = np.column_stack([half * sc[:, None], np.cos(ang / 2)]).tolist()
-    for k in range(n - 1):
-        bx, by, bz, bw = ex[k]
-        x, y, z, w = (w * bx + x * bw + y * bz - z * by,
-                      w * by - x * bz + y * bw + z * bx,
-                      w * bz + x * by - y * bx + z * bw,
-                      w * bw - x * bx - y * by - z * bz)
-        if k % 1000 == 999:  # renormalise now and then against round-off drift
-            nrm = (x * x + y * y + z * z + w * w) ** 0.5
-            x, y, z, w = x / nrm, y / nrm, z / nrm, w / nrm
-        out[k + 1] = x, y, z, w
-    return out
-
 
 
 def from_trajectory(traj) -> Telemetry:

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ._core import InputError
-from ._rotations import quat_to_matrix
+from .algorithms import quat_to_matrix
 from .telemetry import SIGMA_ANG, SIGMA_LIN
 from .simulation import simulate_driven
 from .trajectories import Fourier

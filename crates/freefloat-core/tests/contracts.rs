@@ -403,3 +403,119 @@ fn other_entry_points_refuse_bad_slices_and_indices() {
     }
     assert!(failures.is_empty(), "{} contract failures:\n{}", failures.len(), failures.join("\n"));
 }
+
+#[test]
+fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
+    use freefloat_core::kinematics::{base_twist_for_momentum, base_velocity_coordinates};
+    use freefloat_core::postcapture::equations::{
+        com_form, paper_force_rows, paper_momentum_rows, project_consistent, standard_force_rows,
+        standard_momentum_rows, Measurements,
+    };
+    use freefloat_core::sim::{integrate_base_poses, integrate_planar_base_poses, Steps};
+    let m = builtin::load(MODEL).expect("built-in");
+    let g = good(&m);
+    let mut d = Data::new(&m);
+    let mut failures = vec![];
+    let rates = g.v[6..].to_vec();
+    must_ok("base_twist_for_momentum", &mut failures, || base_twist_for_momentum(&m, &mut d, &g.q, &rates, &[0.0; 6]));
+    for (label, x) in bad_q(&m, &g.q) {
+        must_err(&format!("base_twist_for_momentum q {label}"), &mut failures, || {
+            base_twist_for_momentum(&m, &mut d, &x, &rates, &[0.0; 6])
+        });
+    }
+    for (label, x) in bad(&rates) {
+        must_err(&format!("base_twist_for_momentum joint_rates {label}"), &mut failures, || {
+            base_twist_for_momentum(&m, &mut d, &g.q, &x, &[0.0; 6])
+        });
+    }
+    must_err("base_twist_for_momentum momentum NaN", &mut failures, || {
+        base_twist_for_momentum(&m, &mut d, &g.q, &rates, &[f64::NAN; 6])
+    });
+    let mut other = Data::new(&builtin::load("thesis_ch5_single_arm").expect("built-in"));
+    must_err("base_twist_for_momentum (Data of another model)", &mut failures, || {
+        base_twist_for_momentum(&m, &mut other, &g.q, &rates, &[0.0; 6])
+    });
+    for len in [0usize, 5, 7] {
+        let mut o = vec![0.0; len];
+        must_err(&format!("base_velocity_coordinates out {len}"), &mut failures, || {
+            base_velocity_coordinates(&m, &nalgebra::Vector6::zeros(), &mut o)
+        });
+    }
+    // base poses: 3 samples of 6 (free) or 3 (planar) twist entries
+    let pose0 = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+    let tw = vec![0.1; 18];
+    for (label, x) in bad(&tw) {
+        let mut out = vec![0.0; 21];
+        must_err(&format!("integrate_base_poses twists {label}"), &mut failures, || {
+            integrate_base_poses(Steps::Uniform(0.01), &x, &pose0, &mut out)
+        });
+    }
+    for (label, x) in bad(&pose0) {
+        let mut out = vec![0.0; 21];
+        must_err(&format!("integrate_base_poses pose0 {label}"), &mut failures, || {
+            integrate_base_poses(Steps::Uniform(0.01), &tw, &x, &mut out)
+        });
+    }
+    for len in [0usize, 20, 22] {
+        let mut out = vec![0.0; len];
+        must_err(&format!("integrate_base_poses out {len}"), &mut failures, || {
+            integrate_base_poses(Steps::Uniform(0.01), &tw, &pose0, &mut out)
+        });
+        let mut out = vec![0.0; len];
+        must_err(&format!("integrate_planar_base_poses out {len}"), &mut failures, || {
+            integrate_planar_base_poses(Steps::Uniform(0.01), &tw[..9], &[0.0; 3], &mut out)
+        });
+    }
+    for times in [&[0.0, 0.1][..], &[][..], &[0.0, 0.1, 0.2, 0.3][..]] {
+        let mut out = vec![0.0; 21];
+        must_err(&format!("integrate_base_poses {} times", times.len()), &mut failures, || {
+            integrate_base_poses(Steps::Times(times), &tw, &pose0, &mut out)
+        });
+    }
+    // post-capture rows on the seed 000 robot (base 0, target = last body)
+    let mp = builtin::load("seed000_3d").expect("built-in");
+    let (n, nv, nb) = (3usize, mp.nv, mp.nvs[0]);
+    let target = mp.nbodies() - 1;
+    let t: Vec<f64> = (0..n).map(|k| 0.01 * k as f64).collect();
+    let q = mp.neutral().repeat(n);
+    let (v, ddq, bw, imp) = (vec![0.0; n * nv], vec![0.0; n * nv], vec![0.0; n * nb], vec![0.0; n * 3]);
+    for which in ["q", "v", "ddq", "base_wrench", "impulse_f"] {
+        let base: &[f64] = match which {
+            "q" => &q,
+            "v" => &v,
+            "ddq" => &ddq,
+            "base_wrench" => &bw,
+            _ => &imp,
+        };
+        for (label, x) in bad(base) {
+            let pick = |name: &str, good: &[f64]| if name == which { x.clone() } else { good.to_vec() };
+            let (qq, vv, aa, ww, ff) =
+                (pick("q", &q), pick("v", &v), pick("ddq", &ddq), pick("base_wrench", &bw), pick("impulse_f", &imp));
+            let meas =
+                Measurements { t: &t, q: &qq, v: &vv, ddq: &aa, base_wrench: &ww, impulse_f: &ff, impulse_m: &imp };
+            let tag = format!("{which} {label}");
+            must_err(&format!("paper_momentum_rows ({tag})"), &mut failures, || {
+                paper_momentum_rows(&mp, &meas, 0, target)
+            });
+            must_err(&format!("paper_force_rows ({tag})"), &mut failures, || paper_force_rows(&mp, &meas, 0, target));
+            must_err(&format!("standard_momentum_rows ({tag})"), &mut failures, || {
+                standard_momentum_rows(&mp, &meas, 0, target)
+            });
+            must_err(&format!("standard_force_rows ({tag})"), &mut failures, || {
+                standard_force_rows(&mp, &meas, 0, target)
+            });
+        }
+    }
+    let meas = Measurements { t: &t, q: &q, v: &v, ddq: &ddq, base_wrench: &bw, impulse_f: &imp, impulse_m: &imp };
+    for (b, tg) in [(0, 0), (0, mp.nbodies()), (mp.nbodies(), 1)] {
+        must_err(&format!("paper_momentum_rows bodies {b}, {tg}"), &mut failures, || {
+            paper_momentum_rows(&mp, &meas, b, tg)
+        });
+    }
+    for len in [0usize, 9, 11] {
+        let p = vec![1.0; len];
+        must_err(&format!("com_form {len} parameters"), &mut failures, || com_form(&p));
+        must_err(&format!("project_consistent {len} parameters"), &mut failures, || project_consistent(&p, 1e-9));
+    }
+    assert!(failures.is_empty(), "{} contract failures:\n{}", failures.len(), failures.join("\n"));
+}

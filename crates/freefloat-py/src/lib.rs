@@ -11,6 +11,7 @@ mod excitation;
 mod model;
 mod postcapture;
 mod simulate;
+mod spatial;
 
 use pyo3::prelude::*;
 
@@ -43,6 +44,16 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(excitation::excitation_objective, m)?)?;
     m.add_function(wrap_pyfunction!(excitation::excitation_rows_py, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::postcapture_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::postcapture_m_j, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::inertia_com_form, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::inertia_standard_form, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::inertia_project_consistent, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::quat_to_matrix, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::matrix_to_quat, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::skew, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::integrate_base_poses, m)?)?;
+    m.add_function(wrap_pyfunction!(spatial::base_twist_for_momentum, m)?)?;
     m.add_class::<postcapture::PyRls>()?;
     m.add_class::<postcapture::PyModifiedRls>()?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_dynamics, m)?)?;

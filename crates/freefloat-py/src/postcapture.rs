@@ -265,3 +265,222 @@ impl PyModifiedRls {
         self.inner.samples()
     }
 }
+
+// -- seed 000's identification equations (postcapture::equations), one call per batch ----------------------
+
+fn flat(name: &str, obj: &Bound<'_, PyAny>, width: usize) -> PyResult<Vec<f64>> {
+    let a = crate::batch::array_arg(obj, name)?;
+    let s = a.shape().to_vec();
+    let ok = match s.as_slice() {
+        [_, w] => *w == width,
+        [_] => width == 1,
+        _ => false,
+    };
+    if !ok {
+        return Err(input_err(format!("argument `{name}`: expected shape (T, {width}), got {s:?}")));
+    }
+    Ok(a.as_array().iter().copied().collect())
+}
+
+fn array3<'py>(py: Python<'py>, data: Vec<f64>, shape: &[usize]) -> PyResult<Bound<'py, PyAny>> {
+    let arr = numpy::ndarray::ArrayD::from_shape_vec(shape.to_vec(), data)
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("internal shape error: {e}")))?;
+    Ok(numpy::IntoPyArray::into_pyarray(arr, py).into_any())
+}
+
+/// Seed 000's regression rows over a whole measurement record (Zhang, Yue, Yuan 2020), computed by the
+/// engine (`postcapture::equations`). `form`: "momentum" (eqs. 11-19; cumulative differences from the first
+/// sample, so one block fewer) or "force" (eqs. 26-33, about the base sensor). `solver`: "paper" (dict with
+/// t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict with t, Phi, y, standard
+/// parameters about the reference points). Arrays have a leading sample axis.
+#[pyfunction]
+#[pyo3(signature = (model, form, solver, t, q, v, ddq, base_wrench, impulse_f, impulse_m, base, target))]
+#[allow(clippy::too_many_arguments)]
+pub fn postcapture_rows<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    form: &str,
+    solver: &str,
+    t: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    ddq: &Bound<'py, PyAny>,
+    base_wrench: &Bound<'py, PyAny>,
+    impulse_f: &Bound<'py, PyAny>,
+    impulse_m: &Bound<'py, PyAny>,
+    base: usize,
+    target: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    use freefloat_core::postcapture::equations as eq;
+    let mb = crate::batch::model_arg(model)?;
+    let m = mb.get().inner.clone();
+    let (nq, nv, nb) = (m.nq, m.nv, m.nvs[0]);
+    let t = flat("t", t, 1)?;
+    let (q, v, ddq) = (flat("q", q, nq)?, flat("v", v, nv)?, flat("ddq", ddq, nv)?);
+    let wrench = flat("base_wrench", base_wrench, nb)?;
+    let (imp_f, imp_m) = (flat("impulse_F", impulse_f, 3)?, flat("impulse_M", impulse_m, 3)?);
+    let paper = match solver {
+        "paper" => true,
+        "standard" => false,
+        other => return Err(input_err(format!("argument `solver`: expected 'paper' or 'standard', got '{other}'"))),
+    };
+    let momentum = match form {
+        "momentum" => true,
+        "force" => false,
+        other => return Err(input_err(format!("argument `form`: expected 'momentum' or 'force', got '{other}'"))),
+    };
+    enum Rows {
+        Paper(eq::PaperRows),
+        Standard(eq::StandardRows),
+    }
+    let rows = py.detach(|| {
+        guard(|| {
+            let meas = eq::Measurements {
+                t: &t,
+                q: &q,
+                v: &v,
+                ddq: &ddq,
+                base_wrench: &wrench,
+                impulse_f: &imp_f,
+                impulse_m: &imp_m,
+            };
+            Ok(match (paper, momentum) {
+                (true, true) => Rows::Paper(eq::paper_momentum_rows(&m, &meas, base, target)?),
+                (true, false) => Rows::Paper(eq::paper_force_rows(&m, &meas, base, target)?),
+                (false, true) => Rows::Standard(eq::standard_momentum_rows(&m, &meas, base, target)?),
+                (false, false) => Rows::Standard(eq::standard_force_rows(&m, &meas, base, target)?),
+            })
+        })
+    })?;
+    let d = PyDict::new(py);
+    match rows {
+        Rows::Paper(r) => {
+            let n = r.t.len();
+            let [nl, nmu, na, nth, nd] = r.dims;
+            d.set_item("t", PyArray1::from_vec(py, r.t))?;
+            d.set_item("A", array3(py, r.a, &[n, nl, nmu])?)?;
+            d.set_item("b", array3(py, r.b, &[n, nl])?)?;
+            d.set_item("Phi", array3(py, r.phi, &[n, na, nth])?)?;
+            d.set_item("y", array3(py, r.y, &[n, na])?)?;
+            d.set_item("Psi", array3(py, r.psi, &[n, na, nd])?)?;
+        }
+        Rows::Standard(r) => {
+            let n = r.t.len();
+            let [nr, nx] = r.dims;
+            d.set_item("t", PyArray1::from_vec(py, r.t))?;
+            d.set_item("Phi", array3(py, r.phi, &[n, nr, nx])?)?;
+            d.set_item("y", array3(py, r.y, &[n, nr])?)?;
+        }
+    }
+    Ok(d)
+}
+
+/// `(m, b', I'_c)` from standard parameters (…, 10) about a reference point: masses (…), centres of mass
+/// (…, 3), inertias about the centre of mass (…, 3, 3) (parallel axes; `postcapture::equations::com_form`).
+#[pyfunction]
+pub fn inertia_com_form<'py>(
+    py: Python<'py>,
+    params: &Bound<'py, PyAny>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    use freefloat_core::postcapture::equations as eq;
+    let a = crate::batch::array_arg(params, "params")?;
+    let s = a.shape().to_vec();
+    if s.last() != Some(&10) {
+        return Err(input_err(format!("argument `params`: expected shape (…, 10), got {s:?}")));
+    }
+    let lead = &s[..s.len() - 1];
+    let x: Vec<f64> = a.as_array().iter().copied().collect();
+    let n = x.len() / 10;
+    let (mut ms, mut bs, mut is) = (Vec::with_capacity(n), Vec::with_capacity(3 * n), Vec::with_capacity(9 * n));
+    for (k, p) in x.chunks_exact(10).enumerate() {
+        let (m, b, i) = match eq::com_form(p) {
+            Ok(x) => x,
+            Err(freefloat_core::FfError::Argument { name, msg }) => {
+                return Err(input_err(format!("argument `{name}`: item {k}: {msg}")))
+            }
+            Err(e) => return Err(crate::errors::to_py(e)),
+        };
+        ms.push(m);
+        bs.extend_from_slice(b.as_slice());
+        for r in 0..3 {
+            for c in 0..3 {
+                is.push(i[(r, c)]);
+            }
+        }
+    }
+    let with = |inner: &[usize]| lead.iter().chain(inner).copied().collect::<Vec<usize>>();
+    Ok((array3(py, ms, &with(&[]))?, array3(py, bs, &with(&[3]))?, array3(py, is, &with(&[3, 3]))?))
+}
+
+/// Standard parameters (…, 10) about the reference point from masses (…), centres of mass (…, 3) and
+/// inertias about the centre of mass (…, 3, 3) (`postcapture::equations::standard_form`).
+#[pyfunction]
+pub fn inertia_standard_form<'py>(
+    py: Python<'py>,
+    mass: &Bound<'py, PyAny>,
+    com: &Bound<'py, PyAny>,
+    inertia: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use freefloat_core::postcapture::equations as eq;
+    use freefloat_core::spatial::{M3, V3};
+    let (m, c, i) = (
+        crate::batch::array_arg(mass, "mass")?,
+        crate::batch::array_arg(com, "com")?,
+        crate::batch::array_arg(inertia, "inertia")?,
+    );
+    let lead = m.shape().to_vec();
+    let want = |inner: &[usize]| lead.iter().chain(inner).copied().collect::<Vec<usize>>();
+    if c.shape() != want(&[3]).as_slice() || i.shape() != want(&[3, 3]).as_slice() {
+        return Err(input_err(format!(
+            "arguments `mass`, `com`, `inertia`: expected shapes {lead:?}, {:?}, {:?}; got {:?}, {:?}",
+            want(&[3]),
+            want(&[3, 3]),
+            c.shape(),
+            i.shape()
+        )));
+    }
+    let (m, c, i): (Vec<f64>, Vec<f64>, Vec<f64>) = (
+        m.as_array().iter().copied().collect(),
+        c.as_array().iter().copied().collect(),
+        i.as_array().iter().copied().collect(),
+    );
+    if m.iter().chain(&c).chain(&i).any(|x| !x.is_finite()) {
+        return Err(input_err("arguments `mass`, `com`, `inertia`: entries must be finite"));
+    }
+    let mut out = Vec::with_capacity(10 * m.len());
+    for k in 0..m.len() {
+        let b = V3::new(c[3 * k], c[3 * k + 1], c[3 * k + 2]);
+        out.extend_from_slice(&eq::standard_form(m[k], &b, &M3::from_row_slice(&i[9 * k..9 * k + 9])));
+    }
+    array3(py, out, &want(&[10]))
+}
+
+/// Nearest physically consistent standard parameters (…, 10) (pseudo-inertia eigenvalues clipped at
+/// `eps`·max; `postcapture::equations::project_consistent`).
+#[pyfunction]
+#[pyo3(signature = (params, eps = 1e-9))]
+pub fn inertia_project_consistent<'py>(
+    py: Python<'py>,
+    params: &Bound<'py, PyAny>,
+    eps: f64,
+) -> PyResult<Bound<'py, PyAny>> {
+    use freefloat_core::postcapture::equations as eq;
+    let a = crate::batch::array_arg(params, "params")?;
+    let s = a.shape().to_vec();
+    if s.last() != Some(&10) {
+        return Err(input_err(format!("argument `params`: expected shape (…, 10), got {s:?}")));
+    }
+    let x: Vec<f64> = a.as_array().iter().copied().collect();
+    let mut out = Vec::with_capacity(x.len());
+    for p in x.chunks_exact(10) {
+        out.extend_from_slice(&guard(|| eq::project_consistent(p, eps))?);
+    }
+    array3(py, out, &s)
+}
+
+/// `m J(b')` (10) = [m, m b', m mono(b')] (Zhang 2020, eq. (23)).
+#[pyfunction]
+pub fn postcapture_m_j<'py>(py: Python<'py>, mass: f64, com: [f64; 3]) -> Bound<'py, PyArray1<f64>> {
+    let b = freefloat_core::spatial::V3::new(com[0], com[1], com[2]);
+    PyArray1::from_vec(py, freefloat_core::postcapture::equations::m_j(mass, &b).to_vec())
+}

@@ -3,10 +3,11 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::forward_velocities_unchecked;
+use crate::kinematics::{base_twist_for_momentum, forward_velocities_unchecked};
 use crate::model::{JointType, Model};
 use crate::regressors::momentum_regressor_from_data_unchecked;
-use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, Force, Inertia, Motion, Se3, V3};
+use crate::sim::{integrate_base_poses, Steps};
+use crate::spatial::{rot_from_quat, Motion, Se3, V3};
 use nalgebra::{DMatrix, Vector6};
 
 /// Joint angles and rates of the driven joints on a uniform time grid: `q`, `qd` are (samples × n)
@@ -61,28 +62,16 @@ impl JointPath<'_> {
 }
 
 /// Base twist `[v; ω]` in the base frame that keeps the total momentum zero (seed 001 digest A.10 with
-/// h = 0): `Ic v_b = −h_joints`, with `Ic` the composite inertia of the whole robot and `h_joints` the
-/// momentum of the joint motion alone, both about the base origin in base axes. Zero momentum is zero in
-/// every frame, so `q`'s base pose is irrelevant; it is evaluated at the identity (`q` is used as scratch).
+/// h = 0), by the engine's one momentum solve `kinematics::base_twist_for_momentum`. Zero momentum is zero in
+/// every frame, so `q`'s base pose is irrelevant; it is evaluated at the identity (`q` is used as scratch),
+/// which leaves in `d` the joint-only twists `place_base` needs.
 pub fn base_twist_zero_momentum(m: &Model, d: &mut Data, q: &mut [f64], v: &mut [f64]) -> Result<Vector6<f64>> {
     if m.joint_types.first() != Some(&JointType::Free) {
         return Err(FfError::arg("model", "the zero-momentum base twist needs a free-floating base"));
     }
     crate::check::check_args(m, Some(d), &crate::check::Args::qv(q, v))?;
     q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
-    v[..6].fill(0.0);
-    forward_velocities_unchecked(m, d, q, v);
-    // One pass: the joint motion's momentum and the whole robot's inertia, both about the base origin.
-    let (mut h, mut ic) = (Force::ZERO, Inertia::zero());
-    for i in 0..m.nbodies() {
-        h += d.o_mi[i].act_force(&m.inertias[i].mul_motion(&d.v[i]));
-        ic = ic.add(&m.inertias[i].transformed(&d.o_mi[i]));
-    }
-    let rhs = -Vector6::new(h.lin.x, h.lin.y, h.lin.z, h.ang.x, h.ang.y, h.ang.z);
-    ic.to_matrix()
-        .cholesky()
-        .map(|c| c.solve(&rhs))
-        .ok_or_else(|| FfError::Numerical("the composite inertia of the robot is not positive definite".into()))
+    base_twist_for_momentum(m, d, q, &v[6..], &[0.0; 6])
 }
 
 /// After `base_twist_zero_momentum` (identity base, joint-only twists in `d`): add the base twist to every
@@ -214,23 +203,12 @@ pub(crate) fn sample_blocks(
         Ok::<_, FfError>(all)
     })?;
 
-    // (2) base poses by the trapezoidal rule on the group
-    let mut quat = [q0[3], q0[4], q0[5], q0[6]];
-    quat_normalize(&mut quat);
-    let mut pos = V3::new(q0[0], q0[1], q0[2]);
-    let mut poses = Vec::with_capacity(samples);
-    let mut vel0 = rot_from_quat(&quat) * V3::new(twists[0][0], twists[0][1], twists[0][2]);
-    poses.push(Se3::new(rot_from_quat(&quat), pos));
-    for i in 1..samples {
-        let w = (twists[i - 1].fixed_rows::<3>(3) + twists[i].fixed_rows::<3>(3)) * (0.5 * path.step);
-        quat = quat_mul(&quat, &quat_exp(&V3::new(w.x, w.y, w.z)));
-        quat_normalize(&mut quat);
-        let rot = rot_from_quat(&quat);
-        let vel = rot * V3::new(twists[i][0], twists[i][1], twists[i][2]);
-        pos += (vel0 + vel) * (0.5 * path.step);
-        vel0 = vel;
-        poses.push(Se3::new(rot, pos));
-    }
+    // (2) base poses by the trapezoidal rule on the group (the engine's one copy, `sim::integrate_base_poses`)
+    let flat: Vec<f64> = twists.iter().flat_map(|t| t.iter().copied()).collect();
+    let mut pose_rows = vec![0.0; 7 * samples];
+    integrate_base_poses(Steps::Uniform(path.step), &flat, &q0[..7], &mut pose_rows)?;
+    let poses: Vec<Se3> =
+        pose_rows.chunks_exact(7).map(|p| Se3::new(rot_from_quat(&p[3..7]), V3::new(p[0], p[1], p[2]))).collect();
 
     // (3) regressor rows at the sampled points
     let picked: Vec<usize> = (0..samples).filter(|i| i % stride == offset).collect();
@@ -271,9 +249,7 @@ pub(crate) fn sample_blocks(
     for k in 0..n {
         q_end[path.iq[k]] = path.q[(samples - 1) * n + k];
     }
-    let last = &poses[samples - 1];
-    q_end[..3].copy_from_slice(last.trans.as_slice());
-    q_end[3..7].copy_from_slice(&quat);
+    q_end[..7].copy_from_slice(&pose_rows[7 * (samples - 1)..]);
     let sumsq = parts.iter().map(|p| p.1).sum();
     Ok(SampleBlocks {
         blocks: parts.into_iter().map(|p| p.0).collect(),

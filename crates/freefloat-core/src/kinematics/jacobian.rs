@@ -1,8 +1,8 @@
-use super::{centroidal_momentum_matrix_unchecked, forward_kinematics_unchecked};
+use super::{base_twist_for_momentum, base_velocity_coordinates, forward_kinematics_unchecked};
 use crate::check::{check_args, check_body, check_data, check_finite, check_shape, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::model::{JointType, Model};
+use crate::model::Model;
 use crate::spatial::{Motion, Se3};
 use nalgebra::DMatrix;
 
@@ -82,8 +82,10 @@ fn jacobian_from_data(m: &Model, d: &Data, body: usize, placement: &Se3, referen
 /// Generalized Jacobian of a free-floating robot (Umetani-Yoshida): with the total momentum held at
 /// `h0`, the frame twist is `Jg q̇_m + offset`, where `q̇_m` are the joint rates after the base.
 /// The base velocity is eliminated through the momentum: `A_b v_b + A_m q̇_m = h0`, so
-/// `Jg = J_m − J_b A_b⁻¹ A_m` and `offset = J_b A_b⁻¹ h0`. For a planar base only the conserved
-/// in-plane momenta (p_x, p_y, L_z) are used; for a fixed base `Jg` is the ordinary Jacobian.
+/// `Jg = J_m − J_b A_b⁻¹ A_m` and `offset = J_b A_b⁻¹ h0`. The base velocities come from the one
+/// momentum solve, `base_twist_for_momentum` (column k of `−A_b⁻¹ A_m` is the base velocity of a unit
+/// rate of joint k at zero momentum; `A_b⁻¹ h0` the one of the joints at rest). For a planar base only
+/// the in-plane momenta (p_x, p_y, L_z) are used; for a fixed base `Jg` is the ordinary Jacobian.
 /// Returns (Jg as 6 × (nv − nv_base), offset).
 pub fn generalized_jacobian(
     m: &Model,
@@ -99,28 +101,28 @@ pub fn generalized_jacobian(
     check_finite("h0", h0)?;
     let nb = m.nvs[0];
     let nm = m.nv - nb;
-    with_unit_q(m, d, q, fix, |d, q| centroidal_momentum_matrix_unchecked(m, d, q));
-    let a = d.jac.clone();
     let mut j = DMatrix::zeros(6, m.nv);
-    jacobian_from_data(m, d, body, placement, reference, &mut j);
-    let jm = j.columns(nb, nm).into_owned();
     if nb == 0 {
-        return Ok((jm, [0.0; 6]));
+        with_unit_q(m, d, q, fix, |d, q| forward_kinematics_unchecked(m, d, q));
+        jacobian_from_data(m, d, body, placement, reference, &mut j);
+        return Ok((j, [0.0; 6]));
     }
-    let rows: &[usize] = match m.joint_types[0] {
-        JointType::Free => &[0, 1, 2, 3, 4, 5],
-        JointType::Planar => &[0, 1, 5],
-        _ => unreachable!("a base with velocity coordinates is free or planar"),
-    };
-    let ab = DMatrix::from_fn(nb, nb, |r, c| a[(rows[r], c)]);
-    let am = DMatrix::from_fn(nb, nm, |r, c| a[(rows[r], nb + c)]);
-    let h = nalgebra::DVector::from_fn(nb, |r, _| h0[rows[r]]);
-    let lu = ab.lu();
-    let (Some(x), Some(y)) = (lu.solve(&am), lu.solve(&h)) else {
-        return Err(FfError::Numerical("the base block of the centroidal momentum matrix is singular".into()));
-    };
+    let (mut rates, mut coords) = (vec![0.0; nm], [0.0; 6]);
+    let mut x = DMatrix::zeros(nb, nm);
+    for k in 0..nm {
+        rates[k] = 1.0;
+        let tw = base_twist_for_momentum(m, d, q, &rates, &[0.0; 6])?;
+        base_velocity_coordinates(m, &tw, &mut coords[..nb])?;
+        x.column_mut(k).copy_from_slice(&coords[..nb]);
+        rates[k] = 0.0;
+    }
+    let tw = base_twist_for_momentum(m, d, q, &rates, h0)?;
+    base_velocity_coordinates(m, &tw, &mut coords[..nb])?;
+    let y = nalgebra::DVector::from_column_slice(&coords[..nb]);
+    // `d` holds the kinematics of `q` (the solves above ran them).
+    jacobian_from_data(m, d, body, placement, reference, &mut j);
     let jb = j.columns(0, nb);
-    let jg = jm - jb * x;
+    let jg = j.columns(nb, nm) + jb * x;
     let off = jb * y;
     Ok((jg, [off[0], off[1], off[2], off[3], off[4], off[5]]))
 }

@@ -1,10 +1,12 @@
 //! Forward kinematics, centre of mass, momentum, Jacobians.
 
+mod base_twist;
 mod com;
 mod fk;
 mod jacobian;
 mod momentum;
 
+pub use base_twist::{base_twist_for_momentum, base_velocity_coordinates};
 pub use com::center_of_mass;
 pub(crate) use com::center_of_mass_from_placements;
 pub use fk::{classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities};
@@ -18,6 +20,5 @@ pub use momentum::{
     world_composite_inertias, world_motion_subspaces,
 };
 pub(crate) use momentum::{
-    centroidal_momentum_matrix_unchecked, momentum_from_data_unchecked, world_composite_inertias_unchecked,
-    world_motion_subspaces_unchecked,
+    momentum_from_data_unchecked, world_composite_inertias_unchecked, world_motion_subspaces_unchecked,
 };

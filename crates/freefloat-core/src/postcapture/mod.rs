@@ -8,9 +8,12 @@
 //!
 //! The simulation is the engine's RK4 on the configuration group; the controller runs inside every
 //! Runge-Kutta stage (continuous control, digest §11). Identification is done on the recorded
-//! trajectory (Python `freefloat.postcapture`).
+//! trajectory: the identification equations (eqs. 11-33, and the standard-parameter rows) are
+//! `equations`, the estimators `estimation::{Rls, ModifiedRls}`, the orchestration Python
+//! (`freefloat.postcapture`).
 
 mod control;
+pub mod equations;
 mod simulate;
 
 pub use control::{saturate, PostcaptureControl};

@@ -2,10 +2,12 @@
 //! Dormand-Prince 5(4), with joint torques, base thrusters (the base entries of the generalized
 //! force), prescribed joint motion (hybrid dynamics) and a sampled controller with zero-order hold.
 
+mod base_poses;
 mod inputs;
 mod tableau;
 mod trajectory;
 
+pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use inputs::{Controller, Hold, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 

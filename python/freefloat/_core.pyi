@@ -1,0 +1,340 @@
+"""Type stub of freefloat._core, the compiled Rust engine (written by tools/stubgen.py: do not edit)."""
+
+from typing import Any, Callable
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+class DualQuaternion:
+    """A dual quaternion `r + ε d`; poses are unit (`q q* = 1`), twists `ω + εv`, wrenches `f + ετ`."""
+    def __init__(self, coeffs: ArrayLike) -> None: ...
+    def circle(self, other: DualQuaternion) -> float:
+        """Circle product (Table 2.4), the real number `a∘b`."""
+    def conj(self) -> DualQuaternion:
+        ...
+    def cross(self, other: DualQuaternion) -> DualQuaternion:
+        ...
+    def dot(self, other: DualQuaternion) -> DualQuaternion:
+        ...
+    @property
+    def dual(self) -> Any:
+        """Dual part `(w, x, y, z)`."""
+    def inverse(self) -> DualQuaternion:
+        """General inverse; raises InputError when the real part is zero."""
+    def is_unit(self) -> bool:
+        ...
+    def left_matrix(self) -> np.ndarray:
+        """8×8 left product matrix (2.28): `q.left_matrix() @ b == (q * b)`."""
+    def log(self) -> DualQuaternion:
+        """Principal logarithm of a unit dual quaternion."""
+    def norm(self) -> Any:
+        ...
+    def normalized(self) -> DualQuaternion:
+        """Normalisation (2.30)."""
+    def properized(self) -> DualQuaternion:
+        """Properisation (2.31)."""
+    @property
+    def real(self) -> Any:
+        """Real part `(w, x, y, z)`."""
+    def right_matrix(self) -> np.ndarray:
+        """8×8 right product matrix (2.28): `b.right_matrix() @ a == (a * b)`."""
+    def rotation_matrix(self) -> np.ndarray:
+        """3×3 rotation matrix `C(q_r)` (active: `C v = vec(q v q*)`)."""
+    def sc(self) -> Any:
+        ...
+    def screw(self) -> Any:
+        """Screw parameters `(theta, d, l, m)` of a unit dual quaternion."""
+    def shift_in(self, x: Any) -> Any:
+        """`q* x q` (2.41)/(2.43): a wrench or twist in this pose's reference frame, seen in its own frame."""
+    def shift_out(self, x: Any) -> Any:
+        """`q x q*` (2.42)/(2.44)."""
+    def swap(self) -> DualQuaternion:
+        ...
+    def to_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """Pose in the engine convention: `(quat_xyzw, t)`. Raises InputError if not unit (`q q* = 1`)."""
+    def tolist(self) -> list[float]:
+        """The 8 coefficients as a list (`numpy.asarray(q)` also works)."""
+    def translation(self) -> np.ndarray:
+        """`r^A = 2 q_d q_r*` (position of the frame in the reference frame)."""
+    def unit_defect(self) -> float:
+        """`max |q q* − 1|`."""
+    def vec(self) -> Any:
+        ...
+
+class InputError(ValueError):
+    """An argument has the wrong shape, non-finite entries or an invalid value."""
+
+class Model:
+    ...
+    @property
+    def body_names(self) -> list[str]:
+        ...
+    @staticmethod
+    def builtin(name: str) -> Model:
+        ...
+    @staticmethod
+    def builtin_names() -> list[str]:
+        ...
+    @staticmethod
+    def builtin_source(name: str) -> str:
+        ...
+    @property
+    def frame_names(self) -> list[str]:
+        ...
+    @property
+    def frames(self) -> Any:
+        """Frames as a list of (name, body name, position (3,), quaternion xyzw (4,))."""
+    @staticmethod
+    def from_urdf_string(text: str, base: str = 'free', source: str = '<string>', allow_nonphysical: bool = False) -> Model:
+        """Parse URDF text. `source` names it in error messages."""
+    @staticmethod
+    def from_yaml_string(text: str, source: str = '<string>') -> Model:
+        """Parse the YAML model format (docs/model_format.md)."""
+    @property
+    def gravity(self) -> Any:
+        ...
+    @property
+    def idx_q(self) -> Any:
+        ...
+    @property
+    def idx_v(self) -> Any:
+        ...
+    @property
+    def joint_axes(self) -> Any:
+        """Unit joint axes (nbodies, 3), joint frame."""
+    @property
+    def joint_axes2(self) -> Any:
+        """Second axes of universal joints (nbodies, 3; intermediate frame); z for every other joint."""
+    @property
+    def joint_names(self) -> list[str]:
+        ...
+    @property
+    def joint_types(self) -> list[str]:
+        ...
+    @property
+    def limits(self) -> Any:
+        """Joint limits as a dict of arrays (lower, upper, velocity, effort), NaN where not given."""
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def nbodies(self) -> int:
+        ...
+    def neutral(self) -> np.ndarray:
+        ...
+    @property
+    def nq(self) -> int:
+        ...
+    @property
+    def nqs(self) -> Any:
+        ...
+    @property
+    def nv(self) -> int:
+        ...
+    @property
+    def nvs(self) -> Any:
+        ...
+    def parameters(self) -> np.ndarray:
+        """Standard inertial parameters, (nbodies, 10): [m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]
+about each body-frame origin, body axes.
+        """
+    @property
+    def parents(self) -> Any:
+        """Parent body index of each body (-1 for the base)."""
+    @property
+    def placements(self) -> Any:
+        """Rest placement of each joint frame in its parent body, as (nbodies, 4, 4) homogeneous matrices."""
+    @property
+    def tags(self) -> Any:
+        ...
+    def to_urdf_string(self) -> str:
+        ...
+    @property
+    def total_mass(self) -> float:
+        ...
+    def with_gravity(self, g: ArrayLike) -> Model:
+        ...
+    def with_parameters(self, params: ArrayLike) -> Model:
+        """A new Model with other standard parameters (nbodies, 10); checked for physical consistency."""
+
+class ModelError(ValueError):
+    """A model file or model description is malformed or non-physical."""
+
+class ModifiedRLS:
+    """Seed 000's modified RLS (Rust `estimation::ModifiedRls`), coupling "spatial" or "planar"."""
+    def __init__(self, coupling: str, mu0: ArrayLike, p_mu0: ArrayLike, theta0: ArrayLike, p_theta0: ArrayLike) -> None: ...
+    @property
+    def mu(self) -> Any:
+        ...
+    def run(self, t: ArrayLike, a: ArrayLike, b: ArrayLike, phi: ArrayLike, y: ArrayLike, psi: ArrayLike) -> Any:
+        """Many samples (leading axis N). Returns (mu history (N, nμ), theta history (N, nθ))."""
+    @property
+    def samples(self) -> Any:
+        ...
+    @property
+    def theta(self) -> Any:
+        ...
+    def update(self, t: ArrayLike, a: ArrayLike, b: ArrayLike, phi: ArrayLike, y: ArrayLike, psi: ArrayLike) -> Any:
+        """One sample: a (rμ, nμ), b (rμ,), phi (rθ, nθ), y (rθ,), psi (rθ, nD)."""
+
+class NumericalError(ArithmeticError):
+    """The numbers defeat the algorithm (singular matrix, diverging step...)."""
+
+class RecursiveLS:
+    """Ordinary recursive least squares with forgetting factor (Rust `estimation::Rls`)."""
+    def __init__(self, theta0: ArrayLike, p0: ArrayLike, forgetting: float = 1.0) -> None: ...
+    @property
+    def covariance(self) -> Any:
+        ...
+    @property
+    def estimate(self) -> Any:
+        ...
+    def run(self, t: ArrayLike, phi: ArrayLike, y: ArrayLike) -> Any:
+        """Many samples: t (N,), phi (N, r, n), y (N, r). Returns the estimate after each sample (N, n)."""
+    @property
+    def samples(self) -> Any:
+        ...
+    def update(self, t: ArrayLike, phi: ArrayLike, y: ArrayLike) -> Any:
+        """One sample: phi (r, n), y (r,)."""
+
+def aba(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
+    """Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`."""
+
+def body_accelerations(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, classical: bool = False) -> np.ndarray:
+    """Body accelerations (nbodies, 6) in body frames: spatial (d/dt of the body-frame twist
+components, Pinocchio LOCAL) or, with `classical`, the acceleration of each body origin.
+Gravity is not included.
+    """
+
+def body_velocities(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
+    """Body twists (nbodies, 6) [linear; angular], each in its own body frame (Pinocchio LOCAL)."""
+
+def center_of_mass(model: Model, q: ArrayLike) -> np.ndarray:
+    ...
+
+def centroidal_momentum_matrix(model: Model, q: ArrayLike) -> np.ndarray:
+    """Centroidal momentum matrix about the inertial origin (6, nv): momentum == A @ v."""
+
+def crba(model: Model, q: ArrayLike) -> np.ndarray:
+    """Joint-space inertia matrix (nv, nv), full symmetric."""
+
+def dq_approach_slope(q_ga: ArrayLike, z_a: ArrayLike, half_angle: float) -> Any:
+    ...
+
+def dq_attitude(q_bi: ArrayLike, n_i: ArrayLike, n_b: ArrayLike, max_angle: float) -> Any:
+    ...
+
+def dq_body_poses(model: Model, q: ArrayLike, method: str = 'chain') -> Any:
+    """Body poses of a model as dual quaternions, (nbodies, 8): `method` "chain" (the product of relative poses
+(3.43)) or "poe" (product of exponentials (3.19)).
+    """
+
+def dq_condition_number(model: Model, q: ArrayLike) -> Any:
+    """2-norm condition number of the thesis' system matrix S (6.17) at each configuration (one q or (T, nq))."""
+
+def dq_dh(d: float, theta: float, a: ArrayLike, alpha: float) -> Any:
+    """Standard DH transform (3.26); with `rows` (n × 4 of d, θ, a, α) the chain product."""
+
+def dq_dh_chain(rows: ArrayLike) -> Any:
+    ...
+
+def dq_distance_bound(q: ArrayLike, delta: float) -> Any:
+    ...
+
+def dq_dynamics(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None, locked: ArrayLike | None = None, formulation: str = 'dq') -> tuple[np.ndarray, np.ndarray]:
+    """Returns `(ddq, W)`: accelerations (nv) and, per joint, the wrench it transmits onto its child body
+(nbodies × 6, [force; torque about the child body origin], child body axes; row 0 is the base joint).
+Joints named in `locked` are held at zero acceleration and their `tau` entries are ignored.
+`formulation`: "dq" (chapter 6, default) or "decoupled" (chapter 5's vector formulation, no locking).
+    """
+
+def dq_exp(x: Any) -> Any:
+    """`exp(x)` of a vector dual quaternion."""
+
+def dq_from_pose(quat_xyzw: ArrayLike, t: ArrayLike) -> Any:
+    """Pose from the engine convention: unit quaternion `(x, y, z, w)` (normalised if within 1e-6 of unit,
+rejected otherwise, as everywhere in freefloat) and translation `t`.
+    """
+
+def dq_line_of_sight(q_ga: ArrayLike, y_g: ArrayLike, half_angle: float) -> Any:
+    """Constraint `(value, gradient)`; `value ≤ 0` is feasible. See `freefloat.dq.line_of_sight`."""
+
+def dq_screw(theta: float, d: float, l: ArrayLike, m: ArrayLike) -> Any:
+    """Screw exponential (3.10) `exp(½(θ + εd)(ℓ + εm))`."""
+
+def dynamics_regressor(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> np.ndarray:
+    """Inverse-dynamics regressor (nv, 10·nbodies): rnea(q, v, a) == Y @ P.ravel(), gravity included.
+Per body the thesis' regressor R (Eqs. 4.3, 9.7), the Newton-Euler counterpart of seed 001's Eq. 10,
+projected on every joint between the body and the root.
+    """
+
+def excitation_objective(model: Model, q0: ArrayLike, iq: ArrayLike, iv: ArrayLike, step: float, q: ArrayLike, qd: ArrayLike, stride: int, offset: int, columns: ArrayLike, weight: float, n_signal: int, threads: int = 2) -> Any:
+    """Evaluate seed 001 eq. (32) for B joint paths at once (worker threads, GIL released).
+q (B, S, n) / qd: driven joints' angles and rates on a grid of `step` seconds; iq, iv: their q and v
+indices; q0 (nq,): start configuration (base pose, other joints); rows at grid points offset + k·stride;
+columns: minimal-regressor columns (indices into 10·nbodies); n_signal: how many of the driven joints (the
+first ones) count in the signal term. Returns a dict of arrays (B,):
+objective, condition_number, mean_square, and singular_values (B, len(columns)).
+    """
+
+def excitation_rows(model: Model, q0: ArrayLike, iq: ArrayLike, iv: ArrayLike, step: float, q: ArrayLike, qd: ArrayLike, stride: int, offset: int, columns: ArrayLike, n_signal: int) -> Any:
+    """Minimal-regressor rows along one joint path: dict with rows (6·points, len(columns)), sumsq, count,
+q_end (the configuration at the end, base pose integrated).
+    """
+
+def forward_kinematics(model: Model, q: ArrayLike) -> np.ndarray:
+    """Placement of every body in the inertial frame: (nbodies, 7) = position, quaternion x y z w."""
+
+def frame_jacobian(model: Model, q: ArrayLike, name: str, reference: str = 'local') -> np.ndarray:
+    """Jacobian (6, nv) of a body or frame: its twist [linear; angular] is J @ v."""
+
+def frame_placement(model: Model, q: ArrayLike, name: str) -> np.ndarray:
+    """Placement of a body or frame in the inertial frame: (7,) = position, quaternion x y z w."""
+
+def generalized_jacobian(model: Model, q: ArrayLike, name: str, reference: str = 'world', h0: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Generalized Jacobian of a free-floating robot: with total momentum h0 conserved, the frame's
+twist is Jg @ qdot_joints + offset. Returns (Jg (6, nv - nv_base), offset (6,)).
+    """
+
+def hybrid_dynamics(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, ddq: ArrayLike, prescribed: ArrayLike, fext: ArrayLike | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Hybrid dynamics: joints in `prescribed` follow accelerations `ddq` (their entries of it), the
+rest respond to `tau`. Returns (ddq_all, tau_all), tau_all holding the forces the prescribed
+joints needed.
+    """
+
+def identify_momentum(model: Model, q: ArrayLike, v: ArrayLike, h: ArrayLike, columns: ArrayLike, known_params: ArrayLike, weights: ArrayLike | None = None, method: str = 'auto') -> Any:
+    """Identify the parameters in `columns` (indices into the 10·nbodies standard parameters) from
+measured momenta H (T, 6), states Q (T, nq), V (T, nv). `known_params` (10·nbodies,): the known
+bodies' momentum K·P over the other columns is subtracted from H. `weights` (6,): inverse
+variances of [p; L]. method: "auto" (normal equations + refinement when well conditioned, else
+streaming QR) or "qr". Returns a dict: x, std, covariance, rss, dof, condition_number, rank,
+rows, method. Raises NumericalError naming the unexcited combinations if rank deficient.
+    """
+
+def kinetic_energy(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
+    ...
+
+def momentum(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
+    """Total momentum [linear; angular about the inertial origin], inertial frame."""
+
+def momentum_regressor(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
+    """Momentum regressor (6, 10·nbodies): momentum(q, v) == K @ P.ravel() with P = m.parameters().
+Seed 001's link kinematic matrix (Eq. 10) per body, in our parameter order.
+    """
+
+def momentum_regressor_stream(model: Model, q: ArrayLike, v: ArrayLike, h: ArrayLike, columns: ArrayLike, known_params: ArrayLike, weights: ArrayLike | None = None) -> Any:
+    """For benchmarks: one streaming pass of `identify_momentum` that builds every block of the
+regressor and right-hand side and discards it (no solve). Returns the sum of the right-hand
+sides. Same arguments as `identify_momentum`.
+    """
+
+def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1) -> Any:
+    """Simulate the post-capture scenario. Returns a dict like `simulate` (t, q, v, ddq, tau, momentum,
+kinetic_energy, work) recorded every `record_every` RK4 steps.
+    """
+
+def rnea(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
+    """Inverse dynamics: generalized forces for accelerations `a`."""
+
+def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba') -> Any:
+    ...
