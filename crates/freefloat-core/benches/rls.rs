@@ -40,7 +40,7 @@ fn real_rows(rng: &mut StdRng) -> Vec<Vec<f64>> {
                 *x = rng.gen_range(-3.0..3.0);
             }
             let v: Vec<f64> = (0..m.nv).map(|_| rng.gen_range(-1.0..1.0)).collect();
-            momentum_regressor(&m, &mut d, &q, &v, &mut k);
+            momentum_regressor(&m, &mut d, &q, &v, &mut k).unwrap();
             let mut row = Vec::with_capacity(120);
             for r in 0..6 {
                 for c in (0..10).chain(10 * target..10 * target + 10) {

@@ -7,12 +7,23 @@
 //! base. On this group the stage velocities need the dexp⁻¹ correction (Munthe-Kaas) for Runge-Kutta
 //! to keep its order; see `so3_right_jacobian_inv`.
 
+use crate::check::{check_len, check_vec};
+use crate::error::Result;
 use crate::model::{JointType, Model};
 use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, so3_right_jacobian_inv, V3};
 
 /// Time derivative of the tangent coordinates at `q` for velocity `v` (at δ = 0):
 /// free base [R v_lin, ω], planar base [R(yaw) v_xy, ω_z], spherical ω, scalar joints v.
-pub fn tangent_rate(m: &Model, q: &[f64], v: &[f64], out: &mut [f64]) {
+/// `q`: nq, `v`, `out`: nv.
+pub fn tangent_rate(m: &Model, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+    check_vec("q", q, m.nq)?;
+    check_vec("v", v, m.nv)?;
+    check_len("out", out.len(), m.nv)?;
+    tangent_rate_unchecked(m, q, v, out);
+    Ok(())
+}
+
+pub(crate) fn tangent_rate_unchecked(m: &Model, q: &[f64], v: &[f64], out: &mut [f64]) {
     for i in 0..m.nbodies() {
         let (iq, iv) = (m.idx_q[i], m.idx_v[i]);
         match m.joint_types[i] {
@@ -34,7 +45,16 @@ pub fn tangent_rate(m: &Model, q: &[f64], v: &[f64], out: &mut [f64]) {
 }
 
 /// `q = q0 ⊕ δ`: additive on reals and positions, `quat0 ⊗ exp(δθ)` on rotations.
-pub fn retract(m: &Model, q0: &[f64], delta: &[f64], out: &mut [f64]) {
+/// `q0`, `out`: nq, `delta`: nv.
+pub fn retract(m: &Model, q0: &[f64], delta: &[f64], out: &mut [f64]) -> Result<()> {
+    check_vec("q0", q0, m.nq)?;
+    check_vec("delta", delta, m.nv)?;
+    check_len("out", out.len(), m.nq)?;
+    retract_unchecked(m, q0, delta, out);
+    Ok(())
+}
+
+pub(crate) fn retract_unchecked(m: &Model, q0: &[f64], delta: &[f64], out: &mut [f64]) {
     for i in 0..m.nbodies() {
         let (iq, iv) = (m.idx_q[i], m.idx_v[i]);
         match m.joint_types[i] {
@@ -62,8 +82,15 @@ fn rotate(q0: &[f64], phi: &[f64], out: &mut [f64]) {
 }
 
 /// Map a velocity `k` (in the algebra at `q0 ⊕ δ`) to the rate of the tangent coordinates δ:
-/// `Jr(δθ)⁻¹ k` on rotation blocks, identity elsewhere. Applied in place.
-pub fn dexpinv(m: &Model, delta: &[f64], k: &mut [f64]) {
+/// `Jr(δθ)⁻¹ k` on rotation blocks, identity elsewhere. Applied in place. `delta`, `k`: nv.
+pub fn dexpinv(m: &Model, delta: &[f64], k: &mut [f64]) -> Result<()> {
+    check_vec("delta", delta, m.nv)?;
+    check_vec("k", k, m.nv)?;
+    dexpinv_unchecked(m, delta, k);
+    Ok(())
+}
+
+pub(crate) fn dexpinv_unchecked(m: &Model, delta: &[f64], k: &mut [f64]) {
     for i in 0..m.nbodies() {
         let off = match m.joint_types[i] {
             JointType::Free => m.idx_v[i] + 3,
@@ -78,7 +105,15 @@ pub fn dexpinv(m: &Model, delta: &[f64], k: &mut [f64]) {
 }
 
 /// Scale used by adaptive error control for each tangent coordinate (rotations: 1 rad).
-pub fn tangent_magnitude(m: &Model, q: &[f64], out: &mut [f64]) {
+/// `q`: nq, `out`: nv.
+pub fn tangent_magnitude(m: &Model, q: &[f64], out: &mut [f64]) -> Result<()> {
+    check_vec("q", q, m.nq)?;
+    check_len("out", out.len(), m.nv)?;
+    tangent_magnitude_unchecked(m, q, out);
+    Ok(())
+}
+
+pub(crate) fn tangent_magnitude_unchecked(m: &Model, q: &[f64], out: &mut [f64]) {
     for i in 0..m.nbodies() {
         let (iq, iv) = (m.idx_q[i], m.idx_v[i]);
         match m.joint_types[i] {

@@ -1,9 +1,11 @@
 //! `Data`: every work buffer the algorithms need, allocated once per model (Model/Data split).
 
+use crate::dqdynamics::DqData;
 use crate::model::Model;
 use crate::spatial::{Force, Inertia, Motion, Se3, M6};
 use nalgebra::DMatrix;
 
+/// Work buffers and outputs of the algorithms for one model (make it with `Data::new(&model)`).
 #[derive(Clone, Debug)]
 pub struct Data {
     /// Placement of body i in its parent (joint placement ∘ joint motion).
@@ -22,8 +24,11 @@ pub struct Data {
     /// ABA works in inertial-frame coordinates (twists and accelerations at the inertial origin):
     /// body twists, accelerations, velocity-product terms and bias forces there.
     pub ov: Vec<Motion>,
+    /// ABA: body spatial accelerations at the inertial origin, inertial axes (gravity included).
     pub oa: Vec<Motion>,
+    /// ABA: velocity-product accelerations `v × (oS q̇) + o(Ṡ q̇)`, inertial frame.
     pub oc: Vec<Motion>,
+    /// ABA: bias forces (then articulated bias forces), inertial frame.
     pub of: Vec<Force>,
     /// Motion subspace of each joint in its child frame at the last `forward_kinematics` call: a copy
     /// of `Model::subspaces`, whose universal-joint columns forward kinematics refreshes.
@@ -33,6 +38,7 @@ pub struct Data {
     /// By-products of ABA's first pass: total momentum (about the inertial origin, inertial frame)
     /// and kinetic energy at the state it was called with.
     pub aba_momentum: Force,
+    /// ABA's by-product: kinetic energy (J) at the state it was called with.
     pub aba_kinetic_energy: f64,
     /// `U = I^A S`, one 6×nv block per joint (unused columns zero).
     pub u: Vec<M6>,
@@ -52,9 +58,15 @@ pub struct Data {
     pub jac: DMatrix<f64>,
     /// Normalised copy of q when the caller's quaternions were off by round-off.
     pub qbuf: Vec<f64>,
+    /// Workspace and outputs of the dual-quaternion dynamics (`dqdynamics::dq_dynamics`) and of the
+    /// decoupled formulation.
+    pub dq: DqData,
+    /// Identity of the model this Data was made for (`Model::id`), checked by every entry point.
+    model_id: u64,
 }
 
 impl Data {
+    /// Every buffer sized for `m`, stamped with `m`'s identity.
     pub fn new(m: &Model) -> Data {
         let n = m.nbodies();
         Data {
@@ -81,6 +93,42 @@ impl Data {
             mass_matrix: DMatrix::zeros(m.nv, m.nv),
             jac: DMatrix::zeros(6, m.nv),
             qbuf: Vec::with_capacity(m.nq),
+            dq: DqData::new(m),
+            model_id: m.id(),
         }
+    }
+
+    /// Identity of the model this Data was made for (see `check::check_data`).
+    pub fn model_id(&self) -> u64 {
+        self.model_id
+    }
+
+    /// Whether every buffer still has the size `Data::new(m)` gave it (the fields are public, so a
+    /// caller may have replaced one). O(1): a few length comparisons.
+    pub fn sized_for(&self, m: &Model) -> bool {
+        let n = m.nbodies();
+        let per_body = [
+            self.li_mi.len(),
+            self.o_mi.len(),
+            self.v.len(),
+            self.a.len(),
+            self.f.len(),
+            self.ia.len(),
+            self.ov.len(),
+            self.oa.len(),
+            self.oc.len(),
+            self.of.len(),
+            self.s.len(),
+            self.os.len(),
+            self.u.len(),
+            self.dinv.len(),
+            self.uu.len(),
+            self.ic.len(),
+        ];
+        per_body.iter().all(|&l| l == n)
+            && self.ddq.len() == m.nv
+            && self.tau.len() == m.nv
+            && self.mass_matrix.shape() == (m.nv, m.nv)
+            && self.jac.shape() == (6, m.nv)
     }
 }

@@ -3,11 +3,19 @@
 
 use thiserror::Error;
 
+/// The engine's one error type; every variant's message names what is wrong and where.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum FfError {
     /// A model file (URDF or YAML) could not be read or is malformed.
     #[error("{source_name}{}: {msg}", line.map(|l| format!(", line {l}")).unwrap_or_default())]
-    ModelFile { source_name: String, line: Option<usize>, msg: String },
+    ModelFile {
+        /// File name (or `<string>`) the model was read from.
+        source_name: String,
+        /// Line of the problem, when known.
+        line: Option<usize>,
+        /// What is wrong.
+        msg: String,
+    },
 
     /// A model is structurally wrong (unknown parent, duplicate names, bad joint axis...).
     #[error("invalid model: {0}")]
@@ -15,32 +23,35 @@ pub enum FfError {
 
     /// Inertial parameters that no rigid body can have.
     #[error("non-physical inertia of body '{body}': {msg}")]
-    Inertia { body: String, msg: String },
+    Inertia {
+        /// Name of the body.
+        body: String,
+        /// What is wrong with its parameters.
+        msg: String,
+    },
 
     /// A function argument of the wrong size or with non-finite entries.
     #[error("argument `{name}`: {msg}")]
-    Argument { name: String, msg: String },
+    Argument {
+        /// Name of the argument (as in the function's signature or the Python API).
+        name: String,
+        /// Expected vs got.
+        msg: String,
+    },
 
     /// The numbers themselves defeat the algorithm (singular mass matrix, diverging step...).
     #[error("numerical failure: {0}")]
     Numerical(String),
 }
 
+/// `Result` with the engine's error.
 pub type Result<T> = std::result::Result<T, FfError>;
 
 impl FfError {
+    /// An argument error naming the argument `name`.
     pub fn arg(name: &str, msg: impl Into<String>) -> Self {
         FfError::Argument { name: name.to_string(), msg: msg.into() }
     }
 }
 
-/// Check a slice has the expected length and only finite entries.
-pub fn check_vec(name: &str, x: &[f64], expected: usize) -> Result<()> {
-    if x.len() != expected {
-        return Err(FfError::arg(name, format!("expected {expected} entries, got {}", x.len())));
-    }
-    if let Some(i) = x.iter().position(|v| !v.is_finite()) {
-        return Err(FfError::arg(name, format!("entry {i} is {} (must be finite)", x[i])));
-    }
-    Ok(())
-}
+pub use crate::check::check_vec;

@@ -7,20 +7,37 @@
 // `!(x > 0.0)` is how this crate rejects NaN along with non-positive values; and loops index several
 // joint-aligned arrays at once, which reads better than zipping them.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+#![warn(missing_docs)]
 
+/// The one argument check of every public entry point (sizes, finiteness, quaternions, Data ↔ Model).
+pub mod check;
+/// Configuration-space geometry (tangent rates, retraction, dexp⁻¹) used by the integrators.
 pub mod config;
+/// `Data`: every work buffer of the algorithms, allocated once per model.
 pub mod data;
+/// Dual-quaternion multibody dynamics with joint reaction wrenches (Valverde 2018, ch. 5–6).
 pub mod dqdynamics;
+/// Quaternion and dual-quaternion algebra, poses, kinematics and constraints (Valverde 2018, ch. 2–3).
 pub mod dualquat;
+/// RNEA, CRBA, ABA and hybrid ABA (Featherstone, body coordinates).
 pub mod dynamics;
+/// The engine's error type.
 pub mod error;
+/// Least squares, RLS and the modified RLS for inertial-parameter identification.
 pub mod estimation;
+/// Exciting-trajectory design: zero-momentum base response and regressor rows (Naveen, Shah, Misra, Sec. V).
 pub mod excitation;
+/// Forward kinematics, velocities, accelerations, centre of mass, momentum, energy, Jacobians.
 pub mod kinematics;
+/// `Model`: the immutable rigid-body tree, its builder and readers.
 pub mod model;
+/// Post-capture scenario of Zhang, Yue, Yuan 2020: thrust and attitude laws, RK4 simulation.
 pub mod postcapture;
+/// Momentum and inverse-dynamics regressors, linear in the standard inertial parameters.
 pub mod regressors;
+/// Lie-group Runge-Kutta simulation (RK4, Dormand-Prince 5(4)) with inputs and trajectories.
 pub mod sim;
+/// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers.
 pub mod spatial;
 
 pub use data::Data;

@@ -2,6 +2,9 @@
 //! recursive algorithms: accelerations = ABA, joint wrenches = RNEA's transmitted forces (run at the ABA
 //! accelerations), locked joints = hybrid ABA, on random trees with every joint type the engine has.
 
+// as in the crate: loops index several joint-aligned arrays at once
+#![allow(clippy::needless_range_loop)]
+
 mod common;
 
 use common::{random_model, random_model_of, random_q, random_vec, rel_err, rng, KINDS};
@@ -35,9 +38,9 @@ fn matches_aba_and_rnea_on_random_trees() {
             let mut d = Data::new(&m);
             aba(&m, &mut d, &q, &v, &tau, fx).expect("aba");
             let a = d.ddq.clone();
-            let res = dq_dynamics(&m, &q, &v, &tau, fx, None).expect("dq dynamics");
+            let res = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, fx, None).cloned().expect("dq dynamics");
             let ea = rel_err(&res.ddq, &a);
-            rnea(&m, &mut d, &q, &v, &a, fx);
+            rnea(&m, &mut d, &q, &v, &a, fx).unwrap();
             let f_rnea = flat(&d.f);
             let ew = rel_err(&flat(&res.joint_wrenches), &f_rnea);
             worst_a = worst_a.max(ea);
@@ -75,7 +78,7 @@ fn locked_joints_match_hybrid_aba() {
         let zero = vec![0.0; m.nv];
         let mut d = Data::new(&m);
         hybrid_aba(&m, &mut d, &q, &v, &tau, None, Some(Prescribed { mask: &mask, ddq: &zero })).expect("hybrid");
-        let res = dq_dynamics(&m, &q, &v, &tau, None, Some(&mask)).expect("dq");
+        let res = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, Some(&mask)).cloned().expect("dq");
         assert!(rel_err(&res.ddq, &d.ddq) < 1e-10, "case {case}: {:e}", rel_err(&res.ddq, &d.ddq));
         for i in 0..m.nbodies() {
             if mask[i] {
@@ -88,7 +91,7 @@ fn locked_joints_match_hybrid_aba() {
         }
         // and the joint wrenches are RNEA's at those accelerations
         let a = d.ddq.clone();
-        rnea(&m, &mut d, &q, &v, &a, None);
+        rnea(&m, &mut d, &q, &v, &a, None).unwrap();
         assert!(rel_err(&flat(&res.joint_wrenches), &flat(&d.f)) < 1e-10, "case {case}");
     }
 }
@@ -102,7 +105,7 @@ fn single_free_body_is_newton_euler() {
     let q = [0.3, -0.1, 0.2, 0.1, 0.2, -0.3, (1.0f64 - 0.14).sqrt()];
     let v = [0.2, -0.4, 0.1, 0.5, -0.3, 0.8];
     let tau = [1.0, -2.0, 0.5, 0.3, 0.1, -0.2];
-    let res = dq_dynamics(&m, &q, &v, &tau, None, None).expect("dq");
+    let res = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, None).cloned().expect("dq");
     // by hand: CoM twist and wrench, (2.56), then back to the body origin
     let c = inr.com();
     let (w, vb) = (V3::new(v[3], v[4], v[5]), V3::new(v[0], v[1], v[2]));
@@ -141,24 +144,34 @@ fn bad_input_is_reported() {
     let q = random_q(&m, &mut r);
     let v = random_vec(m.nv, &mut r);
     let tau = random_vec(m.nv, &mut r);
-    assert!(matches!(dq_dynamics(&m, &q[1..], &v, &tau, None, None), Err(FfError::Argument { .. })));
-    assert!(matches!(dq_dynamics(&m, &q, &v[1..], &tau, None, None), Err(FfError::Argument { .. })));
+    assert!(matches!(
+        dq_dynamics(&m, &mut Data::new(&m), &q[1..], &v, &tau, None, None),
+        Err(FfError::Argument { .. })
+    ));
+    assert!(matches!(
+        dq_dynamics(&m, &mut Data::new(&m), &q, &v[1..], &tau, None, None),
+        Err(FfError::Argument { .. })
+    ));
     let mut bad = tau.clone();
     bad[0] = f64::NAN;
-    assert!(matches!(dq_dynamics(&m, &q, &v, &bad, None, None), Err(FfError::Argument { .. })));
+    assert!(matches!(dq_dynamics(&m, &mut Data::new(&m), &q, &v, &bad, None, None), Err(FfError::Argument { .. })));
     let lock0 = vec![true; m.nbodies()];
-    assert!(matches!(dq_dynamics(&m, &q, &v, &tau, None, Some(&lock0)), Err(FfError::Argument { .. })));
+    assert!(matches!(
+        dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, Some(&lock0)),
+        Err(FfError::Argument { .. })
+    ));
     // planar base: not supported
     let mp = random_model(&mut r, JointType::Planar, 3, false);
     let qp = random_q(&mp, &mut r);
-    let e = dq_dynamics(&mp, &qp, &vec![0.0; mp.nv], &vec![0.0; mp.nv], None, None);
+    let e = dq_dynamics(&mp, &mut Data::new(&mp), &qp, &vec![0.0; mp.nv], &vec![0.0; mp.nv], None, None).cloned();
     assert!(matches!(e, Err(FfError::Model(_))));
     // a massless intermediate body (allowed by the engine, which merges it into its child's subtree)
     let mut b = ModelBuilder::new("massless", "base", JointType::Free, inr).expect("base");
     b.add_body(body("a", 0, JointType::Revolute, V3::z(), Se3::identity(), Inertia::zero())).expect("a");
     b.add_body(body("b", 1, JointType::Revolute, V3::x(), Se3::new(M3::identity(), V3::x()), inr)).expect("b");
     if let Ok(m0) = b.build() {
-        let e = dq_dynamics(&m0, &m0.neutral(), &vec![0.0; m0.nv], &vec![0.0; m0.nv], None, None);
+        let e = dq_dynamics(&m0, &mut Data::new(&m0), &m0.neutral(), &vec![0.0; m0.nv], &vec![0.0; m0.nv], None, None)
+            .cloned();
         match e {
             Err(FfError::Model(msg)) => assert!(msg.contains("'a'"), "{msg}"),
             other => panic!("expected a model error naming body a, got {other:?}"),
@@ -179,8 +192,9 @@ fn tree_and_dense_schur_solves_agree() {
         let tau = random_vec(m.nv, &mut r);
         let mask: Vec<bool> = (0..m.nbodies()).map(|i| i > 0 && (i + case) % 4 == 0).collect();
         let lk = if case % 2 == 0 { Some(&mask[..]) } else { None };
-        let t = dq_dynamics_with(&m, &q, &v, &tau, None, lk, Solver::Tree).expect("tree");
-        let d = dq_dynamics_with(&m, &q, &v, &tau, None, lk, Solver::Dense).expect("dense");
+        let t = dq_dynamics_with(&m, &mut Data::new(&m), &q, &v, &tau, None, lk, Solver::Tree).cloned().expect("tree");
+        let d =
+            dq_dynamics_with(&m, &mut Data::new(&m), &q, &v, &tau, None, lk, Solver::Dense).cloned().expect("dense");
         assert!(rel_err(&t.ddq, &d.ddq) < 1e-12, "case {case}");
         assert!(rel_err(&flat(&t.joint_wrenches), &flat(&d.joint_wrenches)) < 1e-12, "case {case}");
     }
@@ -218,8 +232,8 @@ fn decoupled_formulation_agrees_with_dq_and_aba() {
         let tau = random_vec(m.nv, &mut r);
         let fext = random_vec(6 * m.nbodies(), &mut r);
         let fx = if case % 4 == 1 { Some(&fext[..]) } else { None };
-        let dec = decoupled_dynamics(&m, &q, &v, &tau, fx).expect("decoupled");
-        let dq = dq_dynamics(&m, &q, &v, &tau, fx, None).expect("dq");
+        let dec = decoupled_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, fx).cloned().expect("decoupled");
+        let dq = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, fx, None).cloned().expect("dq");
         let mut d = Data::new(&m);
         aba(&m, &mut d, &q, &v, &tau, fx).expect("aba");
         assert!(rel_err(&dec.ddq, &d.ddq) < 1e-10, "case {case}: {:e}", rel_err(&dec.ddq, &d.ddq));
@@ -229,15 +243,17 @@ fn decoupled_formulation_agrees_with_dq_and_aba() {
     }
     // a universal joint is refused with a clear error
     let m = random_model_of(&mut r, JointType::Free, 1, false, &[JointType::Universal]);
-    let err = decoupled_dynamics(&m, &m.neutral(), &vec![0.0; m.nv], &vec![0.0; m.nv], None).err().expect("refused");
+    let err = decoupled_dynamics(&m, &mut Data::new(&m), &m.neutral(), &vec![0.0; m.nv], &vec![0.0; m.nv], None)
+        .cloned()
+        .expect_err("refused");
     assert!(err.to_string().contains("universal"), "{err}");
     // the chapter-5 robot
     let m = freefloat_core::model::builtin::load("thesis_ch5_single_arm").expect("built-in");
     let q = random_q(&m, &mut r);
     let v = random_vec(m.nv, &mut r);
     let tau = random_vec(m.nv, &mut r);
-    let dec = decoupled_dynamics(&m, &q, &v, &tau, None).expect("decoupled");
-    let dq = dq_dynamics(&m, &q, &v, &tau, None, None).expect("dq");
+    let dec = decoupled_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None).cloned().expect("decoupled");
+    let dq = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, None).cloned().expect("dq");
     assert!(rel_err(&dec.ddq, &dq.ddq) < 1e-12);
     assert!(rel_err(&flat(&dec.joint_wrenches), &flat(&dq.joint_wrenches)) < 1e-12);
 }
@@ -255,7 +271,7 @@ fn prescribed_accelerations_match_hybrid_aba() {
         let mask: Vec<bool> = (0..m.nbodies()).map(|i| i > 0 && m.nvs[i] > 0 && (i + case) % 2 == 0).collect();
         let mut d = Data::new(&m);
         hybrid_aba(&m, &mut d, &q, &v, &tau, None, Some(Prescribed { mask: &mask, ddq: &acc })).expect("hybrid");
-        let res = dq_hybrid_dynamics(&m, &q, &v, &tau, None, &mask, &acc).expect("dq");
+        let res = dq_hybrid_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, &mask, &acc).cloned().expect("dq");
         assert!(rel_err(&res.ddq, &d.ddq) < 1e-10, "case {case}: {:e}", rel_err(&res.ddq, &d.ddq));
         for i in 0..m.nbodies() {
             for c in 0..m.nvs[i] {
@@ -280,7 +296,7 @@ fn dual_momentum_and_energy_match_engine() {
         let tau = vec![0.0; m.nv];
         let mut d = Data::new(&m);
         aba(&m, &mut d, &q, &v, &tau, None).expect("aba");
-        let res = dq_dynamics(&m, &q, &v, &tau, None, None).expect("dq");
+        let res = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, None).cloned().expect("dq");
         assert!(rel_err(res.momentum.to_v6().as_slice(), d.aba_momentum.to_v6().as_slice()) < 1e-12, "case {case}");
         assert!((res.kinetic_energy - d.aba_kinetic_energy).abs() < 1e-12 * d.aba_kinetic_energy, "case {case}");
     }

@@ -48,7 +48,7 @@ fn literal_thesis_system_equals_dq_dynamics() {
         let v = random_vec(m.nv, &mut r);
         let tau = random_vec(m.nv, &mut r);
         let mut d = Data::new(&m);
-        forward_velocities(&m, &mut d, &q, &v);
+        forward_velocities(&m, &mut d, &q, &v).unwrap();
         let com: Vec<_> = m.inertias.iter().map(|i| i.com()).collect();
         let to_com: Vec<DualQuat> = com.iter().map(translation).collect();
         // CoM twists (8-vectors): ω^{o_i} = q*_{o/B} ω^B q_{o/B}
@@ -132,7 +132,7 @@ fn literal_thesis_system_equals_dq_dynamics() {
         assert!((lib - cond).abs() < 1e-8 * cond, "case {case}: {lib} vs {cond}");
         let y = s.clone().lu().solve(&b).expect("full system is nonsingular");
         assert!((&s * &y - &b).amax() < 1e-9 * (1.0 + b.amax()));
-        let res = dq_dynamics(&m, &q, &v, &tau, None, None).expect("dq");
+        let res = dq_dynamics(&m, &mut Data::new(&m), &q, &v, &tau, None, None).cloned().expect("dq");
         // base: ẏ_0 = [0, ω̇, 0, v̇_o] → [v̇_b; ω̇]
         let wd = nalgebra::Vector3::new(y[1], y[2], y[3]);
         let vo = nalgebra::Vector3::new(y[5], y[6], y[7]);

@@ -164,7 +164,7 @@ fn dual_arm(samples: usize, seed: u64) -> DualArm {
     let mut k = DMatrix::zeros(6, np);
     for s in 0..samples {
         let (qs, vs) = (random_q(&m, &mut r), random_vec(m.nv, &mut r));
-        momentum_regressor(&m, &mut d, &qs, &vs, &mut k);
+        momentum_regressor(&m, &mut d, &qs, &vs, &mut k).unwrap();
         h.extend((&k * DVector::from_column_slice(&p)).iter());
         k_unknown.view_mut((6 * s, 0), (6, 70)).copy_from(&k.columns(0, 70));
         q.extend(qs);
@@ -228,8 +228,8 @@ fn momentum_regressor_equals_body_frame_columns_carried_to_the_origin() {
         let mut d = Data::new(&m);
         let (q, v) = (random_q(&m, &mut r), random_vec(m.nv, &mut r));
         let mut k = DMatrix::zeros(6, 10 * m.nbodies());
-        momentum_regressor(&m, &mut d, &q, &v, &mut k);
-        forward_velocities(&m, &mut d, &q, &v);
+        momentum_regressor(&m, &mut d, &q, &v, &mut k).unwrap();
+        forward_velocities(&m, &mut d, &q, &v).unwrap();
         let scale = k.amax().max(1.0);
         for i in 0..m.nbodies() {
             for (c, f) in Inertia::mul_motion_columns(&d.v[i]).iter().enumerate() {

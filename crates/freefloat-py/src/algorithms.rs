@@ -20,7 +20,7 @@ pub(crate) fn at_row(e: FfError, k: usize, stacked: bool) -> FfError {
         return e;
     }
     match e {
-        FfError::Argument { name, msg } => FfError::Argument { name, msg: format!("sample {k}: {msg}") },
+        FfError::Argument { name, msg } => FfError::Argument { name, msg: format!("sample {k}, {msg}") },
         FfError::Numerical(msg) => FfError::Numerical(format!("sample {k}: {msg}")),
         other => other,
     }
@@ -38,15 +38,14 @@ pub(crate) fn run_rows<F>(
     f: F,
 ) -> PyResult<Vec<f64>>
 where
-    F: Fn(&Model, &mut Data, usize, &mut [f64], &mut Vec<f64>) -> Result<(), FfError> + Send + Sync,
+    F: Fn(&Model, &mut Data, usize, &mut [f64]) -> Result<(), FfError> + Send + Sync,
 {
     let work = || {
         model.with_data(|m, d| {
             guard(|| {
                 let mut out = vec![0.0; rows * width];
-                let mut buf = Vec::new();
                 for k in 0..rows {
-                    f(m, d, k, &mut out[k * width..(k + 1) * width], &mut buf).map_err(|e| at_row(e, k, stacked))?;
+                    f(m, d, k, &mut out[k * width..(k + 1) * width]).map_err(|e| at_row(e, k, stacked))?;
                 }
                 Ok(out)
             })
@@ -60,7 +59,7 @@ where
 }
 
 pub(crate) fn fext_batch(m: &Model, fext: Option<Arr>) -> PyResult<Option<Batch>> {
-    fext.map(|f| Batch::new("fext", f, &[m.nbodies(), 6])).transpose()
+    fext.map(|f| Batch::shape("fext", f, &[m.nbodies(), 6])).transpose()
 }
 
 fn name_to_frame(m: &Model, name: &str) -> PyResult<(usize, freefloat_core::spatial::Se3)> {
@@ -77,12 +76,12 @@ pub fn forward_kinematics<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nb = m.nbodies();
-    let out = run_rows(py, model, rows, st, nb * 7, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        kin::forward_kinematics(m, d, q);
+    let out = run_rows(py, model, rows, st, nb * 7, |m, d, k, o| {
+        let q = qb.row(k);
+        kin::forward_kinematics(m, d, q)?;
         for i in 0..nb {
             let p = &d.o_mi[i];
             o[7 * i..7 * i + 3].copy_from_slice(p.trans.as_slice());
@@ -105,12 +104,12 @@ pub fn frame_placement<'py>(
     let model = mb.get();
     let m = &model.inner;
     let (body, pl) = name_to_frame(m, name)?;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
-    let out = run_rows(py, model, rows, st, 7, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        kin::forward_kinematics(m, d, q);
-        let p = kin::frame_placement(d, body, &pl);
+    let out = run_rows(py, model, rows, st, 7, |m, d, k, o| {
+        let q = qb.row(k);
+        kin::forward_kinematics(m, d, q)?;
+        let p = kin::frame_placement(m, d, body, &pl)?;
         o[..3].copy_from_slice(p.trans.as_slice());
         o[3..].copy_from_slice(&quat_from_rot(&p.rot));
         Ok(())
@@ -123,11 +122,11 @@ pub fn center_of_mass<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, q: Arr<'_
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
-    let out = run_rows(py, model, rows, st, 3, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        o.copy_from_slice(kin::center_of_mass(m, d, q).as_slice());
+    let out = run_rows(py, model, rows, st, 3, |m, d, k, o| {
+        let q = qb.row(k);
+        o.copy_from_slice(kin::center_of_mass(m, d, q)?.as_slice());
         Ok(())
     })?;
     output(py, out, rows, st, &[3])
@@ -144,11 +143,11 @@ pub fn momentum<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
+    let (qb, vb) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
-    let out = run_rows(py, model, rows, st, 6, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        kin::momentum(m, d, q, vb.row(k)).write(o);
+    let out = run_rows(py, model, rows, st, 6, |m, d, k, o| {
+        let q = qb.row(k);
+        kin::momentum(m, d, q, vb.row(k))?.write(o);
         Ok(())
     })?;
     output(py, out, rows, st, &[6])
@@ -164,11 +163,11 @@ pub fn kinetic_energy<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
+    let (qb, vb) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
-    let out = run_rows(py, model, rows, st, 1, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        o[0] = kin::kinetic_energy(m, d, q, vb.row(k));
+    let out = run_rows(py, model, rows, st, 1, |m, d, k, o| {
+        let q = qb.row(k);
+        o[0] = kin::kinetic_energy(m, d, q, vb.row(k))?;
         Ok(())
     })?;
     output(py, out, rows, st, &[])
@@ -185,12 +184,12 @@ pub fn body_velocities<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
+    let (qb, vb) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
     let nb = m.nbodies();
-    let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        kin::forward_velocities(m, d, q, vb.row(k));
+    let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o| {
+        let q = qb.row(k);
+        kin::forward_velocities(m, d, q, vb.row(k))?;
         for i in 0..nb {
             d.v[i].write(&mut o[6 * i..6 * i + 6]);
         }
@@ -215,12 +214,12 @@ pub fn body_accelerations<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, ab) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("a", a, &[m.nv])?);
+    let (qb, vb, ab) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("a", a, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb), ("a", &ab)])?;
     let nb = m.nbodies();
-    let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        kin::forward_accelerations(m, d, q, vb.row(k), ab.row(k));
+    let out = run_rows(py, model, rows, st, 6 * nb, |m, d, k, o| {
+        let q = qb.row(k);
+        kin::forward_accelerations(m, d, q, vb.row(k), ab.row(k))?;
         for i in 0..nb {
             let acc = if classical { kin::classical_acceleration(&d.a[i], &d.v[i]) } else { d.a[i] };
             acc.write(&mut o[6 * i..6 * i + 6]);
@@ -240,12 +239,12 @@ pub fn centroidal_momentum_matrix<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nv = m.nv;
-    let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        kin::centroidal_momentum_matrix(m, d, q);
+    let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o| {
+        let q = qb.row(k);
+        kin::centroidal_momentum_matrix(m, d, q)?;
         write_rowmajor(&d.jac, o);
         Ok(())
     })?;
@@ -278,12 +277,12 @@ pub fn momentum_regressor<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?);
+    let (qb, vb) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb)])?;
     let np = 10 * m.nbodies();
-    let out = run_rows(py, model, rows, st, 6 * np, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        regressors::momentum_regressor(m, d, q, vb.row(k), &mut rowmajor_view(o, 6, np));
+    let out = run_rows(py, model, rows, st, 6 * np, |m, d, k, o| {
+        let q = qb.row(k);
+        regressors::momentum_regressor(m, d, q, vb.row(k), &mut rowmajor_view(o, 6, np))?;
         Ok(())
     })?;
     output(py, out, rows, st, &[6, np])
@@ -303,12 +302,12 @@ pub fn dynamics_regressor<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, ab) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("a", a, &[m.nv])?);
+    let (qb, vb, ab) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("a", a, &[m.nv])?);
     let (rows, st) = common_rows(&[("q", &qb), ("v", &vb), ("a", &ab)])?;
     let (nv, np) = (m.nv, 10 * m.nbodies());
-    let out = run_rows(py, model, rows, st, nv * np, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        regressors::dynamics_regressor(m, d, q, vb.row(k), ab.row(k), &mut rowmajor_view(o, nv, np));
+    let out = run_rows(py, model, rows, st, nv * np, |m, d, k, o| {
+        let q = qb.row(k);
+        regressors::dynamics_regressor(m, d, q, vb.row(k), ab.row(k), &mut rowmajor_view(o, nv, np))?;
         Ok(())
     })?;
     output(py, out, rows, st, &[nv, np])
@@ -329,15 +328,14 @@ pub fn frame_jacobian<'py>(
     let m = &model.inner;
     let (body, pl) = name_to_frame(m, name)?;
     let rf = guard(|| Reference::from_name(reference))?;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nv = m.nv;
-    let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        let mut j = std::mem::take(&mut d.jac);
-        kin::frame_jacobian(m, d, q, body, &pl, rf, &mut j);
+    let out = run_rows(py, model, rows, st, 6 * nv, |m, d, k, o| {
+        let q = qb.row(k);
+        let mut j = nalgebra::DMatrix::zeros(6, m.nv);
+        kin::frame_jacobian(m, d, q, body, &pl, rf, &mut j)?;
         write_rowmajor(&j, o);
-        d.jac = j;
         Ok(())
     })?;
     output(py, out, rows, st, &[6, nv])
@@ -361,14 +359,11 @@ pub fn generalized_jacobian<'py>(
     let (body, pl) = name_to_frame(m, name)?;
     let rf = guard(|| Reference::from_name(reference))?;
     let h0 = h0.unwrap_or([0.0; 6]);
-    if h0.iter().any(|x| !x.is_finite()) {
-        return Err(input_err("argument `h0`: must be finite"));
-    }
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nm = m.nv - m.nvs[0];
-    let out = run_rows(py, model, rows, st, 6 * nm + 6, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
+    let out = run_rows(py, model, rows, st, 6 * nm + 6, |m, d, k, o| {
+        let q = qb.row(k);
         let (jg, off) = kin::generalized_jacobian(m, d, q, body, &pl, rf, &h0)?;
         write_rowmajor(&jg, &mut o[..6 * nm]);
         o[6 * nm..].copy_from_slice(&off);
@@ -397,16 +392,16 @@ pub fn rnea<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, ab) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("a", a, &[m.nv])?);
+    let (qb, vb, ab) = (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("a", a, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("a", &ab)];
     if let Some(f) = &fb {
         args.push(("fext", f));
     }
     let (rows, st) = common_rows(&args)?;
-    let out = run_rows(py, model, rows, st, m.nv, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        dynamics::rnea(m, d, q, vb.row(k), ab.row(k), fb.as_ref().map(|f| f.row(k)));
+    let out = run_rows(py, model, rows, st, m.nv, |m, d, k, o| {
+        let q = qb.row(k);
+        dynamics::rnea(m, d, q, vb.row(k), ab.row(k), fb.as_ref().map(|f| f.row(k)))?;
         o.copy_from_slice(&d.tau);
         Ok(())
     })?;
@@ -419,12 +414,12 @@ pub fn crba<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, q: Arr<'_, 'py>) ->
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
     let nv = m.nv;
-    let out = run_rows(py, model, rows, st, nv * nv, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
-        dynamics::crba(m, d, q);
+    let out = run_rows(py, model, rows, st, nv * nv, |m, d, k, o| {
+        let q = qb.row(k);
+        dynamics::crba(m, d, q)?;
         write_rowmajor(&d.mass_matrix, o);
         Ok(())
     })?;
@@ -445,15 +440,16 @@ pub fn aba<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let (qb, vb, tb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("tau", tau, &[m.nv])?);
+    let (qb, vb, tb) =
+        (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("tau", tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
     if let Some(f) = &fb {
         args.push(("fext", f));
     }
     let (rows, st) = common_rows(&args)?;
-    let out = run_rows(py, model, rows, st, m.nv, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
+    let out = run_rows(py, model, rows, st, m.nv, |m, d, k, o| {
+        let q = qb.row(k);
         dynamics::aba(m, d, q, vb.row(k), tb.row(k), fb.as_ref().map(|f| f.row(k)))?;
         o.copy_from_slice(&d.ddq);
         Ok(())
@@ -506,10 +502,10 @@ pub fn hybrid_dynamics<'py>(
         mask[b] = true;
     }
     let (qb, vb, tb, ab) = (
-        Batch::new("q", q, &[m.nq])?,
-        Batch::new("v", v, &[m.nv])?,
-        Batch::new("tau", tau, &[m.nv])?,
-        Batch::new("ddq", ddq, &[m.nv])?,
+        Batch::shape("q", q, &[m.nq])?,
+        Batch::shape("v", v, &[m.nv])?,
+        Batch::shape("tau", tau, &[m.nv])?,
+        Batch::shape("ddq", ddq, &[m.nv])?,
     );
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb), ("ddq", &ab)];
@@ -518,8 +514,8 @@ pub fn hybrid_dynamics<'py>(
     }
     let (rows, st) = common_rows(&args)?;
     let nv = m.nv;
-    let out = run_rows(py, model, rows, st, 2 * nv, |m, d, k, o, buf| {
-        let q = m.checked_q(qb.row(k), buf)?;
+    let out = run_rows(py, model, rows, st, 2 * nv, |m, d, k, o| {
+        let q = qb.row(k);
         let p = Prescribed { mask: &mask, ddq: ab.row(k) };
         dynamics::hybrid_aba(m, d, q, vb.row(k), tb.row(k), fb.as_ref().map(|f| f.row(k)), Some(p))?;
         o[..nv].copy_from_slice(&d.ddq);

@@ -42,8 +42,22 @@ pub struct Batch {
 }
 
 impl Batch {
-    /// `inner` is the shape of one sample, e.g. [nq] or [nbodies, 6].
+    /// `inner` is the shape of one sample, e.g. [nq] or [nbodies, 6]. Checks the shape and that every
+    /// entry is finite (for arguments the engine does not check itself).
     pub fn new(name: &str, obj: &Bound<'_, PyAny>, inner: &[usize]) -> PyResult<Batch> {
+        let b = Batch::shape(name, obj, inner)?;
+        if let Some(k) = b.data.iter().position(|x| !x.is_finite()) {
+            let width = b.width.max(1);
+            let where_ =
+                if b.stacked { format!("sample {}, entry {}", k / width, k % width) } else { format!("entry {k}") };
+            return Err(input_err(format!("argument `{name}`: {where_} is {} (must be finite)", b.data[k])));
+        }
+        Ok(b)
+    }
+
+    /// Shape only (one sample or a leading time axis): for the arguments the engine's own check
+    /// (`freefloat_core::check`) validates per sample — finiteness, quaternions, sizes.
+    pub fn shape(name: &str, obj: &Bound<'_, PyAny>, inner: &[usize]) -> PyResult<Batch> {
         let a = array_arg(obj, name)?;
         let shape = a.shape().to_vec();
         let expect = || {
@@ -62,14 +76,6 @@ impl Batch {
             Err(_) => a.as_array().iter().copied().collect(),
         };
         let width: usize = inner.iter().product();
-        if let Some(k) = data.iter().position(|x| !x.is_finite()) {
-            let where_ = if stacked {
-                format!("sample {}, entry {}", k / width.max(1), k % width.max(1))
-            } else {
-                format!("entry {k}")
-            };
-            return Err(input_err(format!("argument `{name}`: {where_} is {} (must be finite)", data[k])));
-        }
         let rows = if stacked { shape[0] } else { 1 };
         Ok(Batch { data, rows, width, stacked })
     }

@@ -381,14 +381,10 @@ pub fn dq_body_poses<'py>(
     let mb = crate::batch::model_arg(model)?;
     let m = &mb.get().inner;
     let qv = floats(q, "q", m.nq)?;
-    let poses = guard(|| {
-        let mut buf = Vec::new();
-        let qc = m.checked_q(&qv, &mut buf)?;
-        match method {
-            "chain" => freefloat_core::dualquat::kinematics::body_poses(m, qc),
-            "poe" => freefloat_core::dualquat::kinematics::ProductOfExponentials::new(m)?.body_poses(m, qc),
-            other => Err(freefloat_core::FfError::arg("method", format!("must be 'chain' or 'poe', got '{other}'"))),
-        }
+    let poses = guard(|| match method {
+        "chain" => freefloat_core::dualquat::kinematics::body_poses(m, &qv),
+        "poe" => freefloat_core::dualquat::kinematics::ProductOfExponentials::new(m)?.body_poses(m, &qv),
+        other => Err(freefloat_core::FfError::arg("method", format!("must be 'chain' or 'poe', got '{other}'"))),
     })?;
     let n = poses.len();
     arr2(py, poses.iter().flat_map(|p| p.to_array()).collect(), n, 8)

@@ -62,7 +62,8 @@ pub fn dq_dynamics<'py>(
     if decoupled && mask.as_ref().is_some_and(|k| k.iter().any(|&x| x)) {
         return Err(input_err("argument `locked`: locking joints is implemented in the 'dq' formulation only"));
     }
-    let (qb, vb, tb) = (Batch::new("q", q, &[m.nq])?, Batch::new("v", v, &[m.nv])?, Batch::new("tau", tau, &[m.nv])?);
+    let (qb, vb, tb) =
+        (Batch::shape("q", q, &[m.nq])?, Batch::shape("v", v, &[m.nv])?, Batch::shape("tau", tau, &[m.nv])?);
     let fb = fext_batch(m, fext)?;
     let mut args = vec![("q", &qb), ("v", &vb), ("tau", &tb)];
     if let Some(f) = &fb {
@@ -71,12 +72,12 @@ pub fn dq_dynamics<'py>(
     let (rows, st) = common_rows(&args)?;
     let (nv, nb) = (m.nv, m.nbodies());
     let width = nv + 6 * nb;
-    let out = run_rows(py, model, rows, st, width, |m, _d, k, o, _buf| {
+    let out = run_rows(py, model, rows, st, width, |m, d, k, o| {
         let fx = fb.as_ref().map(|f| f.row(k));
         let r = if decoupled {
-            decoupled_dynamics(m, qb.row(k), vb.row(k), tb.row(k), fx)?
+            decoupled_dynamics(m, d, qb.row(k), vb.row(k), tb.row(k), fx)?
         } else {
-            core_dq_dynamics(m, qb.row(k), vb.row(k), tb.row(k), fx, mask.as_deref())?
+            core_dq_dynamics(m, d, qb.row(k), vb.row(k), tb.row(k), fx, mask.as_deref())?
         };
         o[..nv].copy_from_slice(&r.ddq);
         for (i, w) in r.joint_wrenches.iter().enumerate() {
@@ -102,9 +103,9 @@ pub fn dq_condition_number<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = &model.inner;
-    let qb = Batch::new("q", q, &[m.nq])?;
+    let qb = Batch::shape("q", q, &[m.nq])?;
     let (rows, st) = common_rows(&[("q", &qb)])?;
-    let out = run_rows(py, model, rows, st, 1, |m, _d, k, o, _buf| {
+    let out = run_rows(py, model, rows, st, 1, |m, _d, k, o| {
         o[0] = freefloat_core::dqdynamics::condition_number(m, qb.row(k))?;
         Ok(())
     })?;

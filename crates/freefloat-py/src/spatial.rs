@@ -164,7 +164,7 @@ pub fn base_twist_for_momentum<'py>(
         parts.push(("momentum", h));
     }
     let (rows, st) = common_rows(&parts)?;
-    let out = run_rows(py, model, rows, st, nb, |m, d, k, o, _buf| {
+    let out = run_rows(py, model, rows, st, nb, |m, d, k, o| {
         let h: [f64; 6] = match &hb {
             Some(h) => std::array::from_fn(|i| h.row(k)[i]),
             None => [0.0; 6],

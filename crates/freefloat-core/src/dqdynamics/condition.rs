@@ -1,7 +1,9 @@
 //! Condition number of the system matrix S of (6.17) (the thesis' Figs. 5.5 and 7.x).
 
 use super::sixvec::M6;
-use super::system::{solve_system, Joint, Solver};
+use super::system::{solve_system, Solver};
+use super::workspace::{DqData, Joint};
+use crate::check::{check_args, Args};
 use crate::dualquat::DualInertia;
 use crate::error::Result;
 use crate::model::Model;
@@ -12,10 +14,15 @@ use nalgebra::DMatrix;
 /// the solve: `S11 = blkdiag(H(M_i))`, `S12 = −G`, `S21 = Gᵀ P_swap` — the thesis' matrix up to a row
 /// permutation of S21 (its E-selector order), which leaves singular values unchanged. The scalar slots the
 /// 6-vectors drop are decoupled rows with singular value 1 (the ones of (2.45)), folded in at the end.
+/// Checks `q`. Allocates its own workspace and the dense matrix (an analysis routine, not a hot path).
 pub fn condition_number(m: &Model, q: &[f64]) -> Result<f64> {
+    let mut qbuf = Vec::new();
+    check_args(m, None, &Args::q(q))?;
+    let q = m.checked_q(q, &mut qbuf)?;
     let (v, tau) = (vec![0.0; m.nv], vec![0.0; m.nv]);
     let mut c = f64::NAN;
-    solve_system(m, q, &v, &tau, None, None, None, Solver::Tree, Some(&mut c))?;
+    let mut w = DqData::new(m);
+    solve_system(m, &mut w, q, &v, &tau, None, None, None, Solver::Tree, Some(&mut c))?;
     Ok(c)
 }
 

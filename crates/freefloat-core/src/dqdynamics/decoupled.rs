@@ -10,10 +10,11 @@
 //! Joints: revolute (reaction: force + torque ⊥ axis), spherical (force), prismatic (force ⊥ axis + torque;
 //! the linear constraint carries the Coriolis term `2 ω_k × ṡ a`), fixed (force + torque); free or fixed base.
 
-use super::system::DqDynamics;
+use super::workspace::DqDynamics;
+use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::forward_velocities;
+use crate::kinematics::forward_velocities_unchecked;
 use crate::model::{JointType, Model};
 use crate::spatial::{skew, Force, M3, V3};
 use nalgebra::{DMatrix, DVector};
@@ -51,16 +52,32 @@ struct J {
 
 /// Forward dynamics and joint wrenches by the decoupled formulation; same conventions and output as
 /// `dq_dynamics` (`reactions` holds the constraint parts; `locked_forces`, `momentum` and `kinetic_energy`
-/// are not computed here and stay zero).
-pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Option<&[f64]>) -> Result<DqDynamics> {
+/// are not computed here and stay zero). The result is `d.dq.out`, returned by reference. Checks every
+/// argument. The dense reference solve allocates its matrices (this formulation is a cross-check, not a
+/// hot path).
+pub fn decoupled_dynamics<'d>(
+    m: &Model,
+    d: &'d mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+) -> Result<&'d DqDynamics> {
+    let fix = check_args(m, Some(d), &Args::qv(q, v).nv("tau", tau).fext(fext))?;
+    let out = with_unit_q(m, d, q, fix, |d, q| decoupled_unchecked(m, d, q, v, tau, fext))?;
+    d.dq.out = out;
+    Ok(&d.dq.out)
+}
+
+fn decoupled_unchecked(
+    m: &Model,
+    d: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+) -> Result<DqDynamics> {
     let n = m.nbodies();
-    let mut qbuf = Vec::new();
-    let q = m.checked_q(q, &mut qbuf)?;
-    crate::error::check_vec("v", v, m.nv)?;
-    crate::error::check_vec("tau", tau, m.nv)?;
-    if let Some(f) = fext {
-        crate::error::check_vec("fext", f, 6 * n)?;
-    }
     let root_fixed = match m.joint_types[0] {
         JointType::Free => false,
         JointType::FixedBase => true,
@@ -71,8 +88,7 @@ pub fn decoupled_dynamics(m: &Model, q: &[f64], v: &[f64], tau: &[f64], fext: Op
             )))
         }
     };
-    let mut d = Data::new(m);
-    forward_velocities(m, &mut d, q, v);
+    forward_velocities_unchecked(m, d, q, v);
     // body unknown offsets (a fixed root has none)
     let mut boff = vec![usize::MAX; n];
     let mut nb = 0;

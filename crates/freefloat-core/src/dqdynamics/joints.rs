@@ -15,6 +15,7 @@ use crate::spatial::{M3, V3};
 /// Wrench slots of the reduced reaction `W̃` (the columns of V_j, Table 6.2). The actuation slots (Table
 /// 6.3) are the swaps of `motion_slots`, and the two sets are disjoint and cover all six.
 pub struct JointSlots {
+    /// Slots (0..6 of `[f; τ]` in the joint frame) the reaction wrench acts in.
     pub reaction: &'static [usize],
 }
 

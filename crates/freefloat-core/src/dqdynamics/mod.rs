@@ -8,7 +8,10 @@ pub mod joints;
 mod sixvec;
 mod system;
 mod tree_solve;
+mod workspace;
 
 pub use condition::condition_number;
 pub use sixvec::{ad_in, ad_out, reduce};
-pub use system::{dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, DqDynamics, Solver};
+pub(crate) use system::solve_system_unchecked;
+pub use system::{dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, Solver};
+pub use workspace::{DqData, DqDynamics};

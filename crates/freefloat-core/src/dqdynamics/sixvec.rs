@@ -5,6 +5,7 @@ use crate::dualquat::{DualInertia, DualQuat};
 use crate::spatial::V6;
 use nalgebra::Matrix6;
 
+/// 6×6 matrix on the vector slots of dual quaternions (twists `[ω; v]`, wrenches `[f; τ]`).
 pub type M6 = Matrix6<f64>;
 
 /// The 6×6 restriction of an 8×8 sandwich matrix to the vector slots (1..4, 5..8) — exact for unit q,

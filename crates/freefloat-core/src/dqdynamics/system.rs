@@ -14,6 +14,9 @@
 use super::joints::{alignment, motion_slots, slots, swapped, universal_alignment, universal_frame_rate};
 use super::sixvec::{ad_in, ad_out, cross6, minv, swap6, M6};
 use super::tree_solve::{solve_spd, solve_tree};
+use super::workspace::{DqData, DqDynamics, Joint};
+use crate::check::{check_args, with_unit_q, Args};
+use crate::data::Data;
 use crate::dualquat::kinematics::joint_pose;
 use crate::dualquat::pose::translation;
 use crate::dualquat::{DualInertia, DualQuat};
@@ -22,65 +25,22 @@ use crate::model::{universal_first_axis, JointType, Model};
 use crate::spatial::{Force, V3, V6};
 use nalgebra::{DMatrix, DVector};
 
-/// Result of `dq_dynamics`.
-#[derive(Clone, Debug, Default)]
-pub struct DqDynamics {
-    /// Generalized accelerations (nv), the engine's convention.
-    pub ddq: Vec<f64>,
-    /// Per body: the total wrench its joint transmits onto it (reaction + actuation), child body frame,
-    /// about the body origin — the engine's RNEA `f_i`.
-    pub joint_wrenches: Vec<Force>,
-    /// Per body: the constraint (reaction) part alone, `V_j W̃_j` (for a locked joint: all but the actuated
-    /// slots; for a free base: zero), same frame.
-    pub reactions: Vec<Force>,
-    /// Per body: for locked joints, the generalized force the joint must supply (zero elsewhere), nv.
-    pub locked_forces: Vec<f64>,
-    /// System dual momentum (2.53) about the inertial origin, inertial axes: [linear; angular].
-    pub momentum: Force,
-    /// System kinetic energy (2.54).
-    pub kinetic_energy: f64,
-}
-
-pub(super) struct Joint {
-    pub(super) body: usize,
-    pub(super) parent: usize,
-    /// offset of W̃_j in the unknown vector, and its slots
-    pub(super) off: usize,
-    pub(super) reaction: &'static [usize],
-    pub(super) locked: bool,
-    /// q_{J/B} of the child body
-    pub(super) align: DualQuat,
-    /// `G` of the distal (child) and proximal (parent) body, 6 × r (first r columns used)
-    pub(super) g_dist: M6,
-    pub(super) g_prox: M6,
-    pub(super) ad_out_oj: M6,
-    pub(super) ad_in_jo: M6,
-    /// joint twist ω^j (6.13) and `x = q*_{j/o_k} ω_k q_{j/o_k}`
-    pub(super) twist: V6,
-    pub(super) parent_twist_in_j: V6,
-    /// twist `[ρ; 0]` of J relative to the child body, in J: zero except for a universal joint, whose J turns
-    /// with θ2. Differentiating `ω^j` in a turning J adds `ρ × ω^j` to (6.15)'s `(q* ω_k q) × ω^j` (the
-    /// derivative of `Ad_{J←o}` is `−(twist of J relative to o) × Ad_{J←o}`, applied to both bodies' terms).
-    pub(super) frame_rate: V6,
-    /// actuation wrench in J (zero if locked)
-    pub(super) act: V6,
-    /// prescribed J-frame twist rate `ω̇_pres` of a locked joint (6.28); locking uses zero
-    pub(super) presc: V6,
-}
-
 /// Forward dynamics and joint wrenches by the dual-quaternion formulation for a tree with a free or fixed
 /// base and revolute, prismatic, spherical and fixed joints. `locked[i]` (per body, optional) holds joint i
 /// at zero joint acceleration (§6.4); its entry of `tau` is ignored and the force it needs is returned.
 /// `fext`: nbodies × 6 body-frame wrenches [force; torque about the body origin], as in the engine.
-pub fn dq_dynamics(
+/// Every buffer is `d.dq`'s and the result is `d.dq.out` (returned by reference): a call allocates nothing.
+/// Checks every argument (sizes, finiteness, unit quaternions, `locked` one flag per body, `d` made for `m`).
+pub fn dq_dynamics<'d>(
     m: &Model,
+    d: &'d mut Data,
     q: &[f64],
     v: &[f64],
     tau: &[f64],
     fext: Option<&[f64]>,
     locked: Option<&[bool]>,
-) -> Result<DqDynamics> {
-    dq_dynamics_with(m, q, v, tau, fext, locked, Solver::Tree)
+) -> Result<&'d DqDynamics> {
+    dq_dynamics_with(m, d, q, v, tau, fext, locked, Solver::Tree)
 }
 
 /// How the Delassus system `K W̃ = rhs` is solved.
@@ -92,39 +52,73 @@ pub enum Solver {
     Tree,
 }
 
-/// `dq_dynamics` with a choice of solver (the two agree to round-off; `Dense` is the reference).
-pub fn dq_dynamics_with(
+/// `dq_dynamics` with a choice of solver (the two agree to round-off; `Dense` is the reference and
+/// allocates its R×R matrix).
+#[allow(clippy::too_many_arguments)]
+pub fn dq_dynamics_with<'d>(
     m: &Model,
+    d: &'d mut Data,
     q: &[f64],
     v: &[f64],
     tau: &[f64],
     fext: Option<&[f64]>,
     locked: Option<&[bool]>,
     solver: Solver,
-) -> Result<DqDynamics> {
-    solve_system(m, q, v, tau, fext, locked, None, solver, None)
+) -> Result<&'d DqDynamics> {
+    let mut args = Args::qv(q, v).nv("tau", tau).fext(fext);
+    if let Some(l) = locked {
+        args = args.mask("locked", l);
+    }
+    let fix = check_args(m, Some(d), &args)?;
+    with_unit_q(m, d, q, fix, |d, q| solve_system(m, &mut d.dq, q, v, tau, fext, locked, None, solver, None))?;
+    Ok(&d.dq.out)
 }
 
 /// Hybrid dynamics in the dual-quaternion formulation (§6.4 with the corrected recipe of digest §2.6): the
 /// joints flagged in `prescribed` (per body) follow the accelerations `ddq` (their entries of the nv-vector),
 /// the others respond to `tau`; `locked_forces` returns what the prescribed joints need. The engine's
-/// `hybrid_aba` with the same arguments gives the same result.
-pub fn dq_hybrid_dynamics(
+/// `hybrid_aba` with the same arguments gives the same result. Checks every argument; allocates nothing.
+#[allow(clippy::too_many_arguments)]
+pub fn dq_hybrid_dynamics<'d>(
     m: &Model,
+    d: &'d mut Data,
     q: &[f64],
     v: &[f64],
     tau: &[f64],
     fext: Option<&[f64]>,
     prescribed: &[bool],
     ddq: &[f64],
-) -> Result<DqDynamics> {
-    crate::error::check_vec("ddq", ddq, m.nv)?;
-    solve_system(m, q, v, tau, fext, Some(prescribed), Some(ddq), Solver::Tree, None)
+) -> Result<&'d DqDynamics> {
+    let args = Args::qv(q, v).nv("tau", tau).nv("ddq", ddq).fext(fext).mask("locked", prescribed);
+    let fix = check_args(m, Some(d), &args)?;
+    with_unit_q(m, d, q, fix, |d, q| {
+        solve_system(m, &mut d.dq, q, v, tau, fext, Some(prescribed), Some(ddq), Solver::Tree, None)
+    })?;
+    Ok(&d.dq.out)
 }
 
+/// `dq_dynamics`/`dq_hybrid_dynamics` without the argument check, for the simulator's stages: `locked` is
+/// the prescribed mask with `presc_ddq` its accelerations (or None).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn solve_system_unchecked(
+    m: &Model,
+    d: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    locked: Option<&[bool]>,
+    presc_ddq: Option<&[f64]>,
+) -> Result<()> {
+    solve_system(m, &mut d.dq, q, v, tau, fext, locked, presc_ddq, Solver::Tree, None)
+}
+
+/// The system of (6.17) assembled and solved in `w` (arguments already checked, `q` normalised). The
+/// result is `w.out`. `cond_out`: also the condition number of the full system (allocates; not a hot path).
 #[allow(clippy::too_many_arguments)]
 pub(super) fn solve_system(
     m: &Model,
+    w: &mut DqData,
     q: &[f64],
     v: &[f64],
     tau: &[f64],
@@ -133,28 +127,40 @@ pub(super) fn solve_system(
     presc_ddq: Option<&[f64]>,
     solver: Solver,
     cond_out: Option<&mut f64>,
-) -> Result<DqDynamics> {
+) -> Result<()> {
     let n = m.nbodies();
-    let mut qbuf = Vec::new();
-    let q = m.checked_q(q, &mut qbuf)?;
-    crate::error::check_vec("v", v, m.nv)?;
-    crate::error::check_vec("tau", tau, m.nv)?;
-    if let Some(f) = fext {
-        crate::error::check_vec("fext", f, 6 * n)?;
-    }
-    if let Some(l) = locked {
-        if l.len() != n {
-            return Err(FfError::arg("locked", format!("expected {n} flags (one per joint), got {}", l.len())));
-        }
-    }
-    let is_locked = |i: usize| locked.map(|l| l[i]).unwrap_or(false);
-    let root_fixed = match m.joint_types[0] {
-        JointType::Free => false,
-        JointType::FixedBase => true,
+    let DqData {
+        inert,
+        iinv,
+        com,
+        local,
+        pose,
+        tw_b,
+        to_com,
+        tw_o,
+        b1,
+        mb1,
+        net,
+        ydot,
+        joints,
+        rhs,
+        sol,
+        inc,
+        start,
+        blocks,
+        mg,
+        rhs6,
+        tree,
+        out,
+    } = w;
+    let is_locked = |i: usize| locked.and_then(|l| l.get(i).copied()).unwrap_or(false);
+    let root_fixed = match m.joint_types.first() {
+        Some(JointType::Free) => false,
+        Some(JointType::FixedBase) => true,
         other => {
             return Err(FfError::Model(format!(
                 "dq_dynamics supports a free or fixed base, not a {} base",
-                other.name()
+                other.map(|j| j.name()).unwrap_or("missing")
             )))
         }
     };
@@ -165,9 +171,9 @@ pub(super) fn solve_system(
     let dynamic = |i: usize| !(i == 0 && root_fixed);
 
     // Mass properties in each body's CoM frame o_i (axes of the body frame B_i).
-    let mut inert = Vec::with_capacity(n);
-    let mut iinv = Vec::with_capacity(n);
-    let mut com = Vec::with_capacity(n);
+    inert.clear();
+    iinv.clear();
+    com.clear();
     for i in 0..n {
         let inr = &m.inertias[i];
         com.push(if inr.mass > 0.0 { inr.com() } else { V3::zeros() });
@@ -187,9 +193,9 @@ pub(super) fn solve_system(
     }
 
     // Kinematics in dual-quaternion form: poses (3.43), CoM twists via (2.43).
-    let mut local = Vec::with_capacity(n); // q_{B_i/B_p}
-    let mut pose = Vec::with_capacity(n); // q_{B_i/I}
-    let mut tw_b: Vec<V6> = Vec::with_capacity(n);
+    local.clear(); // q_{B_i/B_p}
+    pose.clear(); // q_{B_i/I}
+    tw_b.clear();
     for i in 0..n {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
         let l = DualQuat::from_se3(&m.placements[i]).mul(&joint_pose(m.joint_types[i], &m.axes[i], &m.axes2[i], qi)?);
@@ -215,11 +221,14 @@ pub(super) fn solve_system(
         tw_b.push(t);
         local.push(l);
     }
-    let to_com: Vec<DualQuat> = com.iter().map(translation).collect(); // q_{o_i/B_i}
-    let tw_o: Vec<V6> = (0..n).map(|i| ad_in(&to_com[i]) * tw_b[i]).collect();
+    to_com.clear();
+    to_com.extend(com.iter().map(translation)); // q_{o_i/B_i}
+    tw_o.clear();
+    tw_o.extend((0..n).map(|i| ad_in(&to_com[i]) * tw_b[i]));
 
     // Body right-hand sides B1 (6.22): −ω × (M ω^s) + gravity + external + actuation.
-    let mut b1 = vec![V6::zeros(); n];
+    b1.clear();
+    b1.resize(n, V6::zeros());
     for i in 0..n {
         let w = &tw_o[i];
         if let Some(mi) = &inert[i] {
@@ -243,7 +252,7 @@ pub(super) fn solve_system(
     }
 
     // Joints.
-    let mut joints: Vec<Joint> = Vec::with_capacity(n.saturating_sub(1));
+    joints.clear();
     let mut r_total = 0;
     for i in 1..n {
         let Some(k) = m.parents[i] else {
@@ -311,25 +320,25 @@ pub(super) fn solve_system(
     }
 
     if let Some(c) = cond_out {
-        *c = super::condition::full_system_condition(&joints, &inert, n, r_total);
+        *c = super::condition::full_system_condition(joints, inert, n, r_total);
     }
 
     // B2 (6.23): Λ_j ((q* ω_k q) × ω^j) + Λ_j ω̇_pres, with Λ_j = V_jᵀ P_swap.
-    let mut rhs = DVector::zeros(r_total);
-    for j in &joints {
+    rhs.clear();
+    rhs.resize(r_total, 0.0);
+    for j in joints.iter() {
         let c = cross6(&(j.parent_twist_in_j + j.frame_rate), &j.twist) + j.presc;
         for (r, &s) in j.reaction.iter().enumerate() {
             rhs[j.off + r] = c[swapped(s)];
         }
     }
     // rhs −= Σ_i G_ijᵀ M_i⁻¹ B1_i
-    let mb1: Vec<V6> = (0..n)
-        .map(|i| match &inert[i] {
-            Some(mi) => minv(mi, &iinv[i], &b1[i]),
-            None => V6::zeros(),
-        })
-        .collect();
-    for j in &joints {
+    mb1.clear();
+    mb1.extend((0..n).map(|i| match &inert[i] {
+        Some(mi) => minv(mi, &iinv[i], &b1[i]),
+        None => V6::zeros(),
+    }));
+    for j in joints.iter() {
         let r = j.reaction.len();
         for c in 0..r {
             let mut x = j.g_dist.column(c).dot(&mb1[j.body]);
@@ -343,16 +352,18 @@ pub(super) fn solve_system(
     // Delassus matrix K = Σ_i G_iᵀ M_i⁻¹ G_i as 6×6 blocks (each reduced reaction padded to 6 by the zero
     // columns of its G), one set per body over the joints incident to it: its distal joint first, then its
     // children. Block (b, a) of body i is `blocks[start[i] + b·L_i + a]`.
-    let mut inc: Vec<Vec<usize>> = vec![Vec::new(); n];
+    inc.resize_with(n, Vec::new);
+    for x in inc.iter_mut() {
+        x.clear();
+    }
     for (jj, j) in joints.iter().enumerate() {
         inc[j.body].push(jj);
         if dynamic(j.parent) {
             inc[j.parent].push(jj);
         }
     }
-    let mut start = Vec::with_capacity(n);
-    let mut blocks: Vec<M6> = Vec::new();
-    let mut mg: Vec<M6> = Vec::new();
+    start.clear();
+    blocks.clear();
     for i in 0..n {
         start.push(blocks.len());
         let Some(mi) = &inert[i] else { continue };
@@ -367,23 +378,16 @@ pub(super) fn solve_system(
         }
         for &jb in &inc[i] {
             let gt = g_of(jb).transpose();
-            for x in &mg {
+            for x in mg.iter() {
                 blocks.push(gt * x);
             }
         }
     }
-    let mut rhs6: Vec<V6> = joints
-        .iter()
-        .map(|j| {
-            let mut x = V6::zeros();
-            for c in 0..j.reaction.len() {
-                x[c] = rhs[j.off + c];
-            }
-            x
-        })
-        .collect();
-    let sol = match solver {
+    sol.clear();
+    sol.resize(r_total, 0.0);
+    match solver {
         Solver::Dense => {
+            // the reference: assembles the R×R matrix (allocates)
             let mut kmat = DMatrix::zeros(r_total, r_total);
             for i in 0..n {
                 let l = inc[i].len();
@@ -396,35 +400,42 @@ pub(super) fn solve_system(
                     }
                 }
             }
-            solve_spd(kmat, rhs)?
+            let x = solve_spd(kmat, DVector::from_column_slice(rhs))?;
+            sol.copy_from_slice(x.as_slice());
         }
         Solver::Tree => {
-            let x = solve_tree(&joints, &inc, &start, &mut blocks, &mut rhs6)?;
-            let mut out = DVector::zeros(r_total);
-            for (j, xj) in joints.iter().zip(&x) {
+            rhs6.clear();
+            rhs6.extend(joints.iter().map(|j| {
+                let mut x = V6::zeros();
                 for c in 0..j.reaction.len() {
-                    out[j.off + c] = xj[c];
+                    x[c] = rhs[j.off + c];
+                }
+                x
+            }));
+            solve_tree(joints, inc, start, blocks, rhs6, tree)?;
+            for (j, xj) in joints.iter().zip(&tree.x) {
+                for c in 0..j.reaction.len() {
+                    sol[j.off + c] = xj[c];
                 }
             }
-            out
-        }
-    };
-
-    // Body accelerations: (ẏ_i)^s = M_i⁻¹ (B1_i + Σ G W̃).
-    let mut net = b1.clone();
-    for j in &joints {
-        let w = DVector::from_iterator(j.reaction.len(), (0..j.reaction.len()).map(|c| sol[j.off + c]));
-        for c in 0..j.reaction.len() {
-            net[j.body] += j.g_dist.column(c) * w[c];
-            net[j.parent] += j.g_prox.column(c) * w[c];
         }
     }
-    let ydot: Vec<V6> = (0..n)
-        .map(|i| match &inert[i] {
-            Some(mi) => swap6(&minv(mi, &iinv[i], &net[i])),
-            None => V6::zeros(),
-        })
-        .collect();
+
+    // Body accelerations: (ẏ_i)^s = M_i⁻¹ (B1_i + Σ G W̃).
+    net.clear();
+    net.extend_from_slice(b1);
+    for j in joints.iter() {
+        for c in 0..j.reaction.len() {
+            let wc = sol[j.off + c];
+            net[j.body] += j.g_dist.column(c) * wc;
+            net[j.parent] += j.g_prox.column(c) * wc;
+        }
+    }
+    ydot.clear();
+    ydot.extend((0..n).map(|i| match &inert[i] {
+        Some(mi) => swap6(&minv(mi, &iinv[i], &net[i])),
+        None => V6::zeros(),
+    }));
 
     // Generalized accelerations.
     // (2.53) and (2.54) from the CoM poses q_{o_i/I} and twists
@@ -438,14 +449,9 @@ pub(super) fn solve_system(
             ke += mi.kinetic_energy(&w);
         }
     }
-    let mut out = DqDynamics {
-        ddq: vec![0.0; m.nv],
-        joint_wrenches: vec![Force::ZERO; n],
-        reactions: vec![Force::ZERO; n],
-        locked_forces: vec![0.0; m.nv],
-        momentum: Force::new(h.r.v, h.d.v),
-        kinetic_energy: ke,
-    };
+    out.reset(m);
+    out.momentum = Force::new(h.r.v, h.d.v);
+    out.kinetic_energy = ke;
     if !root_fixed {
         // base: ẏ_0 = [ω̇; v̇_o], v_o = v_b + ω × c ⇒ v̇_b = v̇_o − ω̇ × c (c constant in the body)
         let wd = ydot[0].fixed_rows::<3>(0).into_owned();
@@ -459,7 +465,7 @@ pub(super) fn solve_system(
         out.joint_wrenches[0] = Force::from_v6(&(ad_out(&to_com[0]) * w));
         out.reactions[0] = out.joint_wrenches[0];
     }
-    for j in &joints {
+    for j in joints.iter() {
         let i = j.body;
         let k = j.parent;
         // (6.15): ω̇^j = q_{o_i/j} ẏ_i q*_{o_i/j} − q*_{j/o_k} ẏ_k q_{j/o_k} − (q* ω_k q) × ω^j
@@ -486,5 +492,5 @@ pub(super) fn solve_system(
         }
         out.reactions[i] = Force::from_v6(&(ad * pure));
     }
-    Ok(out)
+    Ok(())
 }

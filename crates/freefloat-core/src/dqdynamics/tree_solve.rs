@@ -2,7 +2,7 @@
 //! (default) and the dense Cholesky of the assembled matrix (reference).
 
 use super::sixvec::M6;
-use super::system::Joint;
+use super::workspace::{Joint, TreeWork};
 use crate::error::{FfError, Result};
 use crate::spatial::V6;
 use nalgebra::{DMatrix, DVector};
@@ -12,25 +12,30 @@ use nalgebra::{DMatrix, DVector};
 /// (children before parents) leaves, when j's turn comes, only body i's block of j (its children's Schur
 /// updates already folded in) and neighbours that all share body k: their updates land in body k's blocks,
 /// so there is no fill-in outside the per-body blocks. Every block is a stack 6×6 (padding dimensions get
-/// a unit pivot and stay zero).
+/// a unit pivot and stay zero). The solution is left in `w.x` (one padded 6-vector per joint); every
+/// buffer is `w`'s, so a call allocates nothing once `w` has grown to the model.
 pub(super) fn solve_tree(
     joints: &[Joint],
     inc: &[Vec<usize>],
     start: &[usize],
     blocks: &mut [M6],
     rhs: &mut [V6],
-) -> Result<Vec<V6>> {
+    w: &mut TreeWork,
+) -> Result<()> {
     let nj = joints.len();
     let singular = || {
         FfError::Numerical("the dual-quaternion constraint system (Delassus matrix) is singular or indefinite".into())
     };
-    let mut eliminated = vec![false; nj];
-    let mut pivots: Vec<Option<nalgebra::Cholesky<f64, nalgebra::U6>>> = vec![None; nj];
-    // couplings C[a, j] of joint j to the joints solved before it: flat, joint j owns cstart[j]..cstart[j+1]
-    let mut coupling: Vec<(usize, M6)> = Vec::with_capacity(2 * nj);
-    let mut cstart = vec![0; nj + 1];
-    let mut cend = vec![0; nj];
-    let mut rest: Vec<(usize, usize)> = Vec::new(); // (joint, position in its parent body's list)
+    let TreeWork { eliminated, pivots, coupling, cstart, cend, rest, x } = w;
+    eliminated.clear();
+    eliminated.resize(nj, false);
+    pivots.clear();
+    pivots.resize(nj, None);
+    coupling.clear();
+    cstart.clear();
+    cstart.resize(nj + 1, 0);
+    cend.clear();
+    cend.resize(nj, 0);
     for jj in (0..nj).rev() {
         let (i, k, rj) = (joints[jj].body, joints[jj].parent, joints[jj].reaction.len());
         let mut p = blocks[start[i]];
@@ -51,11 +56,11 @@ pub(super) fn solve_tree(
         let y_rhs = ch.solve(&rhs[jj]);
         cstart[jj] = coupling.len();
         if let Some(pos) = pos {
-            for &(ja, pa) in &rest {
+            for &(ja, pa) in rest.iter() {
                 let c_a = blocks[start[k] + pa * lk + pos]; // C[a, j]
                 let y_a = ch.solve(&c_a.transpose()); // P⁻¹ C[j, a]
                 rhs[ja] -= c_a * y_rhs;
-                for &(_, pb) in &rest {
+                for &(_, pb) in rest.iter() {
                     let c_b = blocks[start[k] + pb * lk + pos];
                     blocks[start[k] + pb * lk + pa] -= c_b * y_a;
                 }
@@ -68,7 +73,8 @@ pub(super) fn solve_tree(
     }
     cstart[nj] = coupling.len();
     // back substitution, parents first: x_j = P⁻¹ (rhs_j − Σ_a C[a, j]ᵀ x_a)
-    let mut x = vec![V6::zeros(); nj];
+    x.clear();
+    x.resize(nj, V6::zeros());
     for jj in 0..nj {
         let mut b = rhs[jj];
         for (ja, c) in &coupling[cstart[jj]..cend[jj]] {
@@ -76,11 +82,11 @@ pub(super) fn solve_tree(
         }
         x[jj] = pivots[jj].as_ref().ok_or_else(singular)?.solve(&b);
     }
-    Ok(x)
+    Ok(())
 }
 
 /// Solve the symmetric positive-definite Delassus system by Cholesky; a failure means dependent constraint
-/// rows (e.g. degenerate joint axes) or a non-physical body.
+/// rows (e.g. degenerate joint axes) or a non-physical body. The dense reference solver: it allocates.
 pub(super) fn solve_spd(k: DMatrix<f64>, rhs: DVector<f64>) -> Result<DVector<f64>> {
     if k.nrows() == 0 {
         return Ok(rhs);

@@ -15,7 +15,9 @@ use crate::spatial::V3;
 /// A constraint value and its gradient `∂g/∂q` (8-vector, `[real; dual]`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConstraintValue {
+    /// Value of the constraint function (≤ 0 when satisfied).
     pub value: f64,
+    /// Its gradient with respect to the 8 entries of the pose.
     pub gradient: V8,
 }
 

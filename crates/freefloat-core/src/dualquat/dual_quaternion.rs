@@ -7,13 +7,17 @@ use crate::spatial::V3;
 use nalgebra::{SMatrix, SVector};
 use std::ops::{Add, Mul, Neg, Sub};
 
+/// An 8-vector `[real (w, x, y, z), dual (w, x, y, z)]` (the thesis' layout, (3.26)).
 pub type V8 = SVector<f64, 8>;
+/// 8×8 matrix on dual quaternions (product and sandwich matrices).
 pub type M8 = SMatrix<f64, 8, 8>;
 
 /// `r + ε d`. Twists are stored `ω + ε v` and wrenches `f + ε τ` (seed 003, (2.36), (2.39)).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct DualQuat {
+    /// Real part.
     pub r: Quat,
+    /// Dual part.
     pub d: Quat,
 }
 
@@ -24,8 +28,10 @@ pub const UNIT_TOL: f64 = 1e-9;
 impl DualQuat {
     /// `1 := 1 + ε0` (seed 003, §2.3 constants).
     pub const ONE: DualQuat = DualQuat { r: Quat::ONE, d: Quat::ZERO };
+    /// `0 + ε0`.
     pub const ZERO: DualQuat = DualQuat { r: Quat::ZERO, d: Quat::ZERO };
 
+    /// `r + ε d`.
     #[inline]
     pub fn new(r: Quat, d: Quat) -> DualQuat {
         DualQuat { r, d }
@@ -35,13 +41,16 @@ impl DualQuat {
     pub fn vector(a: &V3, b: &V3) -> DualQuat {
         DualQuat { r: Quat::pure(a), d: Quat::pure(b) }
     }
+    /// From an 8-vector `[r; d]`, each `(w, x, y, z)`.
     #[inline]
     pub fn from_vec8(x: &V8) -> DualQuat {
         DualQuat { r: Quat::new(x[0], x[1], x[2], x[3]), d: Quat::new(x[4], x[5], x[6], x[7]) }
     }
+    /// From 8 numbers `[r; d]`, each `(w, x, y, z)`.
     pub fn from_slice(x: &[f64; 8]) -> DualQuat {
         DualQuat::from_vec8(&V8::from_column_slice(x))
     }
+    /// As an 8-vector `[r; d]`.
     #[inline]
     pub fn to_vec8(&self) -> V8 {
         let mut x = V8::zeros();
@@ -49,6 +58,7 @@ impl DualQuat {
         x.fixed_rows_mut::<4>(4).copy_from(&self.d.to_vec4());
         x
     }
+    /// As 8 numbers `[r; d]`.
     pub fn to_array(&self) -> [f64; 8] {
         let x = self.to_vec8();
         [x[0], x[1], x[2], x[3], x[4], x[5], x[6], x[7]]
@@ -105,6 +115,7 @@ impl DualQuat {
     pub fn vec(&self) -> DualQuat {
         DualQuat { r: self.r.vec(), d: self.d.vec() }
     }
+    /// Product with a real scalar.
     #[inline]
     pub fn scale(&self, s: f64) -> DualQuat {
         DualQuat { r: self.r.scale(s), d: self.d.scale(s) }
@@ -145,6 +156,7 @@ impl DualQuat {
             *self
         }
     }
+    /// Whether all 8 entries are finite.
     pub fn is_finite(&self) -> bool {
         self.r.is_finite() && self.d.is_finite()
     }

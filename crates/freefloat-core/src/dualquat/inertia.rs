@@ -29,9 +29,11 @@ impl DualInertia {
         };
         Ok(DualInertia { mass, i_com, i_inv: ch.inverse() })
     }
+    /// Mass (kg).
     pub fn mass(&self) -> f64 {
         self.mass
     }
+    /// Inertia about the centre of mass, body axes (kg m²).
     pub fn i_com(&self) -> M3 {
         self.i_com
     }

@@ -38,9 +38,10 @@ pub fn joint_pose(kind: JointType, axis: &V3, axis2: &V3, q: &[f64]) -> Result<D
 }
 
 /// Poses `q_{B_i/I}` of every body frame, as the chain product (3.43) `q_{i/I} = q_{p/I} q_{rest} q_{i/i0}(q)`.
-/// `q` must already be checked (see `Model::checked_q`).
+/// Checks `q` (`check::check_q`) and normalises its quaternions.
 pub fn body_poses(m: &Model, q: &[f64]) -> Result<Vec<DualQuat>> {
-    crate::error::check_vec("q", q, m.nq)?;
+    let mut buf = Vec::new();
+    let q = m.checked_q(q, &mut buf)?;
     let mut out: Vec<DualQuat> = Vec::with_capacity(m.nbodies());
     for i in 0..m.nbodies() {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
@@ -121,7 +122,8 @@ impl ProductOfExponentials {
 
     /// Poses of every body in the inertial frame.
     pub fn body_poses(&self, m: &Model, q: &[f64]) -> Result<Vec<DualQuat>> {
-        crate::error::check_vec("q", q, m.nq)?;
+        let mut buf = Vec::new();
+        let q = m.checked_q(q, &mut buf)?;
         if self.home.len() != m.nbodies() {
             return Err(FfError::arg("m", "is not the model this product of exponentials was built for"));
         }

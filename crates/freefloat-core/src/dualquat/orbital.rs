@@ -10,6 +10,7 @@ use crate::spatial::V3;
 pub const MU_EARTH: f64 = 398600.4418;
 /// Earth's J2 coefficient and equatorial radius [km] (after (2.64)).
 pub const J2_EARTH: f64 = 0.0010826267;
+/// Earth's equatorial radius (km, WGS 84), for the J2 force.
 pub const RE_EARTH: f64 = 6378.137;
 
 /// (2.62)/(2.65): `f_g = M ⋆ (a_g + ε0) = m a_g + ε0`, `a_g = −μ r/‖r‖³`, r = r^B_{B/I} (body coordinates).

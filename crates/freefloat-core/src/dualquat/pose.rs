@@ -91,6 +91,7 @@ pub fn checked_pose(name: &str, q: &DualQuat) -> Result<DualQuat> {
 pub fn twist_from_motion(m: &Motion) -> DualQuat {
     DualQuat::vector(&m.ang, &m.lin)
 }
+/// The engine's `Motion` `[v; ω]` of a twist `ω + εv`.
 pub fn twist_to_motion(w: &DualQuat) -> Motion {
     Motion::new(w.d.v, w.r.v)
 }
@@ -98,6 +99,7 @@ pub fn twist_to_motion(w: &DualQuat) -> Motion {
 pub fn wrench_from_force(f: &Force) -> DualQuat {
     DualQuat::vector(&f.lin, &f.ang)
 }
+/// The engine's `Force` `[f; τ]` of a wrench `f + ετ`.
 pub fn wrench_to_force(w: &DualQuat) -> Force {
     Force::new(w.r.v, w.d.v)
 }

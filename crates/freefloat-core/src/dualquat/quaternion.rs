@@ -7,20 +7,27 @@ use crate::spatial::{skew, M3, V3};
 use nalgebra::{Matrix4, Vector4};
 use std::ops::{Add, Mul, Neg, Sub};
 
+/// 4×4 matrix on quaternions `(w, x, y, z)`.
 pub type M4 = Matrix4<f64>;
+/// A quaternion as a 4-vector `(w, x, y, z)`.
 pub type V4 = Vector4<f64>;
 
 /// A quaternion `w + x i + y j + z k` with `i² = j² = k² = ijk = −1` (seed 003, §2.2, Table 2.1).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Quat {
+    /// Scalar part.
     pub w: f64,
+    /// Vector part `(x, y, z)`.
     pub v: V3,
 }
 
 impl Quat {
+    /// The unit `1`.
     pub const ONE: Quat = Quat { w: 1.0, v: V3::new(0.0, 0.0, 0.0) };
+    /// Zero.
     pub const ZERO: Quat = Quat { w: 0.0, v: V3::new(0.0, 0.0, 0.0) };
 
+    /// `w + x i + y j + z k`.
     #[inline]
     pub fn new(w: f64, x: f64, y: f64, z: f64) -> Quat {
         Quat { w, v: V3::new(x, y, z) }
@@ -30,10 +37,12 @@ impl Quat {
     pub fn pure(s: &V3) -> Quat {
         Quat { w: 0.0, v: *s }
     }
+    /// From a 4-vector `(w, x, y, z)`.
     #[inline]
     pub fn from_vec4(a: &V4) -> Quat {
         Quat::new(a[0], a[1], a[2], a[3])
     }
+    /// As a 4-vector `(w, x, y, z)`.
     #[inline]
     pub fn to_vec4(&self) -> V4 {
         V4::new(self.w, self.v.x, self.v.y, self.v.z)
@@ -43,6 +52,7 @@ impl Quat {
     pub fn from_xyzw(q: &[f64; 4]) -> Quat {
         Quat::new(q[3], q[0], q[1], q[2])
     }
+    /// In the engine's order `(x, y, z, w)`.
     #[inline]
     pub fn to_xyzw(&self) -> [f64; 4] {
         [self.v.x, self.v.y, self.v.z, self.w]
@@ -114,6 +124,7 @@ impl Quat {
             None
         }
     }
+    /// Product with a real scalar.
     #[inline]
     pub fn scale(&self, s: f64) -> Quat {
         Quat { w: self.w * s, v: self.v * s }
@@ -149,6 +160,7 @@ impl Quat {
         m.fixed_view_mut::<3, 3>(1, 1).copy_from(&skew(&self.v));
         m
     }
+    /// Whether all 4 entries are finite.
     pub fn is_finite(&self) -> bool {
         self.w.is_finite() && self.v.iter().all(|x| x.is_finite())
     }

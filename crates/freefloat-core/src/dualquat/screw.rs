@@ -75,9 +75,13 @@ pub fn screw_exp(theta: f64, d: f64, l: &V3, m: &V3) -> DualQuat {
 /// unit axis ℓ and moment m (inverse of (3.10); the thesis defers this to [119], digest §5 gives it).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Screw {
+    /// Rotation angle about the screw axis (rad).
     pub theta: f64,
+    /// Translation along the screw axis (m).
     pub d: f64,
+    /// Unit direction of the screw axis.
     pub l: V3,
+    /// Moment of the axis about the origin, `p × l` (m).
     pub m: V3,
 }
 

@@ -1,7 +1,8 @@
 use super::gravity_acceleration;
+use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::{forward_kinematics, joint_bias};
+use crate::kinematics::{forward_kinematics_unchecked, joint_bias};
 use crate::model::{JointType, Model};
 use crate::spatial::{Force, Motion, M6, V6};
 use nalgebra::Matrix3;
@@ -10,11 +11,14 @@ use nalgebra::Matrix3;
 /// `ddq` (length nv) at that joint's velocity indices.
 #[derive(Clone, Copy)]
 pub struct Prescribed<'a> {
+    /// One flag per body (joint i moves body i): true if that joint's motion is prescribed.
     pub mask: &'a [bool],
+    /// Accelerations (nv); only the prescribed joints' entries are read.
     pub ddq: &'a [f64],
 }
 
 /// Forward dynamics by the articulated-body algorithm: `d.ddq = M⁻¹(τ − h + Σ Jᵢᵀ fextᵢ)`.
+/// Checks every argument (sizes, finiteness, unit quaternions, `d` made for `m`).
 pub fn aba(m: &Model, d: &mut Data, q: &[f64], v: &[f64], tau: &[f64], fext: Option<&[f64]>) -> Result<()> {
     hybrid_aba(m, d, q, v, tau, fext, None)
 }
@@ -27,7 +31,26 @@ pub fn aba(m: &Model, d: &mut Data, q: &[f64], v: &[f64], tau: &[f64], fext: Opt
 /// inertial origin): inertias are expressed there once per body, so passing an articulated inertia
 /// to the parent is an addition instead of a 6×6 change of frame. A prescribed joint passes its
 /// whole articulated inertia to the parent together with the bias of its known acceleration.
+/// Checks every argument (`presc.mask`: one flag per body, `presc.ddq`: nv).
 pub fn hybrid_aba(
+    m: &Model,
+    d: &mut Data,
+    q: &[f64],
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    presc: Option<Prescribed>,
+) -> Result<()> {
+    let mut args = Args::qv(q, v).nv("tau", tau).fext(fext);
+    if let Some(p) = presc {
+        args = args.nv("ddq", p.ddq).mask("prescribed", p.mask);
+    }
+    let fix = check_args(m, Some(d), &args)?;
+    with_unit_q(m, d, q, fix, |d, q| hybrid_aba_unchecked(m, d, q, v, tau, fext, presc))
+}
+
+/// `hybrid_aba` without the argument check.
+pub(crate) fn hybrid_aba_unchecked(
     m: &Model,
     d: &mut Data,
     q: &[f64],
@@ -38,7 +61,7 @@ pub fn hybrid_aba(
 ) -> Result<()> {
     let n = m.nbodies();
     let is_presc = |i: usize| presc.map(|p| p.mask[i]).unwrap_or(false);
-    forward_kinematics(m, d, q);
+    forward_kinematics_unchecked(m, d, q);
 
     // Pass 1: subspaces, twists, velocity-product accelerations and bias forces, inertial frame.
     // Each body's momentum oIᵢ vᵢ is formed here anyway, so the totals come for free.
@@ -136,10 +159,9 @@ pub fn hybrid_aba(
         } else if let Some(p) = parent {
             // Fixed or prescribed joint: the child moves with a known relative acceleration.
             let mut ac = d.oc[i].to_v6();
-            if k > 0 {
-                let ddq = presc.unwrap().ddq;
+            if let (true, Some(pr)) = (k > 0, presc) {
                 for c in 0..k {
-                    ac += d.os[i].column(c) * ddq[iv + c];
+                    ac += d.os[i].column(c) * pr.ddq[iv + c];
                 }
             }
             let pa = d.of[i].to_v6() + d.ia[i] * ac;
@@ -160,8 +182,8 @@ pub fn hybrid_aba(
             None => ag,
         } + d.oc[i].to_v6();
         if k == 0 {
-        } else if is_presc(i) {
-            let ddq = presc.unwrap().ddq;
+        } else if let (true, Some(p)) = (is_presc(i), presc) {
+            let ddq = p.ddq;
             for c in 0..k {
                 a += s.column(c) * ddq[iv + c];
             }

@@ -1,5 +1,7 @@
+use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
-use crate::kinematics::{forward_kinematics, world_composite_inertias};
+use crate::error::Result;
+use crate::kinematics::{forward_kinematics_unchecked, world_composite_inertias_unchecked};
 use crate::model::Model;
 use crate::spatial::Motion;
 
@@ -7,9 +9,17 @@ use crate::spatial::Motion;
 /// symmetric). Works in inertial-frame coordinates: composite inertias of subtrees add without a
 /// change of frame, and entry (j, i) for an ancestor j of i is `oSⱼᵀ oIcᵢ oSᵢ` with no force
 /// transport along the path.
-pub fn crba(m: &Model, d: &mut Data, q: &[f64]) {
-    forward_kinematics(m, d, q);
-    world_composite_inertias(m, d);
+/// Checks `q` and that `d` belongs to `m`.
+pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::q(q))?;
+    with_unit_q(m, d, q, fix, |d, q| crba_unchecked(m, d, q));
+    Ok(())
+}
+
+/// `crba` without the argument check.
+pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
+    forward_kinematics_unchecked(m, d, q);
+    world_composite_inertias_unchecked(m, d);
     let n = m.nbodies();
     d.mass_matrix.fill(0.0);
     for i in 0..n {

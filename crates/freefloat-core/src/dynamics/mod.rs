@@ -5,9 +5,12 @@ mod aba;
 mod crba;
 mod rnea;
 
+pub(crate) use aba::hybrid_aba_unchecked;
 pub use aba::{aba, hybrid_aba, Prescribed};
 pub use crba::crba;
+pub(crate) use crba::crba_unchecked;
 pub use rnea::rnea;
+pub(crate) use rnea::rnea_unchecked;
 
 use crate::model::Model;
 use crate::spatial::{Force, Motion};

@@ -1,14 +1,24 @@
 use super::{fext_of, gravity_acceleration};
+use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
-use crate::kinematics::{forward_kinematics, joint_bias, joint_velocity};
+use crate::error::Result;
+use crate::kinematics::{forward_kinematics_unchecked, joint_bias, joint_velocity};
 use crate::model::Model;
 use crate::spatial::Motion;
 
 /// Inverse dynamics: generalized forces `τ = M(q) a + h(q, v) − Σ Jᵢᵀ fextᵢ`, into `d.tau`.
 /// For a free base the first six entries are the base-frame wrench [force; torque] on the base.
 /// `fext` holds nbodies × 6 body-frame wrenches [force; torque about the body origin].
-pub fn rnea(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64], fext: Option<&[f64]>) {
-    forward_kinematics(m, d, q);
+/// Checks every argument (sizes, finiteness, unit quaternions, `d` made for `m`).
+pub fn rnea(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64], fext: Option<&[f64]>) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::qv(q, v).nv("a", a).fext(fext))?;
+    with_unit_q(m, d, q, fix, |d, q| rnea_unchecked(m, d, q, v, a, fext));
+    Ok(())
+}
+
+/// `rnea` without the argument check.
+pub(crate) fn rnea_unchecked(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64], fext: Option<&[f64]>) {
+    forward_kinematics_unchecked(m, d, q);
     let ag = gravity_acceleration(m);
     for i in 0..m.nbodies() {
         let vj = joint_velocity(m, d, i, v);

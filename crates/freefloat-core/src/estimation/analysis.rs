@@ -14,6 +14,7 @@ pub const RANK_RTOL: f64 = 1e-11;
 /// singular value relative to the largest.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Direction {
+    /// Its singular value divided by the largest one.
     pub relative_sigma: f64,
     /// (parameter index, coefficient), largest first; coefficients below 1e-3 dropped
     pub terms: Vec<(usize, f64)>,

@@ -30,10 +30,12 @@ pub(super) fn strided(s: &[f64], rows: usize, cols: usize, rs: usize, cs: usize)
 pub(super) type StridedView<'a> = MatrixView<'a, f64, Dyn, Dyn, Dyn, Dyn>;
 
 impl GramLs {
+    /// An empty accumulator for `n` unknowns (plus the right-hand side column).
     pub fn new(n: usize) -> Self {
         GramLs { n, g: DMatrix::zeros(n + 1, n + 1), rows: 0 }
     }
 
+    /// Number of rows accumulated so far.
     pub fn rows(&self) -> usize {
         self.rows
     }
@@ -50,6 +52,7 @@ impl GramLs {
         self.rows += rows;
     }
 
+    /// Add another accumulator's rows (the parallel reduction).
     pub fn merge(&mut self, other: &GramLs) {
         self.g += &other.g;
         self.rows += other.rows;

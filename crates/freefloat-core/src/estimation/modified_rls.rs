@@ -78,6 +78,7 @@ impl Coupling {
 /// One sample of the paper's problem; matrices row-major.
 #[derive(Debug, Clone, Copy)]
 pub struct CoupledSample<'a> {
+    /// Sample time (s), increasing from sample to sample.
     pub t: f64,
     /// r_μ × n_μ (eq. 11 rows `ΔB`, or eq. 28 rows `G`)
     pub a: &'a [f64],
@@ -160,14 +161,17 @@ impl ModifiedRls {
         })
     }
 
+    /// Which coupling (2D or 3D scenario) this estimator was built for.
     pub fn coupling(&self) -> Coupling {
         self.coupling
     }
 
+    /// Sizes `(n_mu, n_d, n_theta)` of the estimated vectors.
     pub fn sizes(&self) -> (usize, usize, usize) {
         (self.n_mu, self.n_th, self.n_d)
     }
 
+    /// Number of samples folded in.
     pub fn samples(&self) -> usize {
         self.samples
     }

@@ -5,8 +5,9 @@ use super::gram::{strided, GramLs};
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
+use crate::kinematics::forward_velocities_unchecked;
 use crate::model::Model;
-use crate::regressors::momentum_regressor;
+use crate::regressors::momentum_regressor_from_data_unchecked;
 use nalgebra::{DMatrix, DVector};
 
 /// Samples per block: 64 samples = 384 rows × (n+1) columns (≈160 kB for n = 52), big enough for
@@ -115,7 +116,9 @@ impl<'a> BlockBuilder<'a> {
         let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
         let cols = 10 * m.nbodies();
         let mut k = nalgebra::DMatrixViewMut::from_slice(&mut self.k, 6, cols); // column-major, as the block
-        momentum_regressor(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv], &mut k);
+                                                                                // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
+        forward_velocities_unchecked(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv]);
+        momentum_regressor_from_data_unchecked(m, &self.d, &mut k);
         let n = p.unknown_cols.len();
         // both K (6 × np) and the block are column-major: copy six contiguous numbers per column
         let ks = &self.k[..];

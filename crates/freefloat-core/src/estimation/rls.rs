@@ -44,14 +44,17 @@ impl Rls {
         Ok(Rls { n, theta: theta0.to_vec(), p, lambda, u: vec![0.0; n], samples: 0, last_t: None, failed: None })
     }
 
+    /// Number of estimated parameters.
     pub fn n(&self) -> usize {
         self.n
     }
 
+    /// Number of samples folded in.
     pub fn samples(&self) -> usize {
         self.samples
     }
 
+    /// The current estimate (n).
     pub fn estimate(&self) -> &[f64] {
         &self.theta
     }

@@ -21,10 +21,12 @@ pub struct StreamingLs {
 }
 
 impl StreamingLs {
+    /// An empty factorisation for `n` unknowns.
     pub fn new(n: usize) -> Self {
         StreamingLs { n, r: DMatrix::zeros(n, n + 1), rss: 0.0, rows: 0, work: DMatrix::zeros(0, n + 1) }
     }
 
+    /// Number of unknowns.
     pub fn n(&self) -> usize {
         self.n
     }

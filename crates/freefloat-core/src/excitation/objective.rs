@@ -11,10 +11,15 @@ use nalgebra::DMatrix;
 
 /// Everything about an evaluation except the joint path.
 pub struct ObjectiveSpec<'a> {
+    /// Initial configuration (nq): base pose and the joints that are not driven.
     pub q0: &'a [f64],
+    /// Sample every `stride`-th grid point ...
     pub stride: usize,
+    /// ... starting at grid point `offset` (< stride).
     pub offset: usize,
+    /// Momentum-regressor columns of the minimal parameters (indices into 10·nbodies).
     pub columns: &'a [usize],
+    /// Weight of the signal term against the condition number in eq. (32).
     pub weight: f64,
     /// the first `n_signal` driven joints count in the signal term (see `excitation_rows`)
     pub n_signal: usize,
@@ -25,6 +30,7 @@ pub struct ObjectiveSpec<'a> {
 /// One evaluation of eq. (32).
 #[derive(Clone, Debug)]
 pub struct Evaluation {
+    /// Value of eq. (32) (Naveen, Shah, Misra).
     pub objective: f64,
     /// κ(G_m) from the Gram matrix: accurate up to ~1e8; beyond that only indicative (still large and still
     /// decreasing as excitation improves, which is what an optimiser starting from a poor guess needs)

@@ -3,9 +3,9 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::{base_twist_for_momentum, forward_velocities};
+use crate::kinematics::{base_twist_for_momentum, forward_velocities_unchecked};
 use crate::model::{JointType, Model};
-use crate::regressors::momentum_regressor_from_data;
+use crate::regressors::momentum_regressor_from_data_unchecked;
 use crate::sim::{integrate_base_poses, Steps};
 use crate::spatial::{rot_from_quat, Motion, Se3, V3};
 use nalgebra::{DMatrix, Vector6};
@@ -13,18 +13,25 @@ use nalgebra::{DMatrix, Vector6};
 /// Joint angles and rates of the driven joints on a uniform time grid: `q`, `qd` are (samples × n)
 /// row-major; `iq`/`iv` are the driven joints' indices into the model's q and v.
 pub struct JointPath<'a> {
+    /// Grid step (s).
     pub step: f64,
+    /// Indices of the driven joints in q.
     pub iq: &'a [usize],
+    /// Indices of the driven joints in v (6 or more: after the free base).
     pub iv: &'a [usize],
+    /// Joint angles, samples × n, row-major (rad).
     pub q: &'a [f64],
+    /// Joint rates, samples × n, row-major (rad/s).
     pub qd: &'a [f64],
 }
 
 impl JointPath<'_> {
+    /// Number of driven joints.
     pub fn n(&self) -> usize {
         self.iq.len()
     }
 
+    /// Number of grid points.
     pub fn samples(&self) -> usize {
         if self.iq.is_empty() {
             0
@@ -59,6 +66,10 @@ impl JointPath<'_> {
 /// every frame, so `q`'s base pose is irrelevant; it is evaluated at the identity (`q` is used as scratch),
 /// which leaves in `d` the joint-only twists `place_base` needs.
 pub fn base_twist_zero_momentum(m: &Model, d: &mut Data, q: &mut [f64], v: &mut [f64]) -> Result<Vector6<f64>> {
+    if m.joint_types.first() != Some(&JointType::Free) {
+        return Err(FfError::arg("model", "the zero-momentum base twist needs a free-floating base"));
+    }
+    crate::check::check_args(m, Some(d), &crate::check::Args::qv(q, v))?;
     q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
     base_twist_for_momentum(m, d, q, &v[6..], &[0.0; 6])
 }
@@ -147,6 +158,7 @@ pub(crate) fn sample_blocks(
     if q0.len() != m.nq {
         return Err(FfError::arg("q0", format!("expected {} numbers, got {}", m.nq, q0.len())));
     }
+    crate::check::check_finite("q0", q0)?;
     if stride == 0 || offset >= stride {
         return Err(FfError::arg("stride", format!("need stride ≥ 1 and offset < stride, got {stride}, {offset}")));
     }
@@ -215,9 +227,9 @@ pub(crate) fn sample_blocks(
                     let mut sumsq = 0.0;
                     for (r, &i) in idx.iter().enumerate() {
                         set_joints(i, &mut q, &mut v);
-                        forward_velocities(m, &mut d, &q, &v); // identity base, joint-only twists
+                        forward_velocities_unchecked(m, &mut d, &q, &v); // identity base, joint-only twists
                         place_base(m, &mut d, &twists[i], &poses[i]);
-                        momentum_regressor_from_data(m, &d, &mut full);
+                        momentum_regressor_from_data_unchecked(m, &d, &mut full);
                         for (c, &col) in columns.iter().enumerate() {
                             for k in 0..6 {
                                 rows[(6 * r + k, c)] = full[(k, col)];

@@ -14,7 +14,7 @@
 //! For a planar base this imposes the in-plane momenta (p_x, p_y, L_z) only; the others are not
 //! controllable by an in-plane base.
 
-use super::forward_velocities;
+use super::forward_velocities_unchecked;
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
 use crate::model::{JointType, Model};
@@ -41,6 +41,7 @@ pub fn base_twist_for_momentum(
     if nb == 0 {
         return Err(FfError::arg("model", "the base is fixed: there is no base twist to solve for"));
     }
+    crate::check::check_data(m, d)?;
     check_vec("joint_rates", joint_rates, m.nv - nb)?;
     check_vec("momentum", momentum, 6)?;
     // Borrow the scratch buffers out of `d` (moves, no allocation) so that `d` can be passed on.
@@ -50,7 +51,8 @@ pub fn base_twist_for_momentum(
         let q = m.checked_q(q, &mut qbuf)?;
         v[..nb].fill(0.0);
         v[nb..].copy_from_slice(joint_rates);
-        forward_velocities(m, d, q, &v);
+        // q checked above; d.tau and d.qbuf are out of `d` here, so the unchecked core
+        forward_velocities_unchecked(m, d, q, &v);
         solve_base_block(m, d, momentum)
     })();
     d.qbuf = qbuf;
@@ -153,7 +155,7 @@ mod tests {
                 let mut v = vec![0.0; m.nv];
                 base_velocity_coordinates(&m, &tw, &mut v[..nb]).unwrap();
                 v[nb..].copy_from_slice(&rates);
-                let h = momentum(&m, &mut d, &q, &v).to_v6();
+                let h = momentum(&m, &mut d, &q, &v).unwrap().to_v6();
                 let rows: &[usize] = if nb == 3 { &[0, 1, 5] } else { &[0, 1, 2, 3, 4, 5] };
                 let scale = 1.0 + h0.iter().map(|x| x.abs()).fold(0.0, f64::max) + h.abs().max();
                 for &r in rows {
@@ -174,7 +176,7 @@ mod tests {
             let (q, rates) = random_state(&m, &mut seed);
             let h0: [f64; 6] = std::array::from_fn(|_| lcg(&mut seed));
             let tw = base_twist_for_momentum(&m, &mut d, &q, &rates, &h0).unwrap();
-            centroidal_momentum_matrix(&m, &mut d, &q);
+            centroidal_momentum_matrix(&m, &mut d, &q).unwrap();
             let a = d.jac.clone();
             let ab = a.columns(0, 6).into_owned();
             let am = a.columns(6, m.nv - 6).into_owned();

@@ -1,11 +1,20 @@
+use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
+use crate::error::Result;
 use crate::model::{universal_bias, universal_first_axis, JointType, Model};
 use crate::spatial::{Motion, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
 /// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
-/// `q` must already be checked (see `Model::checked_q`).
-pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) {
+/// Checks `q` (size, finiteness, unit quaternions) and that `d` belongs to `m`.
+pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::q(q))?;
+    with_unit_q(m, d, q, fix, |d, q| forward_kinematics_unchecked(m, d, q));
+    Ok(())
+}
+
+/// `forward_kinematics` without the argument check (`q` checked and normalised by the caller).
+pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     for i in 0..m.nbodies() {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
         let jt = m.joint_types[i];
@@ -23,7 +32,7 @@ pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) {
 
 /// Joint twist `S q̇` of body i, child frame (the subspace of the last `forward_kinematics`).
 #[inline]
-pub fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
+pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
     let s = &d.s[i];
     let k0 = m.idx_v[i];
     let mut out = [0.0; 6];
@@ -39,7 +48,7 @@ pub fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
 /// Joint bias acceleration `Ṡ q̇` of body i, child frame: zero but for a universal joint (RBDA
 /// eq. 3.41 `c_J`), after `forward_kinematics`.
 #[inline]
-pub fn joint_bias(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
+pub(crate) fn joint_bias(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
     if m.joint_types[i] != JointType::Universal {
         return Motion::ZERO;
     }
@@ -49,8 +58,15 @@ pub fn joint_bias(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
 }
 
 /// Placements and body twists (body frame).
-pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
-    forward_kinematics(m, d, q);
+pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::qv(q, v))?;
+    with_unit_q(m, d, q, fix, |d, q| forward_velocities_unchecked(m, d, q, v));
+    Ok(())
+}
+
+/// `forward_velocities` without the argument check.
+pub(crate) fn forward_velocities_unchecked(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
+    forward_kinematics_unchecked(m, d, q);
     for i in 0..m.nbodies() {
         let vj = joint_velocity(m, d, i, v);
         d.v[i] = match m.parents[i] {
@@ -63,8 +79,15 @@ pub fn forward_velocities(m: &Model, d: &mut Data, q: &[f64], v: &[f64]) {
 /// Placements, body twists and body spatial accelerations (body frame; gravity NOT included, unlike
 /// the accelerations RNEA uses internally). The classical acceleration of a body origin in body
 /// axes is given by `classical_acceleration`.
-pub fn forward_accelerations(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64]) {
-    forward_kinematics(m, d, q);
+pub fn forward_accelerations(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64]) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::qv(q, v).nv("a", a))?;
+    with_unit_q(m, d, q, fix, |d, q| forward_accelerations_unchecked(m, d, q, v, a));
+    Ok(())
+}
+
+/// `forward_accelerations` without the argument check.
+pub(crate) fn forward_accelerations_unchecked(m: &Model, d: &mut Data, q: &[f64], v: &[f64], a: &[f64]) {
+    forward_kinematics_unchecked(m, d, q);
     for i in 0..m.nbodies() {
         let vj = joint_velocity(m, d, i, v);
         let aj = joint_velocity(m, d, i, a) + joint_bias(m, d, i, v);

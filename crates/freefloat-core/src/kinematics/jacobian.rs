@@ -1,4 +1,5 @@
-use super::{base_twist_for_momentum, base_velocity_coordinates, forward_kinematics};
+use super::{base_twist_for_momentum, base_velocity_coordinates, forward_kinematics_unchecked};
+use crate::check::{check_args, check_body, check_data, check_finite, check_shape, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::{FfError, Result};
 use crate::model::Model;
@@ -15,6 +16,7 @@ pub enum Reference {
 }
 
 impl Reference {
+    /// Parse `"local"` or `"world"`.
     pub fn from_name(s: &str) -> Result<Reference> {
         match s {
             "local" => Ok(Reference::Local),
@@ -25,7 +27,13 @@ impl Reference {
 }
 
 /// Placement in the inertial frame of body `body` ∘ `placement` (needs forward kinematics).
-pub fn frame_placement(d: &Data, body: usize, placement: &Se3) -> Se3 {
+pub fn frame_placement(m: &Model, d: &Data, body: usize, placement: &Se3) -> Result<Se3> {
+    check_data(m, d)?;
+    check_body(m, "body", body)?;
+    Ok(frame_placement_unchecked(d, body, placement))
+}
+
+fn frame_placement_unchecked(d: &Data, body: usize, placement: &Se3) -> Se3 {
     d.o_mi[body].compose(placement)
 }
 
@@ -39,14 +47,18 @@ pub fn frame_jacobian(
     placement: &Se3,
     reference: Reference,
     out: &mut DMatrix<f64>,
-) {
-    forward_kinematics(m, d, q);
+) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::q(q))?;
+    check_body(m, "body", body)?;
+    check_shape("out", out.nrows(), out.ncols(), (6, m.nv))?;
+    with_unit_q(m, d, q, fix, |d, q| forward_kinematics_unchecked(m, d, q));
     jacobian_from_data(m, d, body, placement, reference, out);
+    Ok(())
 }
 
 fn jacobian_from_data(m: &Model, d: &Data, body: usize, placement: &Se3, reference: Reference, out: &mut DMatrix<f64>) {
     out.fill(0.0);
-    let o_mf = frame_placement(d, body, placement);
+    let o_mf = frame_placement_unchecked(d, body, placement);
     let mut j = Some(body);
     // Only the joints on the path to the base move the frame.
     while let Some(i) = j {
@@ -84,11 +96,14 @@ pub fn generalized_jacobian(
     reference: Reference,
     h0: &[f64; 6],
 ) -> Result<(DMatrix<f64>, [f64; 6])> {
+    let fix = check_args(m, Some(d), &Args::q(q))?;
+    check_body(m, "body", body)?;
+    check_finite("h0", h0)?;
     let nb = m.nvs[0];
     let nm = m.nv - nb;
     let mut j = DMatrix::zeros(6, m.nv);
     if nb == 0 {
-        forward_kinematics(m, d, q);
+        with_unit_q(m, d, q, fix, |d, q| forward_kinematics_unchecked(m, d, q));
         jacobian_from_data(m, d, body, placement, reference, &mut j);
         return Ok((j, [0.0; 6]));
     }

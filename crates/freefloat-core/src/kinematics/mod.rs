@@ -8,11 +8,17 @@ mod momentum;
 
 pub use base_twist::{base_twist_for_momentum, base_velocity_coordinates};
 pub use com::center_of_mass;
-pub use fk::{
-    classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities, joint_bias, joint_velocity,
+pub(crate) use com::center_of_mass_from_placements;
+pub use fk::{classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities};
+pub(crate) use fk::{
+    forward_accelerations_unchecked, forward_kinematics_unchecked, forward_velocities_unchecked, joint_bias,
+    joint_velocity,
 };
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};
 pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,
     world_composite_inertias, world_motion_subspaces,
+};
+pub(crate) use momentum::{
+    momentum_from_data_unchecked, world_composite_inertias_unchecked, world_motion_subspaces_unchecked,
 };

@@ -39,7 +39,7 @@ pub fn source(name: &str) -> Result<&'static str> {
         .ok_or_else(|| FfError::arg("name", format!("no built-in model '{name}'; available: {}", names().join(", "))))
 }
 
-/// Load a built-in robot (by current name or alias).
+/// Load a built-in robot by current name or alias (the YAML files embedded at build time).
 pub fn load(name: &str) -> Result<Model> {
     super::yaml::from_yaml_str(source(name)?, &format!("built-in model '{}'", resolve(name)))
 }

@@ -9,6 +9,7 @@
 
 use crate::spatial::{quat_normalize, rot_from_quat, rotation_about_axis, Se3, M3, M6, V3};
 
+/// Joint types: three for the base (free, planar, fixed), six below it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum JointType {
     /// 6-DoF base: q = [p; quat xyzw], v = [lin; ang] in the base frame.
@@ -17,7 +18,9 @@ pub enum JointType {
     Planar,
     /// Base welded to the inertial frame.
     FixedBase,
+    /// Rotation about the unit axis `a` (joint frame): q = v = [θ] (rad, rad/s).
     Revolute,
+    /// Translation along the unit axis `a`: q = v = [d] (m, m/s).
     Prismatic,
     /// Ball joint: q = quat xyzw of the child relative to the joint frame, v = angular velocity (child frame).
     Spherical,
@@ -29,10 +32,12 @@ pub enum JointType {
     /// intermediate frame (R = R(a1, θ1) R(a2, θ2); a1, a2 not parallel). Child-frame subspace
     /// [0 0; R(a2, θ2)ᵀa1 a2] (Featherstone, RBDA Table 4.1, "universal"): NOT constant.
     Universal,
+    /// Child welded to the parent (no coordinates; the child stays a body with its own parameters).
     Fixed,
 }
 
 impl JointType {
+    /// Number of configuration coordinates (a quaternion counts 4).
     pub fn nq(self) -> usize {
         match self {
             JointType::Free => 7,
@@ -43,6 +48,7 @@ impl JointType {
             JointType::FixedBase | JointType::Fixed => 0,
         }
     }
+    /// Number of velocity coordinates (degrees of freedom).
     pub fn nv(self) -> usize {
         match self {
             JointType::Free => 6,
@@ -52,6 +58,7 @@ impl JointType {
             JointType::FixedBase | JointType::Fixed => 0,
         }
     }
+    /// Whether this joint type attaches the base to the inertial frame (free, planar, fixed base).
     pub fn is_base(self) -> bool {
         matches!(self, JointType::Free | JointType::Planar | JointType::FixedBase)
     }
@@ -69,6 +76,7 @@ impl JointType {
             JointType::Fixed => "fixed",
         }
     }
+    /// Base joint type from its file/Python name (`free`/`floating`, `planar`, `fixed`).
     pub fn base_from_name(s: &str) -> Option<JointType> {
         match s {
             "free" | "floating" => Some(JointType::Free),
@@ -77,6 +85,7 @@ impl JointType {
             _ => None,
         }
     }
+    /// Joint type below the base from its file name (URDF `continuous` = revolute, `ball` = spherical, `cardan` = universal).
     pub fn child_from_name(s: &str) -> Option<JointType> {
         match s {
             "revolute" | "continuous" => Some(JointType::Revolute),
@@ -136,6 +145,10 @@ impl JointType {
 
     /// Placement of the child frame in the joint's rest frame for coordinates `q` (len nq).
     /// Quaternions are used as given: callers normalise `q` once on entry.
+    ///
+    /// # Panics
+    /// If the slice is shorter than this joint's nq (a per-joint helper of the hot loops; the algorithms
+    /// pass it the joint's sub-slice of a checked `q`).
     #[inline]
     pub fn transform(self, axis: &V3, axis2: &V3, q: &[f64]) -> Se3 {
         match self {
@@ -157,6 +170,10 @@ impl JointType {
     }
 
     /// Neutral coordinates (identity quaternions, zeros elsewhere).
+    ///
+    /// # Panics
+    /// If the slice is shorter than this joint's nq (a per-joint helper of the hot loops; the algorithms
+    /// pass it the joint's sub-slice of a checked `q`).
     pub fn neutral(self, out: &mut [f64]) {
         out.fill(0.0);
         if let Some(k) = self.quaternion_offset() {
@@ -165,6 +182,10 @@ impl JointType {
     }
 
     /// Normalise the quaternion part of this joint's q in place.
+    ///
+    /// # Panics
+    /// If the slice is shorter than this joint's nq (a per-joint helper of the hot loops; the algorithms
+    /// pass it the joint's sub-slice of a checked `q`).
     pub fn normalize(self, q: &mut [f64]) {
         if let Some(k) = self.quaternion_offset() {
             quat_normalize(&mut q[k..k + 4]);
@@ -189,8 +210,12 @@ pub fn universal_bias(s1: &V3, a2: &V3, qd1: f64, qd2: f64) -> V3 {
 /// Optional joint limits (from URDF/YAML); `None` where the file gives none.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct JointLimits {
+    /// Lower position limit (rad or m).
     pub lower: Option<f64>,
+    /// Upper position limit (rad or m).
     pub upper: Option<f64>,
+    /// Velocity limit (rad/s or m/s).
     pub velocity: Option<f64>,
+    /// Effort limit (N m or N).
     pub effort: Option<f64>,
 }

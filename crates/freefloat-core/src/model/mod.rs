@@ -1,10 +1,13 @@
 //! `Model`: the immutable description of a rigid-body tree (topology, joint placements, inertial
 //! parameters). Algorithms never change it; their work buffers live in `crate::Data`.
 
+/// Built-in robots, embedded in the engine at build time.
 pub mod builtin;
 mod joint;
 mod physics;
+/// URDF reader and writer.
 pub mod urdf;
+/// The YAML model format (docs/model_format.md).
 pub mod yaml;
 
 pub use joint::{universal_bias, universal_first_axis, JointLimits, JointType};
@@ -16,37 +19,55 @@ use crate::spatial::{Inertia, Se3, M6, V3};
 /// A named frame rigidly attached to a body (end effector, sensor point, thruster).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frame {
+    /// Frame name (unique among frames and bodies).
     pub name: String,
+    /// Body the frame is attached to.
     pub body: usize,
+    /// Placement of the frame in the body frame.
     pub placement: Se3,
 }
 
 /// Description of one body as given to `ModelBuilder::add_body`.
 #[derive(Clone, Debug)]
 pub struct BodySpec {
+    /// Body name.
     pub name: String,
+    /// Index of the parent body (already added).
     pub parent: usize,
+    /// Name of the joint that attaches the body to its parent.
     pub joint_name: String,
+    /// Type of that joint (not a base type).
     pub joint_type: JointType,
+    /// Joint axis in the joint frame (normalised by the builder; revolute, prismatic, cylindrical, universal).
     pub axis: V3,
     /// Second axis of a universal joint (in the intermediate frame); ignored by other joints.
     pub axis2: V3,
+    /// Rest placement of the joint frame in the parent body frame.
     pub placement: Se3,
+    /// Inertial parameters about the body origin, body axes.
     pub inertia: Inertia,
+    /// Joint limits (optional).
     pub limits: JointLimits,
+    /// Free-form tags (e.g. `base`, `wheel`, `target`, `nonphysical`).
     pub tags: Vec<String>,
     /// Skip the physical-consistency check for this body (published data that is itself
     /// inconsistent, e.g. seed 001's Table 2). Finite values and mass ≥ 0 are still required.
     pub allow_nonphysical: bool,
 }
 
+/// Immutable description of a rigid-body tree in topological order (`parents[i] < i`); body 0 is
+/// the base. Make it with `ModelBuilder` (or a reader); its work buffers are a `Data`.
 #[derive(Clone, Debug)]
 pub struct Model {
+    /// Model name.
     pub name: String,
+    /// Body names, in body order.
     pub body_names: Vec<String>,
+    /// Joint names: joint i moves body i (joint 0 is the base joint, `root_joint`).
     pub joint_names: Vec<String>,
     /// Parent body of each body; `None` for the base (body 0). Always `parents[i] < i`.
     pub parents: Vec<Option<usize>>,
+    /// Joint type of each body's joint.
     pub joint_types: Vec<JointType>,
     /// Joint axis in the joint frame (unit; meaningful for revolute/prismatic/cylindrical only).
     pub axes: Vec<V3>,
@@ -54,27 +75,53 @@ pub struct Model {
     pub axes2: Vec<V3>,
     /// Rest placement of each joint frame in its parent body frame (the base: in the inertial frame).
     pub placements: Vec<Se3>,
+    /// Inertial parameters of each body (about the body origin, body axes).
     pub inertias: Vec<Inertia>,
+    /// Joint limits of each joint.
     pub limits: Vec<JointLimits>,
+    /// Tags of each body.
     pub tags: Vec<Vec<String>>,
     /// Bodies exempted from the physical-consistency check (see `BodySpec::allow_nonphysical`).
     pub allow_nonphysical: Vec<bool>,
+    /// Named frames fixed on bodies.
     pub frames: Vec<Frame>,
     /// Gravity in the inertial frame (zero for orbital robots).
     pub gravity: V3,
     // Derived layout, filled by `ModelBuilder::build`.
+    /// Offset of each joint's coordinates in q.
     pub idx_q: Vec<usize>,
+    /// Offset of each joint's coordinates in v.
     pub idx_v: Vec<usize>,
+    /// Number of configuration coordinates of each joint.
     pub nqs: Vec<usize>,
+    /// Number of velocity coordinates of each joint.
     pub nvs: Vec<usize>,
+    /// Length of q.
     pub nq: usize,
+    /// Length of v (degrees of freedom).
     pub nv: usize,
     /// Motion subspace of each joint in the child frame at q = 0 (constant for every joint but the
     /// universal one, whose current subspace is `Data::s`).
     pub subspaces: Vec<M6>,
+    /// Children of each body, in increasing index order.
     pub children: Vec<Vec<usize>>,
+    /// Layout identity stamped by `ModelBuilder::build`, kept by `clone`, `with_parameters` and
+    /// `with_gravity` (which change neither the topology nor the joints, hence no buffer size);
+    /// `Data::new` copies it so that `check::check_data` can tell a `Data` of another model.
+    id: u64,
+    /// (body, offset in q) of every quaternion in q, so that the argument check and the
+    /// normalisation visit only those (filled by `finalize`).
+    quaternions: Vec<(usize, usize)>,
 }
 
+/// A fresh model identity (process-wide counter; 0 is never handed out).
+fn next_model_id() -> u64 {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static NEXT: AtomicU64 = AtomicU64::new(1);
+    NEXT.fetch_add(1, Ordering::Relaxed)
+}
+
+/// Builds a `Model` body by body, validating each, then the whole tree in `build`.
 pub struct ModelBuilder {
     model: Model,
 }
@@ -112,24 +159,31 @@ impl ModelBuilder {
             nv: 0,
             subspaces: vec![],
             children: vec![],
+            id: 0,
+            quaternions: vec![],
         };
         Ok(ModelBuilder { model })
     }
 
+    /// Tags of the base body.
     pub fn set_base_tags(&mut self, tags: Vec<String>) {
         self.model.tags[0] = tags;
     }
+    /// Exempt the base from the physical-consistency check (see `BodySpec::allow_nonphysical`).
     pub fn set_base_allow_nonphysical(&mut self, allow: bool) {
         self.model.allow_nonphysical[0] = allow;
     }
+    /// Gravity in the inertial frame (m/s²; zero for orbital robots).
     pub fn set_gravity(&mut self, g: V3) {
         self.model.gravity = g;
     }
 
+    /// Index of the body named `name`, if added.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.model.body_names.iter().position(|n| n == name)
     }
 
+    /// Add a body below an existing one; returns its index.
     pub fn add_body(&mut self, b: BodySpec) -> Result<usize> {
         let m = &mut self.model;
         let i = m.body_names.len();
@@ -191,6 +245,7 @@ impl ModelBuilder {
         Ok(i)
     }
 
+    /// Attach a named frame to a body.
     pub fn add_frame(&mut self, name: &str, body: usize, placement: Se3) -> Result<()> {
         if body >= self.model.body_names.len() {
             return Err(FfError::Model(format!("frame '{name}': body index {body} does not exist")));
@@ -203,13 +258,27 @@ impl ModelBuilder {
     pub fn build(self) -> Result<Model> {
         let mut m = self.model;
         m.finalize()?;
+        m.id = next_model_id();
         Ok(m)
     }
 }
 
 impl Model {
+    /// Number of bodies (the base included).
     pub fn nbodies(&self) -> usize {
         self.body_names.len()
+    }
+
+    /// This model's layout identity (see `check::check_data`): shared by clones and by the models
+    /// `with_parameters`/`with_gravity` derive from it, distinct for every model `ModelBuilder::build`
+    /// makes (even from the same description).
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// (body, offset in q) of every unit quaternion in q (free base, spherical joints).
+    pub fn quaternions(&self) -> &[(usize, usize)] {
+        &self.quaternions
     }
 
     fn finalize(&mut self) -> Result<()> {
@@ -256,6 +325,8 @@ impl Model {
         }
         self.nq = nq;
         self.nv = nv;
+        self.quaternions =
+            (0..n).filter_map(|i| self.joint_types[i].quaternion_offset().map(|k| (i, self.idx_q[i] + k))).collect();
         self.children = vec![vec![]; n];
         for i in 1..n {
             self.children[self.parents[i].unwrap()].push(i);
@@ -283,6 +354,7 @@ impl Model {
         Ok(())
     }
 
+    /// Index of the body named `name`.
     pub fn body_index(&self, name: &str) -> Option<usize> {
         self.body_names.iter().position(|n| n == name)
     }
@@ -327,6 +399,7 @@ impl Model {
         Ok(m)
     }
 
+    /// A copy with another gravity vector (inertial frame, m/s²); keeps the layout identity.
     pub fn with_gravity(&self, g: V3) -> Result<Model> {
         let mut m = self.clone();
         m.gravity = g;
@@ -334,10 +407,12 @@ impl Model {
         Ok(m)
     }
 
+    /// Total mass (kg).
     pub fn total_mass(&self) -> f64 {
         self.inertias.iter().map(|i| i.mass).sum()
     }
 
+    /// The neutral configuration: zero coordinates, identity quaternions.
     pub fn neutral(&self) -> Vec<f64> {
         let mut q = vec![0.0; self.nq];
         for i in 0..self.nbodies() {
@@ -346,42 +421,15 @@ impl Model {
         q
     }
 
-    /// Check `q` (size, finiteness) and return it with every quaternion normalised.
+    /// Check `q` (size, finiteness, unit quaternions: `check::check_q`) and return it with every
+    /// quaternion normalised (a copy in `buf` only when one was off by round-off).
     /// Policy: a quaternion whose norm is off by more than 1e-6 is rejected, not silently fixed,
     /// because such an input almost always means a wrong layout (e.g. w first) rather than round-off.
     pub fn checked_q<'a>(&self, q: &'a [f64], buf: &'a mut Vec<f64>) -> Result<&'a [f64]> {
-        crate::error::check_vec("q", q, self.nq)?;
-        let mut needs_fix = false;
-        for i in 0..self.nbodies() {
-            if let Some(k) = self.joint_types[i].quaternion_offset() {
-                let s = self.idx_q[i] + k;
-                let n2: f64 = q[s..s + 4].iter().map(|x| x * x).sum();
-                let n = n2.sqrt();
-                if (n - 1.0).abs() > 1e-6 {
-                    return Err(FfError::arg(
-                        "q",
-                        format!(
-                            "the quaternion of joint '{}' (q[{}..{}], order x y z w) has norm {n:.6}; it must be a unit quaternion",
-                            self.joint_names[i],
-                            s,
-                            s + 4
-                        ),
-                    ));
-                }
-                if n != 1.0 {
-                    needs_fix = true;
-                }
-            }
-        }
-        if !needs_fix {
+        if !crate::check::check_q(self, q)? {
             return Ok(q);
         }
-        buf.clear();
-        buf.extend_from_slice(q);
-        for i in 0..self.nbodies() {
-            let s = self.idx_q[i];
-            self.joint_types[i].normalize(&mut buf[s..s + self.nqs[i]]);
-        }
+        crate::check::normalized_into(self, q, buf);
         Ok(&buf[..])
     }
 }

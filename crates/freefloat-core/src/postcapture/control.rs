@@ -1,9 +1,9 @@
 //! The paper's controllers (seed 000, eqs. 39-40) as a generalized-force law for the whole robot.
 
 use crate::data::Data;
-use crate::dynamics::{crba, rnea};
+use crate::dynamics::{crba_unchecked, rnea_unchecked};
 use crate::error::{FfError, Result};
-use crate::kinematics::{center_of_mass, momentum};
+use crate::kinematics::{center_of_mass_from_placements, forward_velocities_unchecked, momentum_from_data_unchecked};
 use crate::model::{JointType, Model};
 use crate::spatial::{rot_from_quat, so3_log, M3, V3};
 use nalgebra::{DMatrix, DVector};
@@ -23,22 +23,28 @@ pub fn saturate(gain: f64, x: f64, max: f64) -> f64 {
 pub struct PostcaptureControl {
     /// eq. (40): thrust `F = clip(K_F P, ±F_max)` per inertial axis, P = total linear momentum
     pub f_max: f64,
+    /// Gain K_F of the thrust law, eq. (40).
     pub k_f: f64,
     /// eq. (40): couple `M = clip(K_M L_G, ±M_max)` per inertial axis, L_G = angular momentum about
     /// the system CoM (digest §11: about the CoM, so that translation does not feed the couple)
     pub m_max: f64,
+    /// Gain K_M of the couple law, eq. (40).
     pub k_m: f64,
     /// eq. (39): base angular acceleration `−K_D ω − K_P φ` per axis of the base frame (φ: yaw in 2D,
     /// rotation vector in 3D; the paper's gains are diagonal, its 3D values are not printed)
     pub k_d: V3,
+    /// Attitude gains K_P, eq. (39).
     pub k_p: V3,
     /// thruster point in the base frame (r'_jet, eq. 15); the thrust's moment about the base origin
     /// is `r'_jet × f`
     pub jet: V3,
     /// null-space motion of the arm: `−damping q̇ + amp sin(freq t + phase)` per arm joint
     pub damping: f64,
+    /// Excitation amplitudes per arm joint (rad/s²).
     pub amp: Vec<f64>,
+    /// Excitation angular frequencies per arm joint (rad/s).
     pub freq: Vec<f64>,
+    /// Excitation phases per arm joint (rad).
     pub phase: Vec<f64>,
 }
 
@@ -104,9 +110,11 @@ impl Controller {
     }
 
     /// Thruster wrench in the inertial frame, eq. (40): (F, M).
-    pub fn thrust(&mut self, m: &Model, q: &[f64], v: &[f64]) -> (V3, V3) {
-        let h = momentum(m, &mut self.d, q, v);
-        let c = center_of_mass(m, &mut self.d, q);
+    pub fn thrust(&mut self, m: &Model, q: &[f64], v: &[f64]) -> Result<(V3, V3)> {
+        crate::check::check_args(m, Some(&self.d), &crate::check::Args::qv(q, v))?;
+        forward_velocities_unchecked(m, &mut self.d, q, v);
+        let h = momentum_from_data_unchecked(m, &self.d);
+        let c = center_of_mass_from_placements(m, &self.d);
         let lg = h.ang - c.cross(&h.lin);
         let c = &self.ctl;
         let mut f = V3::from_fn(|i, _| saturate(c.k_f, h.lin[i], c.f_max));
@@ -116,7 +124,7 @@ impl Controller {
             mm.x = 0.0;
             mm.y = 0.0;
         }
-        (f, mm)
+        Ok((f, mm))
     }
 
     /// Generalized forces: base entries = thruster wrench in the base frame about the base origin;
@@ -124,8 +132,9 @@ impl Controller {
     pub fn generalized_forces(&mut self, m: &Model, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
         let (nb, nv) = (self.nb, m.nv);
         let nj = nv - nb;
+        crate::check::check_len("out", out.len(), nv)?;
+        let (f_in, m_in) = self.thrust(m, q, v)?; // checks q and v first
         let (rot, phi) = self.attitude(q);
-        let (f_in, m_in) = self.thrust(m, q, v);
         let fb = rot.transpose() * f_in;
         let tb = rot.transpose() * m_in + self.ctl.jet.cross(&fb);
         let mut wrench = DVector::zeros(nb);
@@ -140,10 +149,11 @@ impl Controller {
             }
         }
         // Equations of motion M v̇ + c = τ, split into base (b) and arm (j) rows.
-        crba(m, &mut self.d, q);
+        // q and v were checked by `thrust`: the unchecked cores
+        crba_unchecked(m, &mut self.d, q);
         let mass = self.d.mass_matrix.clone();
         let zeros = vec![0.0; nv];
-        rnea(m, &mut self.d, q, v, &zeros, None);
+        rnea_unchecked(m, &mut self.d, q, v, &zeros, None);
         let bias = DVector::from_column_slice(&self.d.tau);
         let mbb = mass.view((0, 0), (nb, nb)).into_owned();
         let mbj = mass.view((0, nb), (nb, nj)).into_owned();

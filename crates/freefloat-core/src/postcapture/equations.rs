@@ -27,19 +27,28 @@ use crate::regressors::{dynamics_regressor, momentum_regressor};
 use crate::spatial::{skew, M3, V3};
 use nalgebra::{DMatrix, SMatrix};
 
+/// 3×4 block (a per-body column block of the planar/3D rows).
 pub type M3x4 = SMatrix<f64, 3, 4>;
+/// 3×6 block.
 pub type M3x6 = SMatrix<f64, 3, 6>;
+/// 3×10 block (one body's ten standard parameters).
 pub type M3x10 = SMatrix<f64, 3, 10>;
 
 /// Motion of a reference point with the axes of its body, all inertial: position `r`, attitude `rot`
 /// (body → inertial), velocity `v`, angular velocity `w`, acceleration `a`, angular acceleration `b`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointMotion {
+    /// Position (m), inertial frame.
     pub r: V3,
+    /// Attitude, body → inertial.
     pub rot: M3,
+    /// Velocity (m/s), inertial frame.
     pub v: V3,
+    /// Angular velocity (rad/s), inertial frame.
     pub w: V3,
+    /// Acceleration (m/s²), inertial frame.
     pub a: V3,
+    /// Angular acceleration (rad/s²), inertial frame.
     pub b: V3,
 }
 
@@ -153,10 +162,12 @@ pub fn q_block(p: &PointMotion) -> M3x6 {
 /// `[m, m bx, m by, m(bx² + by²)]` (the bx² and by² columns of H and S are equal, the bx·by column vanishes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
+    /// True for the planar reduction (x, y, yaw), false for 3D.
     pub planar: bool,
 }
 
 impl Layout {
+    /// The layout of a model with a planar or free base (an error otherwise).
     pub fn of(m: &Model) -> Result<Layout> {
         match m.joint_types[0] {
             JointType::Free => Ok(Layout { planar: false }),
@@ -164,6 +175,7 @@ impl Layout {
             _ => Err(FfError::arg("model", "seed 000's equations need a free or planar base")),
         }
     }
+    /// Rows of the linear (momentum/force) equations used.
     pub fn lin_rows(&self) -> &'static [usize] {
         if self.planar {
             &[0, 1]
@@ -171,6 +183,7 @@ impl Layout {
             &[0, 1, 2]
         }
     }
+    /// Rows of the angular equations used.
     pub fn ang_rows(&self) -> &'static [usize] {
         if self.planar {
             &[2]
@@ -226,12 +239,19 @@ impl Layout {
 /// about the inertial origin).
 #[derive(Clone, Copy, Debug)]
 pub struct Measurements<'a> {
+    /// Sample times (s), T.
     pub t: &'a [f64],
+    /// Configurations, T × nq.
     pub q: &'a [f64],
+    /// Velocities, T × nv.
     pub v: &'a [f64],
+    /// Accelerations, T × nv.
     pub ddq: &'a [f64],
+    /// Thruster generalized force at the sensor, base frame, T × nb.
     pub base_wrench: &'a [f64],
+    /// ∫ F dτ (N s), inertial, T × 3.
     pub impulse_f: &'a [f64],
+    /// ∫ (M + x_F × F) dτ about the inertial origin (N m s), T × 3.
     pub impulse_m: &'a [f64],
 }
 
@@ -271,11 +291,17 @@ impl Measurements<'_> {
 /// `Φ` (na × nθ), `y` (na), `Ψ` (na × nD), all row-major with a leading sample axis.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PaperRows {
+    /// Sample times (s).
     pub t: Vec<f64>,
+    /// `A` per sample (nl × nμ), eq. (34).
     pub a: Vec<f64>,
+    /// `b` per sample (nl), eq. (34).
     pub b: Vec<f64>,
+    /// `Φ` per sample (na × nθ), eq. (35).
     pub phi: Vec<f64>,
+    /// `y` per sample (na), eq. (35).
     pub y: Vec<f64>,
+    /// `Ψ` per sample (na × nD), eq. (35).
     pub psi: Vec<f64>,
     /// (nl, nμ, na, nθ, nD)
     pub dims: [usize; 5],
@@ -284,8 +310,11 @@ pub struct PaperRows {
 /// The standard-parameter regression: per sample `Φ` (rows × unknowns) and `y` (rows).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StandardRows {
+    /// Sample times (s).
     pub t: Vec<f64>,
+    /// `Φ` per sample (rows × unknowns).
     pub phi: Vec<f64>,
+    /// `y` per sample (rows).
     pub y: Vec<f64>,
     /// (rows, unknowns)
     pub dims: [usize; 2],
@@ -408,7 +437,7 @@ pub fn paper_momentum_rows(m: &Model, meas: &Measurements, base: usize, target: 
     let mut first: Option<PaperSample> = None;
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
-        momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k);
+        momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k).map_err(|e| at(e, s))?;
         let (p1, pn) = (PointMotion::of_body(&d, base, false), PointMotion::of_body(&d, target, false));
         let kn: [f64; 6] = std::array::from_fn(|r| row_dot(&k, r, &known)); // Σ_known [m v; m r × v + I ω]
         let imp_f = V3::from_column_slice(&meas.impulse_f[3 * s..3 * s + 3]);
@@ -447,7 +476,7 @@ pub fn paper_force_rows(m: &Model, meas: &Measurements, base: usize, target: usi
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         let (v, a) = (&meas.v[s * m.nv..(s + 1) * m.nv], &meas.ddq[s * m.nv..(s + 1) * m.nv]);
         // the regressor runs `forward_accelerations` and leaves the body twists and accelerations in `d`
-        dynamics_regressor(m, &mut d, q, v, a, &mut y);
+        dynamics_regressor(m, &mut d, q, v, a, &mut y).map_err(|e| at(e, s))?;
         let (p1, pn) = (PointMotion::of_body(&d, base, true), PointMotion::of_body(&d, target, true));
         let (p1s, pns) = (p1.shifted(&p1.r), pn.shifted(&p1.r));
         // base-frame wrench of the thrusters minus the known links' share (base rows of the regressor)
@@ -492,7 +521,7 @@ pub fn standard_momentum_rows(m: &Model, meas: &Measurements, base: usize, targe
     let mut out = StandardRows::with_capacity([rows.len(), cols.len()], n);
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
-        momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k);
+        momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k).map_err(|e| at(e, s))?;
         for (i, &r) in rows.iter().enumerate() {
             let imp = if r < 3 { meas.impulse_f[3 * s + r] } else { meas.impulse_m[3 * s + r - 3] };
             let yr = imp - row_dot(&k, r, &known);
@@ -532,7 +561,7 @@ pub fn standard_force_rows(m: &Model, meas: &Measurements, base: usize, target: 
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         let (v, a) = (&meas.v[s * m.nv..(s + 1) * m.nv], &meas.ddq[s * m.nv..(s + 1) * m.nv]);
-        dynamics_regressor(m, &mut d, q, v, a, &mut y);
+        dynamics_regressor(m, &mut d, q, v, a, &mut y).map_err(|e| at(e, s))?;
         for r in 0..nb {
             out.y.push(meas.base_wrench[s * nb + r] - row_dot(&y, r, &known));
             out.phi.extend(cols.iter().map(|&c| y[(r, c)]));

@@ -1,7 +1,9 @@
-use super::{check_shape, RegressorOut};
+use super::{check_out, RegressorOut};
+use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::dynamics::gravity_acceleration;
-use crate::kinematics::{forward_accelerations, world_motion_subspaces};
+use crate::error::Result;
+use crate::kinematics::{forward_accelerations_unchecked, world_motion_subspaces_unchecked};
 use crate::model::Model;
 use crate::spatial::Inertia;
 use nalgebra::{Dyn, StorageMut};
@@ -24,10 +26,11 @@ pub fn dynamics_regressor<S: StorageMut<f64, Dyn, Dyn>>(
     v: &[f64],
     a: &[f64],
     out: &mut RegressorOut<S>,
-) {
-    check_shape(m, out, m.nv, "dynamics_regressor");
-    forward_accelerations(m, d, q, v, a);
-    world_motion_subspaces(m, d);
+) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::qv(q, v).nv("a", a))?;
+    check_out(m, out, m.nv)?;
+    with_unit_q(m, d, q, fix, |d, q| forward_accelerations_unchecked(m, d, q, v, a));
+    world_motion_subspaces_unchecked(m, d);
     let ag = gravity_acceleration(m);
     out.fill(0.0);
     for i in 0..m.nbodies() {
@@ -48,4 +51,5 @@ pub fn dynamics_regressor<S: StorageMut<f64, Dyn, Dyn>>(
             }
         }
     }
+    Ok(())
 }

@@ -6,8 +6,10 @@ mod dynamics;
 mod momentum;
 
 pub use dynamics::dynamics_regressor;
+pub(crate) use momentum::momentum_regressor_from_data_unchecked;
 pub use momentum::{momentum_regressor, momentum_regressor_from_data};
 
+use crate::error::Result;
 use crate::model::Model;
 use crate::spatial::Force;
 use nalgebra::{Dyn, Matrix, StorageMut};
@@ -16,14 +18,9 @@ use nalgebra::{Dyn, Matrix, StorageMut};
 /// e.g. a row-major view over a numpy buffer.
 pub type RegressorOut<S> = Matrix<f64, Dyn, Dyn, S>;
 
-fn check_shape<S: StorageMut<f64, Dyn, Dyn>>(m: &Model, out: &RegressorOut<S>, rows: usize, what: &str) {
-    let cols = 10 * m.nbodies();
-    assert!(
-        out.nrows() == rows && out.ncols() == cols,
-        "{what}: output must be {rows} × {cols}, got {} × {}",
-        out.nrows(),
-        out.ncols()
-    );
+/// The output must be `rows` × 10·nbodies.
+fn check_out<S: StorageMut<f64, Dyn, Dyn>>(m: &Model, out: &RegressorOut<S>, rows: usize) -> Result<()> {
+    crate::check::check_shape("out", out.nrows(), out.ncols(), (rows, 10 * m.nbodies()))
 }
 
 /// Write a force as rows 0..6 of column `col`.

@@ -1,6 +1,8 @@
-use super::{check_shape, write_column, RegressorOut};
+use super::{check_out, write_column, RegressorOut};
+use crate::check::{check_args, check_data, with_unit_q, Args};
 use crate::data::Data;
-use crate::kinematics::forward_velocities;
+use crate::error::Result;
+use crate::kinematics::forward_velocities_unchecked;
 use crate::model::Model;
 use crate::spatial::{Force, V3};
 use nalgebra::{Dyn, StorageMut};
@@ -25,16 +27,32 @@ pub fn momentum_regressor<S: StorageMut<f64, Dyn, Dyn>>(
     q: &[f64],
     v: &[f64],
     out: &mut RegressorOut<S>,
-) {
-    check_shape(m, out, 6, "momentum_regressor");
-    forward_velocities(m, d, q, v);
-    momentum_regressor_from_data(m, d, out);
+) -> Result<()> {
+    let fix = check_args(m, Some(d), &Args::qv(q, v))?;
+    check_out(m, out, 6)?;
+    with_unit_q(m, d, q, fix, |d, q| forward_velocities_unchecked(m, d, q, v));
+    momentum_regressor_from_data_unchecked(m, d, out);
+    Ok(())
 }
 
 /// The momentum regressor from placements `d.o_mi` and body twists `d.v` already in `d` (e.g. placements
 /// moved rigidly with the base, as the excitation design does, without a second kinematics pass).
-pub fn momentum_regressor_from_data<S: StorageMut<f64, Dyn, Dyn>>(m: &Model, d: &Data, out: &mut RegressorOut<S>) {
-    check_shape(m, out, 6, "momentum_regressor");
+pub fn momentum_regressor_from_data<S: StorageMut<f64, Dyn, Dyn>>(
+    m: &Model,
+    d: &Data,
+    out: &mut RegressorOut<S>,
+) -> Result<()> {
+    check_data(m, d)?;
+    check_out(m, out, 6)?;
+    momentum_regressor_from_data_unchecked(m, d, out);
+    Ok(())
+}
+
+pub(crate) fn momentum_regressor_from_data_unchecked<S: StorageMut<f64, Dyn, Dyn>>(
+    m: &Model,
+    d: &Data,
+    out: &mut RegressorOut<S>,
+) {
     let z = V3::zeros();
     for i in 0..m.nbodies() {
         let (rot, p) = (&d.o_mi[i].rot, d.o_mi[i].trans);

@@ -18,7 +18,9 @@ use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, V3};
 /// The sample times: a uniform step, or the times themselves (uneven steps allowed, increasing).
 #[derive(Clone, Copy, Debug)]
 pub enum Steps<'a> {
+    /// A uniform step (s).
     Uniform(f64),
+    /// The sample times (s), increasing.
     Times(&'a [f64]),
 }
 

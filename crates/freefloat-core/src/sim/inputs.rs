@@ -11,22 +11,29 @@ pub enum Hold {
     Linear,
 }
 
+/// `f(t, q, v, out)`: generalized forces (nv) at time t and state (q, v).
 pub type TorqueFn<'a> = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) -> Result<()> + 'a>;
 
 /// Generalized forces (length nv; for a free base the first six are the base-frame thruster
 /// wrench [force; torque]) as a function of time and state.
 pub enum TorqueSource<'a> {
+    /// No forces.
     Zero,
     /// `values` is T × nv, row-major, sampled at increasing `times`.
     Table {
+        /// Sample times (s), strictly increasing.
         times: Vec<f64>,
+        /// T × nv values, row-major.
         values: Vec<f64>,
+        /// How values are held between samples.
         hold: Hold,
     },
+    /// A function of time and state.
     Function(TorqueFn<'a>),
 }
 
 impl TorqueSource<'_> {
+    /// A table of `times.len()` × `nv` values (checked: sizes, strictly increasing times, finite).
     pub fn table(times: Vec<f64>, values: Vec<f64>, nv: usize, hold: Hold) -> Result<Self> {
         if times.is_empty() || values.len() != times.len() * nv {
             return Err(FfError::arg(
@@ -46,6 +53,7 @@ impl TorqueSource<'_> {
         Ok(TorqueSource::Table { times, values, hold })
     }
 
+    /// Forces at time `t` and state (q, v) into `out` (nv; a table's row length is checked).
     pub fn eval(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
         match self {
             TorqueSource::Zero => out.fill(0.0),
@@ -59,6 +67,15 @@ impl TorqueSource<'_> {
             }
             TorqueSource::Table { times, values, hold } => {
                 let nv = out.len();
+                if values.len() != times.len() * nv {
+                    return Err(FfError::arg(
+                        "out",
+                        format!(
+                            "the torque table has rows of {} entries, got an output of {nv}",
+                            values.len() / times.len().max(1)
+                        ),
+                    ));
+                }
                 // Index of the last sample at or before t (binary search: tables can be long).
                 let k = times.partition_point(|&x| x <= t + 1e-12 * t.abs().max(1.0)).saturating_sub(1);
                 let row = |k: usize| &values[k * nv..(k + 1) * nv];
@@ -79,15 +96,20 @@ impl TorqueSource<'_> {
 /// A controller sampled every `period` seconds; its output (generalized forces, length nv) is held
 /// until the next sample and added to the torque source.
 pub struct Controller<'a> {
+    /// Sampling period (s).
     pub period: f64,
+    /// `f(t, q, v, out)`: the controller's output (nv).
     pub f: TorqueFn<'a>,
 }
 
+/// `f(t, q, v, a)`: prescribed configuration, velocity and acceleration at time t.
 pub type PrescriptionFn<'a> = Box<dyn FnMut(f64, &mut [f64], &mut [f64], &mut [f64]) -> Result<()> + 'a>;
 
 /// Joints (given by their child body index) that follow a prescribed motion. `f(t, q, v, a)` fills
 /// full-length q (nq), v and a (nv); only the prescribed joints' entries are read.
 pub struct Prescription<'a> {
+    /// Child body index of each prescribed joint.
     pub bodies: Vec<usize>,
+    /// The prescribed motion.
     pub f: PrescriptionFn<'a>,
 }

@@ -11,26 +11,40 @@ pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use inputs::{Controller, Hold, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 
-use crate::config::{dexpinv, retract, tangent_magnitude, tangent_rate};
+use crate::config::{
+    dexpinv_unchecked as dexpinv, retract_unchecked as retract, tangent_magnitude_unchecked as tangent_magnitude,
+    tangent_rate_unchecked as tangent_rate,
+};
 use crate::data::Data;
-use crate::dynamics::{hybrid_aba, Prescribed};
+use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
 use crate::error::{check_vec, FfError, Result};
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
 
+/// Integration method.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Method {
     /// Classical RK4 with fixed step `dt`.
     Rk4,
     /// Dormand-Prince 5(4) with error control; `dt` is then the output interval.
-    Rk45 { rtol: f64, atol: f64, max_step: f64 },
+    Rk45 {
+        /// Relative tolerance of the local error.
+        rtol: f64,
+        /// Absolute tolerance of the local error.
+        atol: f64,
+        /// Largest step (s).
+        max_step: f64,
+    },
 }
 
+/// Options of a simulation.
 #[derive(Clone, Copy, Debug)]
 pub struct SimOptions {
+    /// Simulated duration (s), from t = 0.
     pub t_final: f64,
     /// RK4: the step. RK45: the interval between recorded samples.
     pub dt: f64,
+    /// Integration method.
     pub method: Method,
     /// RK4 only: record every n-th step (1 = every step).
     pub record_every: usize,
@@ -51,8 +65,11 @@ pub enum Formulation {
 
 /// Everything that acts on the robot during a simulation.
 pub struct Inputs<'a> {
+    /// Generalized forces (joint torques, base thrusters).
     pub torques: TorqueSource<'a>,
+    /// A sampled controller whose held output is added to `torques`.
     pub controller: Option<Controller<'a>>,
+    /// Joints that follow a prescribed motion (hybrid dynamics).
     pub prescription: Option<Prescription<'a>>,
 }
 
@@ -84,6 +101,9 @@ struct Stepper<'m, 'i> {
     kw: Vec<f64>,
     dq: Vec<f64>,
     dv: Vec<f64>,
+    /// RK45 error control: tangent magnitudes at both ends of a step
+    mag0: Vec<f64>,
+    mag1: Vec<f64>,
     evals: usize,
 }
 
@@ -117,6 +137,8 @@ impl<'m, 'i> Stepper<'m, 'i> {
             kw: vec![0.0; stages],
             dq: vec![0.0; m.nv],
             dv: vec![0.0; m.nv],
+            mag0: vec![0.0; m.nv],
+            mag1: vec![0.0; m.nv],
             evals: 0,
         })
     }
@@ -147,22 +169,24 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
         match self.formulation {
-            Formulation::Aba => hybrid_aba(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?,
+            Formulation::Aba => hybrid_aba_unchecked(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?,
             Formulation::DualQuaternion => {
                 // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
-                let r = match presc {
-                    Some(p) => crate::dqdynamics::dq_hybrid_dynamics(m, &qs, &vs, &self.tau, None, p.mask, p.ddq)?,
-                    None => crate::dqdynamics::dq_dynamics(m, &qs, &vs, &self.tau, None, None)?,
+                let (mask, ddq) = match presc {
+                    Some(p) => (Some(p.mask), Some(p.ddq)),
+                    None => (None, None),
                 };
-                self.d.ddq.copy_from_slice(&r.ddq);
-                self.d.tau.copy_from_slice(&self.tau);
+                crate::dqdynamics::solve_system_unchecked(m, &mut self.d, &qs, &vs, &self.tau, None, mask, ddq)?;
+                let d = &mut self.d;
+                d.ddq.copy_from_slice(&d.dq.out.ddq);
+                d.tau.copy_from_slice(&self.tau);
                 // recorded conservation quantities from the formulation's own algebra, (2.53)/(2.54)
-                self.d.aba_momentum = r.momentum;
-                self.d.aba_kinetic_energy = r.kinetic_energy;
+                d.aba_momentum = d.dq.out.momentum;
+                d.aba_kinetic_energy = d.dq.out.kinetic_energy;
                 for (i, &on) in self.presc_mask.iter().enumerate() {
                     if on && presc.is_some() {
                         let k = m.idx_v[i];
-                        self.d.tau[k..k + m.nvs[i]].copy_from_slice(&r.locked_forces[k..k + m.nvs[i]]);
+                        d.tau[k..k + m.nvs[i]].copy_from_slice(&d.dq.out.locked_forces[k..k + m.nvs[i]]);
                     }
                 }
             }
@@ -233,10 +257,9 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let mut err = 0.0;
         if let (Some(e), Some((rtol, atol))) = (tab.e, tol) {
             // Hairer's RMS error norm over the tangent coordinates of q and over v.
-            let mut mag0 = vec![0.0; nv];
-            let mut mag1 = vec![0.0; nv];
-            tangent_magnitude(m, q0, &mut mag0);
-            tangent_magnitude(m, q1, &mut mag1);
+            let (mag0, mag1) = (&mut self.mag0, &mut self.mag1);
+            tangent_magnitude(m, q0, mag0);
+            tangent_magnitude(m, q1, mag1);
             let mut acc = 0.0;
             for k in 0..nv {
                 let (mut eq, mut ev) = (0.0, 0.0);

@@ -6,10 +6,15 @@ use crate::model::Model;
 /// Samples stored row-major: `q` is T × nq, `v`, `ddq`, `tau` are T × nv, `momentum` T × 6.
 #[derive(Clone, Debug, Default)]
 pub struct Trajectory {
+    /// Length of one configuration.
     pub nq: usize,
+    /// Length of one velocity.
     pub nv: usize,
+    /// Sample times (s).
     pub t: Vec<f64>,
+    /// Configurations, T × nq.
     pub q: Vec<f64>,
+    /// Velocities, T × nv (base twist in the base frame).
     pub v: Vec<f64>,
     /// Accelerations (base: body-frame spatial acceleration, as `v` is body-frame).
     pub ddq: Vec<f64>,
@@ -17,11 +22,15 @@ pub struct Trajectory {
     pub tau: Vec<f64>,
     /// [linear; angular about the inertial origin], inertial frame.
     pub momentum: Vec<f64>,
+    /// Kinetic energy (J).
     pub kinetic_energy: Vec<f64>,
     /// Work done by all generalized forces since t = 0 (integrated with the state).
     pub work: Vec<f64>,
+    /// Accepted integration steps.
     pub steps: usize,
+    /// Rejected steps (adaptive method).
     pub rejected: usize,
+    /// Dynamics evaluations (stages).
     pub evaluations: usize,
 }
 
@@ -45,10 +54,12 @@ impl Trajectory {
         }
     }
 
+    /// Number of samples.
     pub fn len(&self) -> usize {
         self.t.len()
     }
 
+    /// Whether no sample was recorded.
     pub fn is_empty(&self) -> bool {
         self.t.is_empty()
     }

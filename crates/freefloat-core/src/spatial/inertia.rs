@@ -5,12 +5,16 @@ use super::{skew, Force, Motion, Se3, M3, M6, V3};
 /// With this choice momentum and Newton-Euler equations are linear in the 10 numbers.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Inertia {
+    /// Mass (kg).
     pub mass: f64,
+    /// First moment of mass `m c` (kg m), body axes.
     pub h: V3,
+    /// Rotational inertia about the body-frame origin, body axes (kg m²).
     pub i_o: M3,
 }
 
 impl Inertia {
+    /// A massless body.
     pub fn zero() -> Self {
         Inertia { mass: 0.0, h: V3::zeros(), i_o: M3::zeros() }
     }
@@ -22,6 +26,9 @@ impl Inertia {
     }
 
     /// From the 10 standard parameters `[m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`.
+    ///
+    /// # Panics
+    /// If `p` has fewer than 10 entries (callers pass checked slices, e.g. `Model::with_parameters`).
     pub fn from_params(p: &[f64]) -> Self {
         Inertia {
             mass: p[0],
@@ -30,6 +37,7 @@ impl Inertia {
         }
     }
 
+    /// The 10 standard parameters `[m, mcx, mcy, mcz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`.
     pub fn to_params(&self) -> [f64; 10] {
         let i = &self.i_o;
         [self.mass, self.h.x, self.h.y, self.h.z, i[(0, 0)], i[(0, 1)], i[(1, 1)], i[(0, 2)], i[(1, 2)], i[(2, 2)]]
@@ -106,6 +114,7 @@ impl Inertia {
         Inertia { mass: self.mass, h: h_new, i_o: i_new }
     }
 
+    /// Sum of two inertias expressed in the same frame (a composite body).
     pub fn add(&self, o: &Inertia) -> Inertia {
         Inertia { mass: self.mass + o.mass, h: self.h + o.h, i_o: self.i_o + o.i_o }
     }

@@ -17,9 +17,13 @@ pub use so3::{
 };
 pub use vectors::{Force, Motion};
 
+/// 3-vector (f64).
 pub type V3 = nalgebra::Vector3<f64>;
+/// 3×3 matrix (f64).
 pub type M3 = nalgebra::Matrix3<f64>;
+/// 6×6 matrix (f64), e.g. a spatial inertia or a motion subspace padded to 6 columns.
 pub type M6 = nalgebra::Matrix6<f64>;
+/// 6-vector (f64), `[linear; angular]`.
 pub type V6 = nalgebra::Vector6<f64>;
 
 /// Skew-symmetric matrix: `skew(a) * b == a × b`.

@@ -4,7 +4,9 @@ use super::{Force, Motion, M3, V3};
 /// `act_*` map vectors expressed in B to A; `inv_act_*` map A to B.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Se3 {
+    /// Rotation of B in A (columns: B's axes in A).
     pub rot: M3,
+    /// Origin of B in A (m).
     pub trans: V3,
 }
 
@@ -15,10 +17,12 @@ impl Default for Se3 {
 }
 
 impl Se3 {
+    /// The identity placement.
     #[inline]
     pub fn identity() -> Self {
         Se3 { rot: M3::identity(), trans: V3::zeros() }
     }
+    /// From a rotation and a translation.
     #[inline]
     pub fn new(rot: M3, trans: V3) -> Self {
         Se3 { rot, trans }
@@ -28,6 +32,7 @@ impl Se3 {
     pub fn compose(&self, o: &Se3) -> Se3 {
         Se3 { rot: self.rot * o.rot, trans: self.rot * o.trans + self.trans }
     }
+    /// The placement of A in B.
     #[inline]
     pub fn inverse(&self) -> Se3 {
         let rt = self.rot.transpose();
@@ -39,25 +44,30 @@ impl Se3 {
         let rt = self.rot.transpose();
         Se3 { rot: rt * o.rot, trans: rt * (o.trans - self.trans) }
     }
+    /// A point given in B, expressed in A.
     #[inline]
     pub fn act_point(&self, p: &V3) -> V3 {
         self.rot * p + self.trans
     }
+    /// A twist in B coordinates, expressed in A (about A's origin).
     #[inline]
     pub fn act_motion(&self, m: &Motion) -> Motion {
         let ang = self.rot * m.ang;
         Motion { lin: self.rot * m.lin + self.trans.cross(&ang), ang }
     }
+    /// A twist in A coordinates, expressed in B.
     #[inline]
     pub fn inv_act_motion(&self, m: &Motion) -> Motion {
         let rt = self.rot.transpose();
         Motion { lin: rt * (m.lin - self.trans.cross(&m.ang)), ang: rt * m.ang }
     }
+    /// A wrench in B coordinates (moment about B's origin), expressed in A (about A's origin).
     #[inline]
     pub fn act_force(&self, f: &Force) -> Force {
         let lin = self.rot * f.lin;
         Force { lin, ang: self.rot * f.ang + self.trans.cross(&lin) }
     }
+    /// A wrench in A coordinates, expressed in B.
     #[inline]
     pub fn inv_act_force(&self, f: &Force) -> Force {
         let rt = self.rot.transpose();

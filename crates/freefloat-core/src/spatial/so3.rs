@@ -16,6 +16,9 @@ pub fn quat_mul(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
     ]
 }
 
+/// Normalise a quaternion (4 entries, any order) in place.
+/// # Panics
+/// If `q` has fewer than 4 entries (an internal helper: callers pass checked slices).
 #[inline]
 pub fn quat_normalize(q: &mut [f64]) {
     let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
@@ -25,6 +28,9 @@ pub fn quat_normalize(q: &mut [f64]) {
 }
 
 /// Rotation matrix of a unit quaternion (x, y, z, w).
+///
+/// # Panics
+/// If `q` has fewer than 4 entries (callers pass checked slices).
 #[inline]
 pub fn rot_from_quat(q: &[f64]) -> M3 {
     let (x, y, z, w) = (q[0], q[1], q[2], q[3]);

@@ -5,7 +5,9 @@ use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 /// `ang` the angular part.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Motion {
+    /// Linear part (velocity or acceleration of the frame origin), m/s or m/s².
     pub lin: V3,
+    /// Angular part (angular velocity or acceleration), rad/s or rad/s².
     pub ang: V3,
 }
 
@@ -13,30 +15,42 @@ pub struct Motion {
 /// frame origin (angular momentum about it).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Force {
+    /// Force (N) or linear momentum (kg m/s).
     pub lin: V3,
+    /// Moment about the frame origin (N m) or angular momentum about it (kg m²/s).
     pub ang: V3,
 }
 
 macro_rules! vec6_ops {
     ($t:ident) => {
         impl $t {
+            /// All six entries zero.
             pub const ZERO: $t = $t { lin: V3::new(0.0, 0.0, 0.0), ang: V3::new(0.0, 0.0, 0.0) };
+            /// From the linear and angular parts.
             #[inline]
             pub fn new(lin: V3, ang: V3) -> Self {
                 Self { lin, ang }
             }
+            /// From a 6-vector `[linear; angular]`.
             #[inline]
             pub fn from_v6(x: &V6) -> Self {
                 Self { lin: V3::new(x[0], x[1], x[2]), ang: V3::new(x[3], x[4], x[5]) }
             }
+            /// From the first six numbers of a slice, `[linear; angular]`.
+            /// # Panics
+            /// If `x` has fewer than 6 entries (an internal helper: the engine passes checked slices).
             #[inline]
             pub fn from_slice(x: &[f64]) -> Self {
                 Self { lin: V3::new(x[0], x[1], x[2]), ang: V3::new(x[3], x[4], x[5]) }
             }
+            /// As a 6-vector `[linear; angular]`.
             #[inline]
             pub fn to_v6(&self) -> V6 {
                 V6::new(self.lin.x, self.lin.y, self.lin.z, self.ang.x, self.ang.y, self.ang.z)
             }
+            /// Write `[linear; angular]` into the first six entries of `out`.
+            /// # Panics
+            /// If `out` has fewer than 6 entries.
             #[inline]
             pub fn write(&self, out: &mut [f64]) {
                 out[..3].copy_from_slice(self.lin.as_slice());
