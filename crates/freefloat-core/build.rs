@@ -40,7 +40,9 @@ fn main() {
         fail(&format!("the built-in model folder {} holds no .yaml robot files", dir.display()));
     }
     entries.sort();
-    let mut code = String::from("/// Built-in robots: (name, YAML text), sorted by name.\npub static MODELS: &[(&str, &str)] = &[\n");
+    let mut code = String::from(
+        "/// Built-in robots: (name, YAML text), sorted by name.\npub static MODELS: &[(&str, &str)] = &[\n",
+    );
     for (name, path) in entries {
         code.push_str(&format!("    ({name:?}, include_str!({path:?})),\n"));
     }
