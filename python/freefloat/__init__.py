@@ -12,6 +12,10 @@ parameters, excitation design, least squares, consistent parameters, validation,
 `postcapture` (Zhang, Yue, Yuan 2020), `dq` (Valverde 2018's dual quaternions and reaction wrenches), `control`,
 `viz` (plotting helpers) and `cli` (the `freefloat` command). Every number is computed by the Rust engine."""
 
+from . import _cpu
+
+_cpu.check()  # before anything loads the engine: a clear ImportError on too old a processor, not SIGILL
+
 from . import constants, control, dq, identification, io, models, trajectories, viz
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (

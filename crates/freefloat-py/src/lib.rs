@@ -3,6 +3,7 @@
 
 mod algorithms;
 mod batch;
+mod cpu;
 mod dq;
 mod dqdynamics;
 mod errors;
@@ -18,6 +19,7 @@ use pyo3::prelude::*;
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    m.add("COMPILED_CPU_FEATURES", cpu::compiled_features())?;
     m.add_class::<model::PyModel>()?;
     m.add("ModelError", py.get_type::<errors::ModelError>())?;
     m.add("InputError", py.get_type::<errors::InputError>())?;

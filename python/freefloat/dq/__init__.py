@@ -25,4 +25,21 @@ from .algebra import (
     vector,
 )
 
-__all__ = [*algebra.__all__, "algebra", "reactions"]
+__all__ = [
+    "DualQuaternion",
+    "from_pose",
+    "identity",
+    "vector",
+    "exp",
+    "screw",
+    "dh",
+    "dh_chain",
+    "line_of_sight",
+    "approach_slope",
+    "attitude",
+    "distance_bound",
+    "body_poses",
+    "condition_number",
+    "algebra",
+    "reactions",
+]
