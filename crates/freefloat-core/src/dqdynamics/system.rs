@@ -4,8 +4,9 @@
 //! `G_ij` the map from joint j's reduced wrench to the wrench on body i at its CoM (6.20), the body rows are
 //! `M_i (ẏ_i)^s = B1_i + Σ_j G_ij W̃_j` ((2.56) with (6.22)) and the joint rows (6.16) are
 //! `Σ_i G_ijᵀ (ẏ_i)^s = B2_j`; we take the constraint selector `Λ_j = V_jᵀ P_swap` (the symmetric variant:
-//! as assembled, (6.21)'s `S21 S11⁻¹ S12` is not symmetric), which makes `S21 = G_physᵀ P_swap` because `Ad_inᵀ P_swap = P_swap Ad_out` (power is frame
-//! invariant). Eliminating `ẏ` (Schur complement on S11, (6.24)–(6.27)) leaves
+//! as assembled, (6.21)'s `S21 S11⁻¹ S12` is not symmetric), which makes `S21 = G_physᵀ P_swap` because
+//! `Ad_inᵀ P_swap = P_swap Ad_out` (power is frame invariant). Eliminating `ẏ` (Schur complement on S11,
+//! (6.24)–(6.27)) leaves
 //!   `K W̃ = B2 − Σ_i G_iᵀ M_i⁻¹ B1_i`,  `K = Σ_i G_iᵀ M_i⁻¹ G_i = −S21 S11⁻¹ S12`,
 //! K symmetric positive definite (the Delassus matrix), solved by Cholesky. K has a block for every pair of
 //! joints sharing a body; eliminating joints from the leaves up creates no fill-in (the joint graph of a

@@ -132,7 +132,8 @@ impl DualQuat {
         let e = self.mul(&self.conj()) - DualQuat::ONE;
         e.to_vec8().amax()
     }
-    /// Unit dual quaternion: `q q* = 1` within `UNIT_TOL` (not `‖q‖ = 1`: a unit pose has `‖q‖² = 1 + ‖r‖²/4`, Lemma 7).
+    /// Unit dual quaternion: `q q* = 1` within `UNIT_TOL` (not `‖q‖ = 1`: a unit pose has
+    /// `‖q‖² = 1 + ‖r‖²/4`, Lemma 7).
     pub fn is_unit(&self) -> bool {
         self.unit_defect() <= UNIT_TOL
     }

@@ -11,10 +11,10 @@ use crate::error::{FfError, Result};
 use crate::model::{JointType, Model};
 use crate::spatial::V3;
 
-/// Relative pose of a joint's child frame in its rest frame, `q_{i/i0}(Γ)` (the thesis uses it in §6.2 but never writes it out; per joint type it is the
-/// rotation and/or translation of the joint coordinates along/about the joint axis), for the
-/// engine's joint coordinates `q` (length nq). Quaternions are used as given (normalise them first).
-/// `axis2` is a universal joint's second axis (ignored by the other joints).
+/// Relative pose of a joint's child frame in its rest frame, `q_{i/i0}(Γ)` (the thesis uses it in §6.2 but never writes
+/// it out; per joint type it is the rotation and/or translation of the joint coordinates along/about the joint axis),
+/// for the engine's joint coordinates `q` (length nq). Quaternions are used as given (normalise them first). `axis2` is
+/// a universal joint's second axis (ignored by the other joints).
 pub fn joint_pose(kind: JointType, axis: &V3, axis2: &V3, q: &[f64]) -> Result<DualQuat> {
     if q.len() != kind.nq() {
         return Err(FfError::arg(
@@ -190,11 +190,11 @@ pub fn dh_chain(rows: &[[f64; 4]]) -> DualQuat {
     rows.iter().fold(DualQuat::ONE, |acc, r| acc.mul(&dh(r[0], r[1], r[2], r[3])))
 }
 
-/// Body Jacobian of a serial chain in the form of (3.57)–(3.60) (corrected: the printed (3.55) misses a dot on its third term and
-/// (3.57) has `q_{e/I}`, `q_{2/I}` where `q_{e/2}`, `q_{2/1}` are meant):
-/// `ω^e_{e/I} = Σ_k Ad_{(q_{k+1/k} ⋯ q_{e/n})*} ξ_k α̇_k`. `rel = [q_{1/I}, q_{2/1}, …, q_{e/n}]` are the
-/// relative poses (n + 1 of them) and `screws[k]` is joint k's unit twist ξ_k in the frame it moves
-/// (Table 3.1). Returns the n columns (8-vectors, `[real; dual]`).
+/// Body Jacobian of a serial chain in the form of (3.57)–(3.60) (corrected: the printed (3.55) misses a dot on its
+/// third term and (3.57) has `q_{e/I}`, `q_{2/I}` where `q_{e/2}`, `q_{2/1}` are meant):
+/// `ω^e_{e/I} = Σ_k Ad_{(q_{k+1/k} ⋯ q_{e/n})*} ξ_k α̇_k`. `rel = [q_{1/I}, q_{2/1}, …, q_{e/n}]` are the relative
+/// poses (n + 1 of them) and `screws[k]` is joint k's unit twist ξ_k in the frame it moves (Table 3.1). Returns the n
+/// columns (8-vectors, `[real; dual]`).
 pub fn serial_body_jacobian(rel: &[DualQuat], screws: &[DualQuat]) -> Result<Vec<DualQuat>> {
     if rel.len() != screws.len() + 1 {
         return Err(FfError::arg(

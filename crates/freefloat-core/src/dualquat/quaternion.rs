@@ -129,7 +129,8 @@ impl Quat {
     pub fn scale(&self, s: f64) -> Quat {
         Quat { w: self.w * s, v: self.v * s }
     }
-    /// Rotate a 3-vector: `vec(q (0, v̄) q*)` (coordinate change `s^X = q_{Y/X} s^Y q*_{Y/X}`, the thesis' passive convention).
+    /// Rotate a 3-vector: `vec(q (0, v̄) q*)` (coordinate change `s^X = q_{Y/X} s^Y q*_{Y/X}`, the thesis' passive
+    /// convention).
     #[inline]
     pub fn rotate(&self, v: &V3) -> V3 {
         self.mul(&Quat::pure(v)).mul(&self.conj()).v

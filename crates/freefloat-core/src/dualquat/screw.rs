@@ -72,9 +72,10 @@ pub fn screw_exp(theta: f64, d: f64, l: &V3, m: &V3) -> DualQuat {
 }
 
 /// Screw parameters of a unit dual quaternion: rotation angle θ ∈ [0, π], translation d along the axis,
-/// unit axis ℓ and moment m (inverse of (3.10); the thesis defers this to its reference [119], so the formulas here are derived:
-/// `θ = 2 atan2(‖q̄_r‖, q_r0)`, `ℓ = q̄_r / sin(θ/2)`, `d = −2 q_d0 / sin(θ/2)`,
-/// `m = (q̄_d − ½ d ℓ cos(θ/2)) / sin(θ/2)`; for θ = 0 the axis is the translation's direction, ẑ if there is none, and m = 0).
+/// unit axis ℓ and moment m (inverse of (3.10); the thesis defers this to its reference [119], so the formulas here are
+/// derived: `θ = 2 atan2(‖q̄_r‖, q_r0)`, `ℓ = q̄_r / sin(θ/2)`, `d = −2 q_d0 / sin(θ/2)`,
+/// `m = (q̄_d − ½ d ℓ cos(θ/2)) / sin(θ/2)`; for θ = 0 the axis is the translation's direction, ẑ if there is none, and
+/// m = 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Screw {
     /// Rotation angle about the screw axis (rad).

@@ -63,8 +63,8 @@ impl JointPath<'_> {
 
 /// Base twist `[v; ω]` in the base frame that keeps the total momentum zero (Naveen, Shah, Misra's
 /// `[v_0; ω_0] = H_b⁻¹ (h − H_q q̇)` with h = 0), by the engine's one momentum solve
-/// `kinematics::base_twist_for_momentum`. Zero momentum is zero in every frame, so `q`'s base pose is irrelevant; it is evaluated at the identity (`q` is used as scratch),
-/// which leaves in `d` the joint-only twists `place_base` needs.
+/// `kinematics::base_twist_for_momentum`. Zero momentum is zero in every frame, so `q`'s base pose is irrelevant; it is
+/// evaluated at the identity (`q` is used as scratch), which leaves in `d` the joint-only twists `place_base` needs.
 pub fn base_twist_zero_momentum(m: &Model, d: &mut Data, q: &mut [f64], v: &mut [f64]) -> Result<Vector6<f64>> {
     if m.joint_types.first() != Some(&JointType::Free) {
         return Err(FfError::arg("model", "the zero-momentum base twist needs a free-floating base"));

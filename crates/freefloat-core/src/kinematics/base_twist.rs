@@ -171,7 +171,7 @@ mod tests {
     #[test]
     fn matches_the_centroidal_momentum_matrix_solve() {
         let mut seed = 11u64;
-        let m = builtin("seed001_dual_arm").unwrap();
+        let m = builtin("naveen_dual_arm").unwrap();
         let mut d = Data::new(&m);
         for _ in 0..10 {
             let (q, rates) = random_state(&m, &mut seed);
@@ -191,7 +191,7 @@ mod tests {
 
     #[test]
     fn bad_arguments_are_errors() {
-        let m = builtin("seed001_dual_arm").unwrap();
+        let m = builtin("naveen_dual_arm").unwrap();
         let mut d = Data::new(&m);
         let (q, rates) = random_state(&m, &mut 3u64);
         assert!(base_twist_for_momentum(&m, &mut d, &q[1..], &rates, &[0.0; 6]).is_err());
