@@ -161,7 +161,7 @@ class ModelError(ValueError):
     """A model file or model description is malformed or non-physical."""
 
 class ModifiedRLS:
-    """Seed 000's modified RLS (Rust `estimation::ModifiedRls`), coupling "spatial" or "planar"."""
+    """The modified RLS of Zhang, Yue, Yuan 2020 (Rust `estimation::ModifiedRls`), coupling "spatial" or "planar"."""
     def __init__(self, coupling: str, mu0: ArrayLike, p_mu0: ArrayLike, theta0: ArrayLike, p_theta0: ArrayLike) -> None: ...
     @property
     def mu(self) -> Any:
@@ -236,7 +236,7 @@ def dq_body_poses(model: Model, q: ArrayLike, method: str = 'chain') -> Any:
     """
 
 def dq_condition_number(model: Model, q: ArrayLike) -> Any:
-    """2-norm condition number of the thesis' system matrix S (6.17) at each configuration (one q or (T, nq))."""
+    """2-norm condition number of Valverde 2018's system matrix S (6.17) at each configuration (one q or (T, nq))."""
 
 def dq_dh(d: float, theta: float, a: ArrayLike, alpha: float) -> Any:
     """Standard DH transform (3.26); with `rows` (n × 4 of d, θ, a, α) the chain product."""
@@ -270,12 +270,12 @@ def dq_screw(theta: float, d: float, l: ArrayLike, m: ArrayLike) -> Any:
 
 def dynamics_regressor(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike) -> np.ndarray:
     """Inverse-dynamics regressor (nv, 10·nbodies): rnea(q, v, a) == Y @ P.ravel(), gravity included.
-Per body the thesis' regressor R (Eqs. 4.3, 9.7), the Newton-Euler counterpart of seed 001's Eq. 10,
-projected on every joint between the body and the root.
+Per body Valverde 2018's regressor R (Eqs. 4.3, 9.7), the Newton-Euler counterpart of Naveen, Shah,
+Misra's Eq. 10, projected on every joint between the body and the root.
     """
 
 def excitation_objective(model: Model, q0: ArrayLike, iq: ArrayLike, iv: ArrayLike, step: float, q: ArrayLike, qd: ArrayLike, stride: int, offset: int, columns: ArrayLike, weight: float, n_signal: int, threads: int = 2) -> Any:
-    """Evaluate seed 001 eq. (32) for B joint paths at once (worker threads, GIL released).
+    """Evaluate Naveen, Shah, Misra's eq. (32) for B joint paths at once (worker threads, GIL released).
 q (B, S, n) / qd: driven joints' angles and rates on a grid of `step` seconds; iq, iv: their q and v
 indices; q0 (nq,): start configuration (base pose, other joints); rows at grid points offset + k·stride;
 columns: minimal-regressor columns (indices into 10·nbodies); n_signal: how many of the driven joints (the
@@ -352,7 +352,7 @@ def momentum(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
 
 def momentum_regressor(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
     """Momentum regressor (6, 10·nbodies): momentum(q, v) == K @ P.ravel() with P = m.parameters().
-Seed 001's link kinematic matrix (Eq. 10) per body, in our parameter order.
+The link kinematic matrix of Naveen, Shah, Misra (Eq. 10) per body, in our parameter order.
     """
 
 def momentum_regressor_stream(model: Model, q: ArrayLike, v: ArrayLike, h: ArrayLike, columns: ArrayLike, known_params: ArrayLike, weights: ArrayLike | None = None) -> Any:
@@ -365,7 +365,7 @@ def postcapture_m_j(mass: ArrayLike, com: ArrayLike) -> Any:
     """`m J(b')` (10) = [m, m b', m mono(b')] (Zhang 2020, eq. (23))."""
 
 def postcapture_rows(model: Model, form: ArrayLike, solver: ArrayLike, t: ArrayLike, q: ArrayLike, v: ArrayLike, ddq: ArrayLike, base_wrench: ArrayLike, impulse_f: ArrayLike, impulse_m: ArrayLike, base: str, target: ArrayLike) -> Any:
-    """Seed 000's regression rows over a whole measurement record (Zhang, Yue, Yuan 2020), computed by the
+    """Regression rows of Zhang, Yue, Yuan 2020 over a whole measurement record, computed by the
 engine (`postcapture::equations`). `form`: "momentum" (eqs. 11-19; cumulative differences from the first
 sample, so one block fewer) or "force" (eqs. 26-33, about the base sensor). `solver`: "paper" (dict with
 t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict with t, Phi, y, standard

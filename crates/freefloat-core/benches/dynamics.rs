@@ -1,4 +1,4 @@
-//! Criterion benchmarks of the engine's core algorithms on the built-in `seed001_dual_arm`
+//! Criterion benchmarks of the engine's core algorithms on the built-in `naveen_dual_arm`
 //! (free base + two 3R arms + three reaction wheels: nq = 16, nv = 15), and of a 10 s, 1 kHz RK4
 //! simulation with sinusoidal arm torques (the same scenario as benches/compare_pinocchio.py).
 //!
@@ -20,7 +20,7 @@ use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 use std::time::Duration;
 
-const MODEL: &str = "seed001_dual_arm";
+const MODEL: &str = "naveen_dual_arm";
 const NSTATES: usize = 64;
 
 struct State {

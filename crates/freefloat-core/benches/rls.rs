@@ -1,10 +1,10 @@
-//! Update rate of the online estimators on the seed 000 3D problem (issue 3 target: ≥ 10⁶ updates/s).
+//! Update rate of the online estimators on the Zhang, Yue, Yuan 2020 3D problem (issue 3 target: ≥ 10⁶ updates/s).
 //!
 //!     nice cargo bench -p freefloat-core --bench rls
 //!
 //! - `rls_standard_3d`: ordinary RLS, 20 unknowns (standard parameters of base and target), 6 rows
 //!   per sample: the real rows of the 3D problem, i.e. the base and target columns of the engine's
-//!   momentum regressor of `seed000_3d` at random states (the linear rows have no inertia columns).
+//!   momentum regressor of `zhang2020_3d` at random states (the linear rows have no inertia columns).
 //! - `rls_dense_20x6`: the same estimator on dense random rows (no structure to exploit).
 //! - `modified_rls_3d`: the paper's modified RLS (eqs. 34-38): μ ∈ R⁸ from 3 rows, θ ∈ R¹² from
 //!   3 rows, D(μ) ∈ R²⁰ (so M is 12 × 20).
@@ -28,7 +28,7 @@ fn pool(rows: usize, cols: usize, rng: &mut StdRng) -> Vec<Vec<f64>> {
 /// Rows of the 3D standard-parameter momentum regression: base (body 0) and target columns of the
 /// momentum regressor at random states (row-major 6 × 20).
 fn real_rows(rng: &mut StdRng) -> Vec<Vec<f64>> {
-    let m = freefloat_core::model::builtin::load("seed000_3d").expect("built-in model");
+    let m = freefloat_core::model::builtin::load("zhang2020_3d").expect("built-in model");
     let target = m.nbodies() - 1;
     let mut d = Data::new(&m);
     let mut k = DMatrix::zeros(6, 10 * m.nbodies());

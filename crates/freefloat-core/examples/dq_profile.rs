@@ -4,7 +4,7 @@ use freefloat_core::model::builtin;
 use freefloat_core::Data;
 
 fn main() {
-    let m = builtin::load("thesis_ch7_two_arm").expect("built-in");
+    let m = builtin::load("valverde_ch7_two_arm").expect("built-in");
     let q = m.neutral();
     let v: Vec<f64> = (0..m.nv).map(|k| 0.1 * (k as f64).sin()).collect();
     let tau: Vec<f64> = (0..m.nv).map(|k| 0.2 * (k as f64).cos()).collect();

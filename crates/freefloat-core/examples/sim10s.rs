@@ -1,6 +1,6 @@
-//! A 10 s, 1 kHz RK4 simulation of the seed 001 robot with smooth arm torques: a fixed workload for
-//! instruction counting (`valgrind --tool=callgrind`), which, unlike wall time, does not depend on
-//! what else the shared machine is doing.
+//! A 10 s, 1 kHz RK4 simulation of the Naveen, Shah, Misra robot (`naveen_dual_arm`) with smooth arm torques: a fixed
+//! workload for instruction counting (`valgrind --tool=callgrind`), which, unlike wall time, does not depend on what
+//! else the shared machine is doing.
 //!
 //!     cargo build --release --example sim10s && valgrind --tool=callgrind target/release/examples/sim10s
 
@@ -8,7 +8,7 @@ use freefloat_core::model::builtin;
 use freefloat_core::sim::{simulate, Inputs, Method, SimOptions, TorqueSource};
 
 fn main() {
-    let m = builtin::load("seed001_dual_arm").expect("built-in model");
+    let m = builtin::load("naveen_dual_arm").expect("built-in model");
     let mut q = m.neutral();
     q[0..3].copy_from_slice(&[0.5, -0.2, 0.1]);
     let mut v = vec![0.0; m.nv];

@@ -62,7 +62,7 @@ fn count(f: impl FnOnce()) -> usize {
 #[test]
 fn hot_paths_allocate_nothing() {
     let mut report = vec![];
-    for name in ["seed001_dual_arm_consistent", "thesis_ch7_two_arm"] {
+    for name in ["naveen_dual_arm_consistent", "valverde_ch7_two_arm"] {
         let m = builtin::load(name).expect("built-in");
         let mut d = Data::new(&m);
         // states whose quaternion is off by round-off, so the normalised copy (d.qbuf) is exercised

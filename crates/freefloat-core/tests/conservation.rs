@@ -1,4 +1,4 @@
-//! Conservation laws and convergence order of the integrators on the seed 001 dual-arm robot.
+//! Conservation laws and convergence order of the integrators on the Naveen, Shah, Misra dual-arm robot.
 #![allow(clippy::needless_range_loop)]
 
 use freefloat_core::model::builtin;
@@ -57,7 +57,7 @@ fn drift(tr: &freefloat_core::sim::Trajectory) -> (f64, f64) {
 
 #[test]
 fn rk4_conserves_momentum_and_energy_over_60s() {
-    let m = builtin::load("seed001_dual_arm").unwrap();
+    let m = builtin::load("naveen_dual_arm").unwrap();
     let tr = run(&m, 60.0, 1e-3, Method::Rk4);
     let (dp, dl) = drift(&tr);
     assert!(dp < 1e-9 && dl < 1e-9, "relative momentum drift {dp:e} / {dl:e}");
@@ -71,7 +71,7 @@ fn rk4_conserves_momentum_and_energy_over_60s() {
 /// Error against a fine reference shrinks ~16× when dt halves (fourth order, base attitude included).
 #[test]
 fn rk4_is_fourth_order_on_the_rotation_group() {
-    let m = builtin::load("seed001_dual_arm").unwrap();
+    let m = builtin::load("naveen_dual_arm").unwrap();
     let t = 2.0;
     let reference = run(&m, t, 1e-3 / 8.0, Method::Rk4);
     let last = |tr: &freefloat_core::sim::Trajectory| tr.q[(tr.len() - 1) * m.nq..].to_vec();
@@ -88,7 +88,7 @@ fn rk4_is_fourth_order_on_the_rotation_group() {
 
 #[test]
 fn rk45_meets_its_tolerance() {
-    let m = builtin::load("seed001_dual_arm").unwrap();
+    let m = builtin::load("naveen_dual_arm").unwrap();
     let reference = run(&m, 3.0, 1e-3 / 4.0, Method::Rk4);
     let tr = run(&m, 3.0, 1e-1, Method::Rk45 { rtol: 1e-10, atol: 1e-12, max_step: f64::INFINITY });
     let qa = &tr.q[(tr.len() - 1) * m.nq..];

@@ -23,7 +23,7 @@ use freefloat_core::{Data, FfError, JointType, Model};
 use nalgebra::DMatrix;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-const MODEL: &str = "seed001_dual_arm_consistent";
+const MODEL: &str = "naveen_dual_arm_consistent";
 
 /// Calls `f` and fails the test unless it returns `Err` (a panic is a failure, with its message).
 fn must_err<T>(what: &str, failures: &mut Vec<String>, f: impl FnOnce() -> Result<T, FfError>) {
@@ -262,7 +262,7 @@ fn a_data_of_another_model_is_refused() {
     let mut failures = vec![];
     // the same description built again is another model; so is a different robot
     let same_again = builtin::load(MODEL).expect("built-in");
-    let other = builtin::load("thesis_ch5_single_arm").expect("built-in");
+    let other = builtin::load("valverde_ch5_single_arm").expect("built-in");
     for (tag, mut d) in [("same description, built again", Data::new(&same_again)), ("other robot", Data::new(&other))]
     {
         state_calls(&m, &mut d, &g.q, &g.v, &g.a, &g.fext, tag, Some("data"), &mut failures);
@@ -431,7 +431,7 @@ fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
     must_err("base_twist_for_momentum momentum NaN", &mut failures, || {
         base_twist_for_momentum(&m, &mut d, &g.q, &rates, &[f64::NAN; 6])
     });
-    let mut other = Data::new(&builtin::load("thesis_ch5_single_arm").expect("built-in"));
+    let mut other = Data::new(&builtin::load("valverde_ch5_single_arm").expect("built-in"));
     must_err("base_twist_for_momentum (Data of another model)", &mut failures, || {
         base_twist_for_momentum(&m, &mut other, &g.q, &rates, &[0.0; 6])
     });
@@ -472,8 +472,8 @@ fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
             integrate_base_poses(Steps::Times(times), &tw, &pose0, &mut out)
         });
     }
-    // post-capture rows on the seed 000 robot (base 0, target = last body)
-    let mp = builtin::load("seed000_3d").expect("built-in");
+    // post-capture rows on the Zhang, Yue, Yuan 2020 robot (base 0, target = last body)
+    let mp = builtin::load("zhang2020_3d").expect("built-in");
     let (n, nv, nb) = (3usize, mp.nv, mp.nvs[0]);
     let target = mp.nbodies() - 1;
     let t: Vec<f64> = (0..n).map(|k| 0.01 * k as f64).collect();

@@ -1,4 +1,4 @@
-//! The dual-quaternion Newton–Euler formulation (seed 003, Ch. 6) against the engine's independent
+//! The dual-quaternion Newton–Euler formulation (Valverde 2018, Ch. 6) against the engine's independent
 //! recursive algorithms: accelerations = ABA, joint wrenches = RNEA's transmitted forces (run at the ABA
 //! accelerations), locked joints = hybrid ABA, on random trees with every joint type the engine has.
 
@@ -98,7 +98,7 @@ fn locked_joints_match_hybrid_aba() {
 
 #[test]
 fn single_free_body_is_newton_euler() {
-    // T5 (digest §5): B = 1, J = 0 reproduces (2.56) component-wise.
+    // one body, no joint (B = 1, J = 0): reproduces (2.56) component-wise.
     let inr =
         Inertia::from_com(2.5, V3::new(0.1, -0.2, 0.3), M3::new(0.9, 0.1, -0.05, 0.1, 1.3, 0.02, -0.05, 0.02, 0.7));
     let m = ModelBuilder::new("one", "b", JointType::Free, inr).expect("base").build().expect("model");
@@ -181,7 +181,7 @@ fn bad_input_is_reported() {
 
 #[test]
 fn tree_and_dense_schur_solves_agree() {
-    // T4 (digest §5): the tree-sparse elimination equals the dense solve of the assembled Delassus matrix.
+    // the tree-sparse elimination equals the dense solve of the assembled Delassus matrix.
     use freefloat_core::dqdynamics::{dq_dynamics_with, Solver};
     let mut r = rng(99);
     for case in 0..40 {
@@ -219,7 +219,7 @@ fn closed_form_adjoints_equal_the_product_matrices() {
 
 #[test]
 fn decoupled_formulation_agrees_with_dq_and_aba() {
-    // T6 (digest §5): the chapter-5 decoupled formulation and the dual-quaternion one give the same
+    // the chapter-5 decoupled formulation and the dual-quaternion one give the same
     // accelerations and joint wrenches; both equal the engine's ABA / RNEA.
     use freefloat_core::dqdynamics::decoupled::decoupled_dynamics;
     let mut r = rng(55);
@@ -248,7 +248,7 @@ fn decoupled_formulation_agrees_with_dq_and_aba() {
         .expect_err("refused");
     assert!(err.to_string().contains("universal"), "{err}");
     // the chapter-5 robot
-    let m = freefloat_core::model::builtin::load("thesis_ch5_single_arm").expect("built-in");
+    let m = freefloat_core::model::builtin::load("valverde_ch5_single_arm").expect("built-in");
     let q = random_q(&m, &mut r);
     let v = random_vec(m.nv, &mut r);
     let tau = random_vec(m.nv, &mut r);
@@ -305,7 +305,7 @@ fn dual_momentum_and_energy_match_engine() {
 #[test]
 fn simulation_with_the_dual_quaternion_formulation() {
     use freefloat_core::sim::{simulate_with, Formulation, Hold, Inputs, Method, SimOptions, TorqueSource};
-    for name in ["thesis_ch5_single_arm", "thesis_ch7_two_arm"] {
+    for name in ["valverde_ch5_single_arm", "valverde_ch7_two_arm"] {
         let m = freefloat_core::model::builtin::load(name).expect("built-in");
         let opts = SimOptions { t_final: 1.0, dt: 1e-3, method: Method::Rk4, record_every: 100, max_steps: 1_000_000 };
         let tau: Vec<f64> = (0..m.nv).map(|k| if k >= 6 { 0.3 * ((k % 3) as f64 - 1.0) } else { 0.0 }).collect();

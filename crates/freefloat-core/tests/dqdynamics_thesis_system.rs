@@ -1,4 +1,4 @@
-//! The thesis' own system (seed 003, (6.17)–(6.27)) assembled literally in 8-vector form — 8×8 product
+//! Valverde 2018's own system ((6.17)–(6.27)) assembled literally in 8-vector form — 8×8 product
 //! matrices, the E-selectors of Tables 6.2/6.3 in the thesis' slot order (not our symmetric variant), the
 //! zero scalar slots kept — and solved with a dense LU of the full (8B + R)-square matrix. Its accelerations
 //! and joint wrenches must equal `dq_dynamics` (symmetric variant, 6-vectors, tree elimination). Geometry and

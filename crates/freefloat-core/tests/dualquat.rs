@@ -1,5 +1,6 @@
-//! Property tests of the dual-quaternion algebra (seed 003, Ch. 2; digest
-//! `thesis_ch2_3_dual_quaternions.md` §11, items 1–9) on random inputs. Expected values come from the
+//! Property tests of the dual-quaternion algebra (Valverde 2018, Ch. 2–3: product matrices, unit
+//! poses, composition and normalisation, Lemmas 1–2, circle-product identities, shifting laws, dual velocity,
+//! dual inertia and dynamics, screws and DH) on random inputs. Expected values come from the
 //! definitions written out component by component, from the engine's independent SO(3)/SE(3) code, from
 //! finite differences or from power series — never from the routine under test.
 
@@ -163,7 +164,7 @@ fn circle_product_identities() {
         // (2.24), all dual quaternions
         let ab = a.circle_scalar(&b);
         assert!((a.swap().circle_scalar(&b.swap()) - ab).abs() < 1e-12 && (b.circle_scalar(&a) - ab).abs() < 1e-12);
-        // (2.25), holds for all dual quaternions (the thesis states it for vectors only, digest §10.4)
+        // (2.25), holds for all dual quaternions (the thesis states it for vector dual quaternions only)
         let x = a.circle_scalar(&b.mul(&c));
         assert!((b.swap().circle_scalar(&a.swap().mul(&c.conj())) - x).abs() < 1e-10);
         assert!((c.swap().circle_scalar(&b.conj().mul(&a.swap())) - x).abs() < 1e-10);
@@ -173,7 +174,7 @@ fn circle_product_identities() {
         assert!((b.swap().circle_scalar(&c.cross(&a.swap())) - x).abs() < 1e-10);
         assert!((c.swap().circle_scalar(&a.swap().cross(&b)) - x).abs() < 1e-10);
     }
-    // negative tests (digest §3): with a general c the second equality of (2.26) fails, with a general b
+    // negative tests: with a general c the second equality of (2.26) fails, with a general b
     // the first one does
     let (mut worst_c, mut worst_b): (f64, f64) = (0.0, 0.0);
     for _ in 0..20 {
@@ -275,7 +276,7 @@ fn lemmas_1_and_2() {
 
 #[test]
 fn shifting_law_numeric_case() {
-    // digest §9 extras: 90° about z, Y's origin at [1,0,0] in X
+    // independently computed case: 90° about z, Y's origin at [1,0,0] in X
     let q = from_rotation_translation(&Quat::from_axis_angle(&V3::z(), std::f64::consts::FRAC_PI_2), &V3::x());
     let h = std::f64::consts::FRAC_1_SQRT_2;
     assert_dq!(q, DualQuat::from_slice(&[h, 0.0, 0.0, h, 0.0, 0.5 * h, -0.5 * h, 0.0]), 1e-15);
@@ -469,8 +470,8 @@ fn screw_exponential_and_logarithm() {
 }
 
 #[test]
-fn digest_screw_vector() {
-    // digest §9 extras: θ = π/2, d = 0.2, ℓ = ẑ through p = [1,0,0] (m = [0,−1,0]); r^A = [1,−1,0.2]
+fn screw_exp_numeric_case() {
+    // independently computed case: θ = π/2, d = 0.2, ℓ = ẑ through p = [1,0,0] (m = [0,−1,0]); r^A = [1,−1,0.2]
     let q = screw_exp(std::f64::consts::FRAC_PI_2, 0.2, &V3::z(), &V3::new(0.0, -1.0, 0.0));
     let h = std::f64::consts::FRAC_1_SQRT_2;
     assert_dq!(q, DualQuat::from_slice(&[h, 0.0, 0.0, h, -0.1 * h, 0.0, -h, 0.1 * h]), 1e-15);

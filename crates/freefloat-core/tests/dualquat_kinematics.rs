@@ -1,6 +1,7 @@
-//! Dual-quaternion kinematics (seed 003, Ch. 3) against the engine's forward kinematics, closed forms, the
-//! chapter 3 worked examples (digest §8–9; the thesis gives no numbers, the digest's test values were
-//! computed independently with numpy) and the constraint encodings of §3.4.
+//! Dual-quaternion kinematics (Valverde 2018, Ch. 3) against the engine's forward kinematics, closed forms,
+//! the chapter 3 worked examples (§3.5–3.6; the thesis works them symbolically, so the link lengths, angles
+//! and expected values here were chosen and computed independently with numpy) and the constraint encodings
+//! of §3.4.
 
 mod common;
 
@@ -53,7 +54,7 @@ fn chain_and_poe_match_engine_fk_on_random_trees() {
 #[test]
 fn dh_forms_agree_and_match_the_htm() {
     let mut r = rng(7);
-    // digest §9 extra vectors
+    // independently computed DH vectors (the thesis gives no numbers)
     let a = dh(0.3, 0.8, 1.2, -0.6);
     let expect = [0.87992318, -0.27219214, -0.11508099, 0.37202555, 0.10751145, 0.54521605, 0.18238651, 0.20103707];
     assert!(close(&a, &expect, 1e-8));
@@ -73,13 +74,13 @@ fn dh_forms_agree_and_match_the_htm() {
         let htm =
             Se3::new(M3::new(ct, -st * ca, st * sa, st, ct * ca, -ct * sa, 0.0, sa, ca), V3::new(aa * ct, aa * st, d));
         assert_pose_eq(&c, &htm, 1e-14);
-        // (3.27) is its inverse (the passive map), digest §10.10
+        // (3.27) is its inverse (the passive map i−1 → i), although the thesis calls it the HTM equivalent to q_{i/i−1}
         let inv = Se3::new(
             M3::new(ct, st, 0.0, -ca * st, ca * ct, sa, sa * st, -sa * ct, ca),
             V3::new(-aa, -d * sa, -d * ca),
         );
         assert_pose_eq(&c.conj(), &inv, 1e-14);
-        // the literal (3.20) without ½ does not reproduce (3.26) (digest §10.9)
+        // the literal (3.20) without ½ does not reproduce (3.26): the printed (3.20)–(3.21) drop the ½
         let literal = DualQuat::new(Quat::ONE, Quat::pure(&V3::new(0.0, 0.0, d)))
             .mul(&rotation(&Quat::from_axis_angle(&V3::z(), th)))
             .mul(&DualQuat::new(Quat::ONE, Quat::pure(&V3::new(aa, 0.0, 0.0))))
@@ -144,7 +145,7 @@ fn example_a_chain(l1: f64, l2: f64, a1: f64, a2: f64) -> [DualQuat; 3] {
 }
 
 #[test]
-#[allow(clippy::approx_constant)] // 0.70710678 is the digest's printed number, compared to 1e-8
+#[allow(clippy::approx_constant)] // 0.70710678 is the reference value to 8 digits, compared to 1e-8
 fn chapter3_example_a_planar_rr() {
     let (l1, l2) = (1.0, 0.5);
     let (a1, a2) = (std::f64::consts::FRAC_PI_6, std::f64::consts::FRAC_PI_4);
@@ -162,7 +163,7 @@ fn chapter3_example_a_planar_rr() {
         .mul(&freefloat_core::dualquat::screw_exp(a2, 0.0, &V3::z(), &V3::new(l1, 0.0, 0.0).cross(&V3::z())))
         .mul(&home);
     assert!((poe.to_vec8() - q.to_vec8()).amax() < 1e-15);
-    // body Jacobian (3.57)–(3.60), corrected: closed-form columns and the digest's twist
+    // body Jacobian (3.57)–(3.60), corrected: closed-form columns and the independently computed twist
     let xi = DualQuat::vector(&V3::z(), &V3::zeros());
     let j = serial_body_jacobian(&rel, &[xi, xi]).expect("3 poses, 2 joints");
     let j1 = DualQuat::vector(&V3::z(), &V3::new(l1 * a2.sin(), l1 * a2.cos() + l2, 0.0));
@@ -227,7 +228,7 @@ fn constraint_encodings_and_sign() {
         let z = V3::new(r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0), r.gen_range(-1.0..1.0)).normalize();
         let r_ga_a = q.translation(); // r^A_{G/A}
         let r_ga_g = q.translation_body(); // r^G_{G/A}
-                                           // the encodings (digest §7)
+                                           // the encodings of §3.4
         assert!((v.dot(&(approach_slope_matrix(&z) * v)) - r_ga_a.dot(&z)).abs() < 1e-12);
         assert!((v.dot(&(line_of_sight_matrix(&y) * v)) - r_ga_g.dot(&y)).abs() < 1e-12); // the sign issue
         let nb = z;

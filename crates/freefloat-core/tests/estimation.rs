@@ -142,7 +142,7 @@ fn rank_deficiency_names_the_unexcited_combination() {
     assert!(err.contains("rank 7 of 8") && err.contains("x[2]") && err.contains("x[6]"), "{err}");
 }
 
-/// Momentum data of seed001_dual_arm at random states, with the wheels known.
+/// Momentum data of naveen_dual_arm at random states, with the wheels known.
 struct DualArm {
     m: freefloat_core::Model,
     q: Vec<f64>,
@@ -153,7 +153,7 @@ struct DualArm {
 }
 
 fn dual_arm(samples: usize, seed: u64) -> DualArm {
-    let m = builtin::load("seed001_dual_arm").unwrap();
+    let m = builtin::load("naveen_dual_arm").unwrap();
     let mut r = rng(seed);
     let mut d = Data::new(&m);
     let np = 10 * m.nbodies();
@@ -175,7 +175,7 @@ fn dual_arm(samples: usize, seed: u64) -> DualArm {
 
 #[test]
 fn momentum_identification_reports_the_grouped_parameters_as_unexcited() {
-    // all 70 standard parameters of base + 6 links: 18 of them are grouped (seed 001: 70 → 52)
+    // all 70 standard parameters of base + 6 links: 18 of them are grouped (Naveen, Shah, Misra: 70 → 52)
     let da = dual_arm(200, 10);
     let cols: Vec<usize> = (0..70).collect();
     let p =

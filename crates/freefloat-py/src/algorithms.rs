@@ -266,7 +266,7 @@ fn rowmajor_view(o: &mut [f64], rows: usize, cols: usize) -> MatrixViewMut<'_, f
 }
 
 /// Momentum regressor (6, 10·nbodies): momentum(q, v) == K @ P.ravel() with P = m.parameters().
-/// Seed 001's link kinematic matrix (Eq. 10) per body, in our parameter order.
+/// The link kinematic matrix of Naveen, Shah, Misra (Eq. 10) per body, in our parameter order.
 #[pyfunction]
 pub fn momentum_regressor<'py>(
     py: Python<'py>,
@@ -289,8 +289,8 @@ pub fn momentum_regressor<'py>(
 }
 
 /// Inverse-dynamics regressor (nv, 10·nbodies): rnea(q, v, a) == Y @ P.ravel(), gravity included.
-/// Per body the thesis' regressor R (Eqs. 4.3, 9.7), the Newton-Euler counterpart of seed 001's Eq. 10,
-/// projected on every joint between the body and the root.
+/// Per body Valverde 2018's regressor R (Eqs. 4.3, 9.7), the Newton-Euler counterpart of Naveen, Shah,
+/// Misra's Eq. 10, projected on every joint between the body and the root.
 #[pyfunction]
 pub fn dynamics_regressor<'py>(
     py: Python<'py>,

@@ -93,7 +93,7 @@ pub fn dq_dynamics<'py>(
     Ok((output(py, a, rows, st, &[nv])?, output(py, w, rows, st, &[nb, 6])?))
 }
 
-/// 2-norm condition number of the thesis' system matrix S (6.17) at each configuration (one q or (T, nq)).
+/// 2-norm condition number of Valverde 2018's system matrix S (6.17) at each configuration (one q or (T, nq)).
 #[pyfunction]
 pub fn dq_condition_number<'py>(
     py: Python<'py>,

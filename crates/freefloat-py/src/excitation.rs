@@ -33,7 +33,7 @@ fn path_pair(q: Arr, qd: Arr, n: usize) -> PyResult<(Vec<f64>, Vec<f64>, usize, 
     Ok((qa, qda, b, s))
 }
 
-/// Evaluate seed 001 eq. (32) for B joint paths at once (worker threads, GIL released).
+/// Evaluate Naveen, Shah, Misra's eq. (32) for B joint paths at once (worker threads, GIL released).
 /// q (B, S, n) / qd: driven joints' angles and rates on a grid of `step` seconds; iq, iv: their q and v
 /// indices; q0 (nq,): start configuration (base pose, other joints); rows at grid points offset + k·stride;
 /// columns: minimal-regressor columns (indices into 10·nbodies); n_signal: how many of the driven joints (the

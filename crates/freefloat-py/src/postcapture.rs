@@ -1,4 +1,4 @@
-//! Seed 000 post-capture bindings: the scenario simulation (eqs. 39-40, RK4) and the two online
+//! Post-capture bindings (Zhang, Yue, Yuan 2020): the scenario simulation (eqs. 39-40, RK4) and the two online
 //! estimators (ordinary RLS with forgetting; the paper's modified RLS, eqs. 34-38) as Python objects
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
@@ -157,7 +157,7 @@ impl PyRls {
     }
 }
 
-/// Seed 000's modified RLS (Rust `estimation::ModifiedRls`), coupling "spatial" or "planar".
+/// The modified RLS of Zhang, Yue, Yuan 2020 (Rust `estimation::ModifiedRls`), coupling "spatial" or "planar".
 #[pyclass(name = "ModifiedRLS", module = "freefloat._core")]
 pub struct PyModifiedRls {
     inner: ModifiedRls,
@@ -266,7 +266,7 @@ impl PyModifiedRls {
     }
 }
 
-// -- seed 000's identification equations (postcapture::equations), one call per batch ----------------------
+// -- Zhang 2020's identification equations (postcapture::equations), one call per batch -------------------
 
 fn flat(name: &str, obj: &Bound<'_, PyAny>, width: usize) -> PyResult<Vec<f64>> {
     let a = crate::batch::array_arg(obj, name)?;
@@ -288,7 +288,7 @@ fn array3<'py>(py: Python<'py>, data: Vec<f64>, shape: &[usize]) -> PyResult<Bou
     Ok(numpy::IntoPyArray::into_pyarray(arr, py).into_any())
 }
 
-/// Seed 000's regression rows over a whole measurement record (Zhang, Yue, Yuan 2020), computed by the
+/// Regression rows of Zhang, Yue, Yuan 2020 over a whole measurement record, computed by the
 /// engine (`postcapture::equations`). `form`: "momentum" (eqs. 11-19; cumulative differences from the first
 /// sample, so one block fewer) or "force" (eqs. 26-33, about the base sensor). `solver`: "paper" (dict with
 /// t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict with t, Phi, y, standard

@@ -1,4 +1,4 @@
-//! Condition number of the system matrix S of (6.17) (the thesis' Figs. 5.5 and 7.x).
+//! Condition number of the system matrix S of (6.17) (Valverde 2018, Figs. 5.5 and 7.x).
 
 use super::sixvec::M6;
 use super::system::{solve_system, Solver};

@@ -1,4 +1,4 @@
-//! The decoupled Newton–Euler formulation of seed 003, §5.1 (after Stoneking [94]; digest §1.2), generalised
+//! The decoupled Newton–Euler formulation of Valverde 2018, §5.1 (after Stoneking [94]), generalised
 //! from the chapter-5 chain to trees: per body the CoM-frame Newton and Euler equations (5.1)–(5.8) with the
 //! rotations the thesis leaves implicit made explicit; per joint the "joint-point accelerations are equal"
 //! linear constraint (5.20) and the angular constraint (5.29)/(5.33) projected off the joint axis. Plain

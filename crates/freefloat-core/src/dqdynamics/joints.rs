@@ -1,7 +1,7 @@
-//! Per-joint selectors of the dual-quaternion formulation (seed 003, Tables 6.2–6.4), for the engine's
+//! Per-joint selectors of the dual-quaternion formulation (Valverde 2018, Tables 6.2–6.4), for the engine's
 //! joint types. Inside `dqdynamics` twists and wrenches are 6-vectors holding the vector slots of the
 //! dual quaternion: twist `[ω; v]` (real; dual), wrench `[f; τ]` (real; dual). The scalar slots 1 and 5 of
-//! the 8-vector are always zero and are dropped (digest §2.5, "acceptable simplification").
+//! the 8-vector are always zero for twists and wrenches, so dropping them loses nothing.
 //!
 //! Each joint j has a frame J_j fixed to its child body, with its origin at the child body frame's origin
 //! and its z-axis along the revolute/prismatic axis (the thesis puts the DOF on Z_i, §2.1). Slot indices:

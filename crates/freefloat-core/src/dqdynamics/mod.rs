@@ -1,4 +1,4 @@
-//! Dual-quaternion multibody dynamics (seed 003, Ch. 5–6): accelerations and every joint's reaction wrench
+//! Dual-quaternion multibody dynamics (Valverde 2018, Ch. 5–6): accelerations and every joint's reaction wrench
 //! from one linear system solved through the Schur complement of the body block. Cross-checked against the
 //! engine's ABA (accelerations) and RNEA (transmitted wrenches) in tests/dqdynamics.rs.
 

@@ -9,7 +9,7 @@ use nalgebra::Matrix6;
 pub type M6 = Matrix6<f64>;
 
 /// The 6×6 restriction of an 8×8 sandwich matrix to the vector slots (1..4, 5..8) — exact for unit q,
-/// which maps vector dual quaternions to vector dual quaternions. The thesis' form; kept as the reference
+/// which maps vector dual quaternions to vector dual quaternions. Valverde 2018's form; kept as the reference
 /// the closed forms below are tested against.
 pub fn reduce(m: &crate::dualquat::M8) -> M6 {
     const IDX: [usize; 6] = [1, 2, 3, 5, 6, 7];

@@ -1,11 +1,12 @@
-//! Assembly and solution of the dual-quaternion Newton–Euler system (seed 003, §6.3, (6.17)–(6.27)).
+//! Assembly and solution of the dual-quaternion Newton–Euler system (Valverde 2018, §6.3, (6.17)–(6.27)).
 //!
 //! Unknowns: every body's CoM-frame twist rate `ẏ_i` and every joint's reduced reaction `W̃_j`. With
 //! `G_ij` the map from joint j's reduced wrench to the wrench on body i at its CoM (6.20), the body rows are
 //! `M_i (ẏ_i)^s = B1_i + Σ_j G_ij W̃_j` ((2.56) with (6.22)) and the joint rows (6.16) are
-//! `Σ_i G_ijᵀ (ẏ_i)^s = B2_j`; we take the constraint selector `Λ_j = V_jᵀ P_swap` (the symmetric variant,
-//! digest §2.5), which makes `S21 = G_physᵀ P_swap` because `Ad_inᵀ P_swap = P_swap Ad_out` (power is frame
-//! invariant). Eliminating `ẏ` (Schur complement on S11, (6.24)–(6.27)) leaves
+//! `Σ_i G_ijᵀ (ẏ_i)^s = B2_j`; we take the constraint selector `Λ_j = V_jᵀ P_swap` (the symmetric variant:
+//! as assembled, (6.21)'s `S21 S11⁻¹ S12` is not symmetric), which makes `S21 = G_physᵀ P_swap` because
+//! `Ad_inᵀ P_swap = P_swap Ad_out` (power is frame invariant). Eliminating `ẏ` (Schur complement on S11,
+//! (6.24)–(6.27)) leaves
 //!   `K W̃ = B2 − Σ_i G_iᵀ M_i⁻¹ B1_i`,  `K = Σ_i G_iᵀ M_i⁻¹ G_i = −S21 S11⁻¹ S12`,
 //! K symmetric positive definite (the Delassus matrix), solved by Cholesky. K has a block for every pair of
 //! joints sharing a body; eliminating joints from the leaves up creates no fill-in (the joint graph of a
@@ -74,7 +75,11 @@ pub fn dq_dynamics_with<'d>(
     Ok(&d.dq.out)
 }
 
-/// Hybrid dynamics in the dual-quaternion formulation (§6.4 with the corrected recipe of digest §2.6): the
+/// Hybrid dynamics in the dual-quaternion formulation (§6.4, corrected: the printed
+/// recipe deletes the prescribed joint's distal body from the unknowns without substituting its
+/// acceleration (6.31), which drops that body's inertia and ignores the prescribed acceleration in the joint's
+/// constraint rows; here a prescribed joint constrains all six slots, its prescribed acceleration enters B2,
+/// and its actuation is the actuated part of that six-slot reaction, see docs/architecture.md): the
 /// joints flagged in `prescribed` (per body) follow the accelerations `ddq` (their entries of the nv-vector),
 /// the others respond to `tau`; `locked_forces` returns what the prescribed joints need. The engine's
 /// `hybrid_aba` with the same arguments gives the same result. Checks every argument; allocates nothing.

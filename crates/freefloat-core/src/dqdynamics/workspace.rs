@@ -58,7 +58,7 @@ impl DqDynamics {
     }
 }
 
-/// One joint's rows of the dual-quaternion system (seed 003, (6.13)–(6.23)).
+/// One joint's rows of the dual-quaternion system (Valverde 2018, (6.13)–(6.23)).
 #[derive(Clone, Debug)]
 pub(super) struct Joint {
     pub(super) body: usize,

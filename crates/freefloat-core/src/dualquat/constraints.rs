@@ -1,11 +1,11 @@
-//! The convex pose constraints of seed 003, §3.4 (after [112]), as functions usable by controllers: each
+//! The convex pose constraints of Valverde 2018, §3.4 (after [112]), as functions usable by controllers: each
 //! returns `g(q)` with `g ≤ 0` feasible, and its gradient with respect to the 8-vector of q.
 //!
-//! Sign of Proposition 1 (digest §10.11, checked in tests/dualquat_kinematics.rs): with the thesis' own
-//! pose convention `q_{G/A}∘(M_H ⋆ q_{G/A}) = r^G_{G/A}·ŷ^G = −r^G_{A/G}·ŷ^G`, so the printed (3.35)
-//! `−q∘(M_H q) + 2‖E_d q‖cos θ ≤ 0` encodes `r^G_{G/A}·ŷ ≥ ‖r‖cos θ`, i.e. the target *behind* the
-//! gripper. We implement the physical statement (3.34), the target A inside the cone about ŷ^G seen from
-//! G: `+q∘(M_H q) + 2‖E_d q‖cos θ ≤ 0`. Propositions 2 and 3 are sign-consistent as printed.
+//! Sign of Proposition 1 (a correction of the printed (3.35), checked in tests/dualquat_kinematics.rs): with the
+//! thesis' own pose convention `q_{G/A}∘(M_H ⋆ q_{G/A}) = r^G_{G/A}·ŷ^G = −r^G_{A/G}·ŷ^G`, so the printed (3.35)
+//! `−q∘(M_H q) + 2‖E_d q‖cos θ ≤ 0` encodes `r^G_{G/A}·ŷ ≥ ‖r‖cos θ`, i.e. the target *behind* the gripper. We
+//! implement the physical statement (3.34), the target A inside the cone about ŷ^G seen from G:
+//! `+q∘(M_H q) + 2‖E_d q‖cos θ ≤ 0`. Propositions 2 and 3 are sign-consistent as printed.
 
 use super::dual_quaternion::{DualQuat, M8, V8};
 use super::quaternion::Quat;
@@ -45,7 +45,8 @@ pub fn line_of_sight_matrix(y_g: &V3) -> M8 {
 pub fn approach_slope_matrix(z_a: &V3) -> M8 {
     off_diagonal(&Quat::pure(z_a).left_matrix())
 }
-/// M_A of Prop. 3 (3.42), read with n̂ for the printed ẑ (digest §10.12): `[[ [[n^I]]_L [[n^B]]_R, 0], [0, 0]]`.
+/// M_A of Prop. 3 (3.42), read with n̂ for the printed ẑ (the constraint (3.40) uses n̂):
+/// `[[ [[n^I]]_L [[n^B]]_R, 0], [0, 0]]`.
 pub fn attitude_matrix(n_i: &V3, n_b: &V3) -> M8 {
     let mut m = M8::zeros();
     m.fixed_view_mut::<4, 4>(0, 0).copy_from(&(Quat::pure(n_i).left_matrix() * Quat::pure(n_b).right_matrix()));

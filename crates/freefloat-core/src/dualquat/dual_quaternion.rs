@@ -1,5 +1,5 @@
 //! Dual quaternions `q_r + ε q_d` (ε² = 0) stored as the 8-vector `[real (w,x,y,z), dual (w,x,y,z)]`:
-//! the operations of seed 003, Tables 2.4 and 2.5, the 8×8 product matrices (2.27)–(2.29), the
+//! the operations of Valverde 2018, Tables 2.4 and 2.5, the 8×8 product matrices (2.27)–(2.29), the
 //! normalisation (2.30) and properisation (2.31).
 
 use super::quaternion::{Quat, M4};
@@ -12,7 +12,7 @@ pub type V8 = SVector<f64, 8>;
 /// 8×8 matrix on dual quaternions (product and sandwich matrices).
 pub type M8 = SMatrix<f64, 8, 8>;
 
-/// `r + ε d`. Twists are stored `ω + ε v` and wrenches `f + ε τ` (seed 003, (2.36), (2.39)).
+/// `r + ε d`. Twists are stored `ω + ε v` and wrenches `f + ε τ` (the thesis, (2.36), (2.39)).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct DualQuat {
     /// Real part.
@@ -26,7 +26,7 @@ pub struct DualQuat {
 pub const UNIT_TOL: f64 = 1e-9;
 
 impl DualQuat {
-    /// `1 := 1 + ε0` (seed 003, §2.3 constants).
+    /// `1 := 1 + ε0` (the thesis, §2.3 constants).
     pub const ONE: DualQuat = DualQuat { r: Quat::ONE, d: Quat::ZERO };
     /// `0 + ε0`.
     pub const ZERO: DualQuat = DualQuat { r: Quat::ZERO, d: Quat::ZERO };
@@ -120,25 +120,26 @@ impl DualQuat {
     pub fn scale(&self, s: f64) -> DualQuat {
         DualQuat { r: self.r.scale(s), d: self.d.scale(s) }
     }
-    /// Inverse of a general dual quaternion with invertible real part (not in the thesis, digest §3):
+    /// Inverse of a general dual quaternion with invertible real part (not in the thesis):
     /// `q⁻¹ = q_r⁻¹ − ε q_r⁻¹ q_d q_r⁻¹`. `None` when `q_r = 0` (a dual number with zero real part has no
-    /// inverse; the thesis' "x ≠ 0" is a typo, digest §10.2). For a unit dual quaternion this is `q*`.
+    /// inverse; the thesis' "no inverse exists if x ≠ 0" is a typo for x = 0). For a unit dual quaternion this is `q*`.
     pub fn inverse(&self) -> Option<DualQuat> {
         let ri = self.r.inverse()?;
         Some(DualQuat { r: ri, d: -ri.mul(&self.d).mul(&ri) })
     }
-    /// `q q* − 1`, the defect of the unit constraints `q_r·q_r = 1`, `q_r·q_d = 0` (seed 003, §2.3).
+    /// `q q* − 1`, the defect of the unit constraints `q_r·q_r = 1`, `q_r·q_d = 0` (the thesis, §2.3).
     pub fn unit_defect(&self) -> f64 {
         let e = self.mul(&self.conj()) - DualQuat::ONE;
         e.to_vec8().amax()
     }
-    /// Unit dual quaternion: `q q* = 1` within `UNIT_TOL` (not `‖q‖ = 1`, digest §10.18).
+    /// Unit dual quaternion: `q q* = 1` within `UNIT_TOL` (not `‖q‖ = 1`: a unit pose has
+    /// `‖q‖² = 1 + ‖r‖²/4`, Lemma 7).
     pub fn is_unit(&self) -> bool {
         self.unit_defect() <= UNIT_TOL
     }
     /// Normalisation (2.30): `q_r ← q_r/‖q_r‖`, `q_d ← (I − q_r q_rᵀ) q_d` (the projection removes the
     /// component of q_d along q_r, so `q_r·q_d = 0`). As in the thesis q_d is not rescaled, so the
-    /// translation `2 q_d q_r*` picks up the factor ‖q_r‖_old (digest §10.6). `None` if `q_r = 0`.
+    /// translation `2 q_d q_r*` picks up the factor ‖q_r‖_old (negligible for small drift). `None` if `q_r = 0`.
     pub fn normalized(&self) -> Option<DualQuat> {
         let n = self.r.norm();
         if !(n > 0.0) || !n.is_finite() {
@@ -196,7 +197,7 @@ fn block_lower(a: &M4, b: &M4) -> M8 {
     m
 }
 
-/// The 8×8 permutation of the swap: `P_swap x = x^s` (digest §0.5).
+/// The 8×8 permutation of the swap: `P_swap x = x^s`, i.e. `[[0, I₄], [I₄, 0]]`, so that `H(M) = M P_swap`.
 pub fn swap_matrix() -> M8 {
     let mut p = M8::zeros();
     for k in 0..4 {

@@ -1,5 +1,5 @@
 //! Dual inertia, dual momentum, kinetic energy and the rigid-body Newton–Euler equations in dual-quaternion
-//! form (seed 003, §2.3.2, (2.45)–(2.57)). Every quantity is about the centre of mass, in body axes.
+//! form (Valverde 2018, §2.3.2, (2.45)–(2.57)). Every quantity is about the centre of mass, in body axes.
 
 use super::dual_quaternion::{swap_matrix, DualQuat, M8};
 use super::quaternion::Quat;

@@ -1,6 +1,6 @@
-//! Forward kinematics in dual-quaternion form (seed 003, Ch. 3): the chain product of relative poses
+//! Forward kinematics in dual-quaternion form (Valverde 2018, Ch. 3): the chain product of relative poses
 //! ((3.43)/(3.61)), the product of exponentials (3.19) and standard Denavit–Hartenberg ((3.20)–(3.29) with
-//! the missing ½ restored, digest §10.9). Both model-based routines reproduce the engine's
+//! the ½ that the printed (3.20)–(3.21) drop restored; (3.26) has it). Both model-based routines reproduce the engine's
 //! `kinematics::forward_kinematics` (tests/dualquat_kinematics.rs).
 
 use super::dual_quaternion::DualQuat;
@@ -11,9 +11,10 @@ use crate::error::{FfError, Result};
 use crate::model::{JointType, Model};
 use crate::spatial::V3;
 
-/// Relative pose of a joint's child frame in its rest frame, `q_{i/i0}(Γ)` (digest §2.2 table), for the
-/// engine's joint coordinates `q` (length nq). Quaternions are used as given (normalise them first).
-/// `axis2` is a universal joint's second axis (ignored by the other joints).
+/// Relative pose of a joint's child frame in its rest frame, `q_{i/i0}(Γ)` (the thesis uses it in §6.2 but never writes
+/// it out; per joint type it is the rotation and/or translation of the joint coordinates along/about the joint axis),
+/// for the engine's joint coordinates `q` (length nq). Quaternions are used as given (normalise them first). `axis2` is
+/// a universal joint's second axis (ignored by the other joints).
 pub fn joint_pose(kind: JointType, axis: &V3, axis2: &V3, q: &[f64]) -> Result<DualQuat> {
     if q.len() != kind.nq() {
         return Err(FfError::arg(
@@ -93,7 +94,7 @@ impl ProductOfExponentials {
         Ok(match m.joint_types[i] {
             // m = p × ℓ (3.7), d = 0 for a revolute joint.
             JointType::Revolute => screw_exp(qi[0], 0.0, &self.axes[i], &p.cross(&self.axes[i])),
-            // θ = 0: exp(½ d (0 + ε ℓ)) (digest §5); the moment does not enter.
+            // θ = 0: exp(½ d (0 + ε ℓ)), the thesis' prismatic dual angle 0 + ε d; the moment does not enter.
             JointType::Prismatic => screw_exp(0.0, qi[0], &self.axes[i], &V3::zeros()),
             // a general screw (3.10): rotation θ and translation d along the same line
             JointType::Cylindrical => screw_exp(qi[0], qi[1], &self.axes[i], &p.cross(&self.axes[i])),
@@ -171,7 +172,7 @@ pub fn dh(d: f64, theta: f64, a: f64, alpha: f64) -> DualQuat {
 }
 
 /// The same transform as the product of the four elementary motions (3.20)–(3.25), with the factor ½ the
-/// printed (3.20)–(3.21) drop (digest §10.9).
+/// printed (3.20)–(3.21) drop (they print `1 + ε r` for `1 + ε½ r`; without it they do not reproduce (3.26)).
 pub fn dh_product(d: f64, theta: f64, a: f64, alpha: f64) -> DualQuat {
     translation(&V3::new(0.0, 0.0, d))
         .mul(&rotation(&Quat::from_axis_angle(&V3::z(), theta)))
@@ -189,10 +190,11 @@ pub fn dh_chain(rows: &[[f64; 4]]) -> DualQuat {
     rows.iter().fold(DualQuat::ONE, |acc, r| acc.mul(&dh(r[0], r[1], r[2], r[3])))
 }
 
-/// Body Jacobian of a serial chain in the form of (3.57)–(3.60) (corrected, digest §10.13):
-/// `ω^e_{e/I} = Σ_k Ad_{(q_{k+1/k} ⋯ q_{e/n})*} ξ_k α̇_k`. `rel = [q_{1/I}, q_{2/1}, …, q_{e/n}]` are the
-/// relative poses (n + 1 of them) and `screws[k]` is joint k's unit twist ξ_k in the frame it moves
-/// (Table 3.1). Returns the n columns (8-vectors, `[real; dual]`).
+/// Body Jacobian of a serial chain in the form of (3.57)–(3.60) (corrected: the printed (3.55) misses a dot on its
+/// third term and (3.57) has `q_{e/I}`, `q_{2/I}` where `q_{e/2}`, `q_{2/1}` are meant):
+/// `ω^e_{e/I} = Σ_k Ad_{(q_{k+1/k} ⋯ q_{e/n})*} ξ_k α̇_k`. `rel = [q_{1/I}, q_{2/1}, …, q_{e/n}]` are the relative
+/// poses (n + 1 of them) and `screws[k]` is joint k's unit twist ξ_k in the frame it moves (Table 3.1). Returns the n
+/// columns (8-vectors, `[real; dual]`).
 pub fn serial_body_jacobian(rel: &[DualQuat], screws: &[DualQuat]) -> Result<Vec<DualQuat>> {
     if rel.len() != screws.len() + 1 {
         return Err(FfError::arg(

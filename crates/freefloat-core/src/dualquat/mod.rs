@@ -1,11 +1,11 @@
-//! Dual-quaternion toolkit (seed 003, Ch. 2–3): quaternions, dual quaternions, poses, screws, twists and
+//! Dual-quaternion toolkit (Valverde 2018, Ch. 2–3): quaternions, dual quaternions, poses, screws, twists and
 //! wrenches, dual inertia and Newton–Euler, forward kinematics and the convex pose constraints.
 //!
 //! Inside this module dual quaternions are 8-vectors `[real (w,x,y,z), dual (w,x,y,z)]` (the thesis'
 //! order, (3.26)); the engine's `(x, y, z, w)` quaternions and `Se3` placements are converted at the edges
 //! (`Quat::from_xyzw`, `DualQuat::from_se3`, `from_pose_xyzw`). A twist is `ω + ε v`, a wrench `f + ε τ`;
 //! the engine's `Motion`/`Force` are `[linear; angular]`, converted by `pose::twist_from_motion` etc.
-//! Unit-ness means `q q* = 1`, never `‖q‖ = 1` (digest §10.18).
+//! Unit-ness means `q q* = 1`, never `‖q‖ = 1` (a unit pose has `‖q‖² = 1 + ‖r‖²/4`).
 
 pub mod constraints;
 mod dual_quaternion;

@@ -1,4 +1,4 @@
-//! External dual forces on an Earth-orbiting body (seed 003, §2.3.3, (2.61)–(2.68)) and the relative pose
+//! External dual forces on an Earth-orbiting body (Valverde 2018, §2.3.3, (2.61)–(2.68)) and the relative pose
 //! (error) dynamics (2.58). All wrenches are `f + ετ` about the body's CoM in body coordinates. Units are the
 //! caller's: with `MU_EARTH` in km³/s², positions are in km.
 
@@ -6,7 +6,7 @@ use super::dual_quaternion::DualQuat;
 use super::inertia::DualInertia;
 use crate::spatial::V3;
 
-/// Earth's gravitational parameter μ [km³/s²] (seed 003, after (2.62)).
+/// Earth's gravitational parameter μ [km³/s²] (the thesis, after (2.62)).
 pub const MU_EARTH: f64 = 398600.4418;
 /// Earth's J2 coefficient and equatorial radius [km] (after (2.64)).
 pub const J2_EARTH: f64 = 0.0010826267;

@@ -1,4 +1,4 @@
-//! Poses as unit dual quaternions (seed 003, §3.1, (3.1)–(3.4)), conversions to the engine's `Se3` and
+//! Poses as unit dual quaternions (Valverde 2018, §3.1, (3.1)–(3.4)), conversions to the engine's `Se3` and
 //! `(x, y, z, w)` quaternions, and the shifting laws of twists and wrenches ((2.41)–(2.44)).
 //!
 //! `q_{B/A} = q + ε ½ r^A q` (translation first, (3.2)) is the pose of frame B in frame A: rotation
@@ -72,7 +72,7 @@ impl DualQuat {
     }
 }
 
-/// Check user input: finite and unit (`q q* = 1`, digest §10.18), naming the argument otherwise.
+/// Check user input: finite and unit (`q q* = 1`, not the 8-norm), naming the argument otherwise.
 pub fn checked_pose(name: &str, q: &DualQuat) -> Result<DualQuat> {
     if !q.is_finite() {
         return Err(FfError::arg(name, "has non-finite entries"));

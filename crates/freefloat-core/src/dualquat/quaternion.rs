@@ -1,4 +1,4 @@
-//! Hamilton quaternions stored scalar-first `(w, x, y, z)`: the operations of seed 003, Table 2.2, and the
+//! Hamilton quaternions stored scalar-first `(w, x, y, z)`: the operations of Valverde 2018, Table 2.2, and the
 //! 4×4 product matrices (2.10)–(2.12).
 //!
 //! The engine stores quaternions `(x, y, z, w)`; `from_xyzw` / `to_xyzw` are the only crossing points.
@@ -12,7 +12,7 @@ pub type M4 = Matrix4<f64>;
 /// A quaternion as a 4-vector `(w, x, y, z)`.
 pub type V4 = Vector4<f64>;
 
-/// A quaternion `w + x i + y j + z k` with `i² = j² = k² = ijk = −1` (seed 003, §2.2, Table 2.1).
+/// A quaternion `w + x i + y j + z k` with `i² = j² = k² = ijk = −1` (the thesis, §2.2, Table 2.1).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Quat {
     /// Scalar part.
@@ -32,7 +32,7 @@ impl Quat {
     pub fn new(w: f64, x: f64, y: f64, z: f64) -> Quat {
         Quat { w, v: V3::new(x, y, z) }
     }
-    /// The vector quaternion `(0, s̄)` of a 3-vector (seed 003, §2.2 "vector quaternions").
+    /// The vector quaternion `(0, s̄)` of a 3-vector (the thesis, §2.2 "vector quaternions").
     #[inline]
     pub fn pure(s: &V3) -> Quat {
         Quat { w: 0.0, v: *s }
@@ -57,8 +57,8 @@ impl Quat {
     pub fn to_xyzw(&self) -> [f64; 4] {
         [self.v.x, self.v.y, self.v.z, self.w]
     }
-    /// Rotation by `angle` about the unit `axis`: `(cos θ/2, n̄ sin θ/2)` (seed 003, §2.2; the printed
-    /// `cos(φ/2)` is a typo, digest §10.1).
+    /// Rotation by `angle` about the unit `axis`: `(cos θ/2, n̄ sin θ/2)` (the thesis, §2.2; the printed
+    /// `(cos(φ/2), n̄ sin(θ/2))` is a typo for θ).
     pub fn from_axis_angle(axis: &V3, angle: f64) -> Quat {
         let (s, c) = (0.5 * angle).sin_cos();
         Quat { w: c, v: axis * s }
@@ -68,7 +68,7 @@ impl Quat {
         Quat::from_xyzw(&crate::spatial::quat_from_rot(r))
     }
     /// The active rotation matrix `C(q) = (q₀² − |q̄|²) I + 2 q̄ q̄ᵀ + 2 q₀ [q̄]ˣ` of a unit quaternion
-    /// (digest §0), so `C(q) v̄ = vec(q v q*)`.
+    /// (Hamilton convention, scalar first), so `C(q) v̄ = vec(q v q*)`.
     pub fn rotation_matrix(&self) -> M3 {
         (self.w * self.w - self.v.norm_squared()) * M3::identity()
             + 2.0 * self.v * self.v.transpose()
@@ -129,7 +129,8 @@ impl Quat {
     pub fn scale(&self, s: f64) -> Quat {
         Quat { w: self.w * s, v: self.v * s }
     }
-    /// Rotate a 3-vector: `vec(q (0, v̄) q*)` (coordinate change `s^X = q_{Y/X} s^Y q*_{Y/X}`, digest §0).
+    /// Rotate a 3-vector: `vec(q (0, v̄) q*)` (coordinate change `s^X = q_{Y/X} s^Y q*_{Y/X}`, the thesis' passive
+    /// convention).
     #[inline]
     pub fn rotate(&self, v: &V3) -> V3 {
         self.mul(&Quat::pure(v)).mul(&self.conj()).v

@@ -1,5 +1,5 @@
 //! Exponential and logarithm: `exp` of a vector dual quaternion, the screw exponential of Lemma 5
-//! (seed 003, (3.8)–(3.12)) and its inverse (3.18).
+//! (Valverde 2018, (3.8)–(3.12)) and its inverse (3.18).
 //!
 //! Write the argument `x = a + ε b` (a, b vector quaternions) and `φ = ‖ā‖`. With the dual angle
 //! `φ̂ = φ + ε (ā·b̄)/φ`, `exp(x) = cos φ̂ + x sin(φ̂)/φ̂`; expanding the dual-number functions
@@ -72,7 +72,10 @@ pub fn screw_exp(theta: f64, d: f64, l: &V3, m: &V3) -> DualQuat {
 }
 
 /// Screw parameters of a unit dual quaternion: rotation angle θ ∈ [0, π], translation d along the axis,
-/// unit axis ℓ and moment m (inverse of (3.10); the thesis defers this to [119], digest §5 gives it).
+/// unit axis ℓ and moment m (inverse of (3.10); the thesis defers this to its reference [119], so the formulas here are
+/// derived: `θ = 2 atan2(‖q̄_r‖, q_r0)`, `ℓ = q̄_r / sin(θ/2)`, `d = −2 q_d0 / sin(θ/2)`,
+/// `m = (q̄_d − ½ d ℓ cos(θ/2)) / sin(θ/2)`; for θ = 0 the axis is the translation's direction, ẑ if there is none, and
+/// m = 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Screw {
     /// Rotation angle about the screw axis (rad).

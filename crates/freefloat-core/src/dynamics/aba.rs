@@ -82,7 +82,7 @@ pub(crate) fn hybrid_aba_unchecked(
         };
         d.ov[i] = vi;
         // d/dt(oS q̇) = v × (oS q̇) + o(Ṡ q̇); the second term is non-zero for universal joints only, so the
-        // others skip its frame change (measured: ~8 % of ABA on the seed 001 robot).
+        // others skip its frame change (measured: ~8 % of ABA on `naveen_dual_arm`).
         d.oc[i] = vi.cross_motion(&vj);
         if m.joint_types[i] == JointType::Universal {
             let bias = omi.act_motion(&joint_bias(m, d, i, v));

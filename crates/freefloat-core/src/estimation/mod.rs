@@ -1,7 +1,7 @@
-//! Recursive estimators for online identification (seed 000): [`Rls`] (ordinary RLS with
+//! Recursive estimators for online identification (Zhang, Yue, Yuan 2020): [`Rls`] (ordinary RLS with
 //! forgetting) and [`ModifiedRls`] (the paper's one-step mass/CoM + inertia recursion, eqs. 34-38).
 //!
-//! Batch least squares for inertial-parameter identification (seed 001 §A.9, eqs. 26–27), without
+//! Batch least squares for inertial-parameter identification (Naveen, Shah, Misra, eqs. 26–27), without
 //! ever forming the tall regressor `G_m` (6N × n).
 //!
 //! Two accumulators, both fed blocks of rows and merged across threads:

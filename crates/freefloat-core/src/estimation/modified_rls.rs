@@ -1,4 +1,4 @@
-//! Seed 000's modified RLS (eqs. 34-38; digest §6): mass/CoM and inertia of two bodies in one step.
+//! The modified RLS of Zhang, Yue, Yuan 2020 (eqs. 34-38): mass/CoM and inertia of two bodies in one step.
 //!
 //! The identification splits into
 //! - `A μ = b` (eq. 34), linear in `μ = [m_1, m_1 b'_1, m_n, m_n b'_n]`, and
@@ -15,7 +15,8 @@ use super::rls::full_covariance;
 use super::rls_kernel::{check_finite, check_len, check_time, row_update};
 use crate::error::{FfError, Result};
 
-/// How `D(μ)` is built from μ (digest §4.2, eq. 23 and its planar reduction).
+/// How `D(μ)` is built from μ (eq. 23, `m J(b') = [m, m b', m·mono(b')]` with the six monomials
+/// `b_x², b_x b_y, b_x b_z, b_y², b_y b_z, b_z²`, or its planar reduction `[m, m b', m (b_x² + b_y²)]`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Coupling {
     /// 3D: per body `m J(b') = [m, m b' (3), m·(bx², bx by, bx bz, by², by bz, bz²)]`, 10 entries;
@@ -42,7 +43,7 @@ impl Coupling {
         }
     }
 
-    /// D(μ) for the two bodies (seed 000, eq. 23): `m J(b')` with `b' = (m b')/m`, i.e. the
+    /// D(μ) for the two bodies (Zhang 2020, eq. 23): `m J(b')` with `b' = (m b')/m`, i.e. the
     /// quadratic entries are `(m b')_k (m b')_l / m`. Errors if a mass estimate is not usable.
     pub fn d_of_mu(self, mu: &[f64], out: &mut [f64]) -> Result<()> {
         let (km, kd) = (self.mu_per_body(), self.d_per_body());
@@ -204,7 +205,7 @@ impl ModifiedRls {
         out
     }
 
-    /// Fold in one sample (seed 000, eqs. 36-38). Errors: wrong sizes, NaN/inf, time not after the
+    /// Fold in one sample (Zhang 2020, eqs. 36-38). Errors: wrong sizes, NaN/inf, time not after the
     /// previous sample, a covariance losing positive definiteness or a vanishing mass estimate; after
     /// an error inside the recursion the estimator is marked failed.
     pub fn update(&mut self, s: &CoupledSample) -> Result<()> {
@@ -325,7 +326,8 @@ mod tests {
     }
 
     /// Draw a random coupled problem from a true (m, b', I) and check the recursion against the
-    /// two-step batch least squares with the same priors (digest §6 "why it is exact"):
+    /// two-step batch least squares with the same priors (the batch estimate is affine in D(μ) with slope M(N),
+    /// which is what eq. 38 propagates, so the recursion is exact):
     /// μ_N = ridge LS of (A, b); θ_N = ridge LS of (Φ, y + ψ D(μ_N)).
     fn check_against_batch(coupling: Coupling, n_th: usize, r_mu: usize, r_th: usize) {
         let mut rng = StdRng::seed_from_u64(11);

@@ -1,4 +1,4 @@
-//! Identification from momentum (seed 001 eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
+//! Identification from momentum (Naveen, Shah, Misra, eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
 
 use super::analysis::{check_rank, finish};
 use super::gram::{strided, GramLs};

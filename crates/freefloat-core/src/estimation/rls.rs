@@ -1,8 +1,8 @@
 //! Ordinary recursive least squares with an optional forgetting factor, for problems that are exactly
-//! linear in the unknowns: `Φ_N θ = y_N + e`. In freefloat it solves seed 000's identification
-//! written in standard parameters (digest §7): `[m, m b', I about the reference point]` of the base
-//! and of the target enter the momentum and Newton-Euler equations linearly, so no second-order
-//! term (the paper's `D(μ)`) has to be handled.
+//! linear in the unknowns: `Φ_N θ = y_N + e`. In freefloat it solves the identification of Zhang, Yue, Yuan
+//! 2020 written in standard parameters (docs/postcapture.md, "The two solvers"):
+//! `[m, m b', I about the reference point]` of the base and of the target enter the momentum and Newton-Euler equations
+//! linearly, so no second-order term (the paper's `D(μ)`) has to be handled.
 //!
 //! Cost per sample: O(r n²) for r rows and n unknowns, independent of how many samples came before.
 //! Without forgetting the estimate after N samples is the ridge-regularised batch LS

@@ -85,7 +85,7 @@ fn row_update_n(n: usize, p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64,
     Ok(())
 }
 
-/// Dispatch to a constant-size copy for the sizes of the seed 000 problems (2D/3D, paper and
+/// Dispatch to a constant-size copy for the sizes of the Zhang, Yue, Yuan 2020 problems (2D/3D, paper and
 /// standard forms); any other size runs the same code with a run-time bound.
 #[inline(always)]
 fn row_update_sized(p: &mut [f64], theta: &mut [f64], phi: &[f64], y: f64, u: &mut [f64]) -> Result<()> {

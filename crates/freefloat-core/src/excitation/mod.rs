@@ -1,4 +1,4 @@
-//! Exciting-trajectory design (seed 001, Sec. V): the numbers the design loop needs, fast.
+//! Exciting-trajectory design (Naveen, Shah, Misra, Sec. V): the numbers the design loop needs, fast.
 //!
 //! The design optimises joint trajectories of a free-floating robot so that the momentum regressor of the
 //! minimal parameters is well conditioned (eq. 32). Evaluating a candidate needs the base motion it causes,

@@ -1,4 +1,4 @@
-//! Objective of the exciting-trajectory design, seed 001 eq. (32):
+//! Objective of the exciting-trajectory design, Naveen, Shah, Misra, eq. (32):
 //!     C = κ(G_m) + w · N_l N_m / Σ_i Σ_j h_ij²
 //! κ is the 2-norm condition number of the stacked minimal regressor, obtained from the eigenvalues of its
 //! small Gram matrix (n_min × n_min) rather than an SVD of the tall matrix; h ranges over the base twist
@@ -79,7 +79,7 @@ pub fn evaluate_batch(m: &Model, spec: &ObjectiveSpec, paths: &[JointPath], thre
 
 /// GᵀG summed over the row blocks, each block's product in parallel: nalgebra hands `Bᵀ · B` of dynamic
 /// matrices to a blocked kernel (matrixmultiply), faster than `gemm_tr`'s column dot products at this size,
-/// and it is the largest cost of an evaluation (7680 × 52 for the seed 001 design).
+/// and it is the largest cost of an evaluation (7680 × 52 for the paper's design).
 fn gram(blocks: &[DMatrix<f64>], n: usize) -> DMatrix<f64> {
     std::thread::scope(|s| {
         let parts: Vec<_> = blocks.iter().map(|b| s.spawn(move || b.transpose() * b)).collect();

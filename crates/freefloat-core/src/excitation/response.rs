@@ -61,10 +61,10 @@ impl JointPath<'_> {
     }
 }
 
-/// Base twist `[v; ω]` in the base frame that keeps the total momentum zero (seed 001 digest A.10 with
-/// h = 0), by the engine's one momentum solve `kinematics::base_twist_for_momentum`. Zero momentum is zero in
-/// every frame, so `q`'s base pose is irrelevant; it is evaluated at the identity (`q` is used as scratch),
-/// which leaves in `d` the joint-only twists `place_base` needs.
+/// Base twist `[v; ω]` in the base frame that keeps the total momentum zero (Naveen, Shah, Misra's
+/// `[v_0; ω_0] = H_b⁻¹ (h − H_q q̇)` with h = 0), by the engine's one momentum solve
+/// `kinematics::base_twist_for_momentum`. Zero momentum is zero in every frame, so `q`'s base pose is irrelevant; it is
+/// evaluated at the identity (`q` is used as scratch), which leaves in `d` the joint-only twists `place_base` needs.
 pub fn base_twist_zero_momentum(m: &Model, d: &mut Data, q: &mut [f64], v: &mut [f64]) -> Result<Vector6<f64>> {
     if m.joint_types.first() != Some(&JointType::Free) {
         return Err(FfError::arg("model", "the zero-momentum base twist needs a free-floating base"));
@@ -100,7 +100,7 @@ pub struct ExcitationRows {
 /// Integrate the base pose along `path` (starting at `q0`'s base pose, every other joint at `q0`'s value)
 /// with the zero-momentum base twist, and stack the momentum-regressor `columns` at grid points
 /// `offset, offset + stride, …`. The signal sums the base twist and the rates of the first `n_signal` driven
-/// joints (the designed ones: seed 001's wheels follow fixed seeds and would swamp it).
+/// joints (the designed ones: Naveen et al.'s wheels follow fixed seeds and would swamp it).
 ///
 /// Integration is the trapezoidal rule on the group between grid points: the attitude advances by
 /// `exp(h (ω_i + ω_{i+1}) / 2)` and the position by `h (R_i v_i + R_{i+1} v_{i+1}) / 2` (second order;

@@ -1,6 +1,7 @@
 //! The base twist of a free-floating robot that gives a stated total momentum: the base block of the
 //! momentum equation `A_b v_b + A_m q̇_m = h` solved for `v_b` (Naveen, Shah, Misra's momentum model;
-//! the base part of Umetani-Yoshida's generalized Jacobian; seed 001's digest A.10 with h = 0).
+//! the base part of Umetani-Yoshida's generalized Jacobian; with h = 0 it is the base twist
+//! `[v_0; ω_0] = H_b⁻¹ (h − H_q q̇)` that Naveen et al. use for prediction, Sec. VI.D).
 //!
 //! This is the one copy of that formula: the exciting-trajectory design (`excitation::response`), the
 //! generalized Jacobian (`kinematics::jacobian`) and, through the binding, Python's zero-momentum driven
@@ -144,7 +145,7 @@ mod tests {
     #[test]
     fn momentum_of_the_solved_state_is_the_requested_one() {
         let mut seed = 7u64;
-        for name in ["seed001_dual_arm", "seed000_3d", "seed000_2d_medium", "thesis_ch7_two_arm"] {
+        for name in ["naveen_dual_arm", "zhang2020_3d", "zhang2020_2d_medium", "valverde_ch7_two_arm"] {
             let m = builtin(name).unwrap();
             let mut d = Data::new(&m);
             let nb = m.nvs[0];
@@ -170,7 +171,7 @@ mod tests {
     #[test]
     fn matches_the_centroidal_momentum_matrix_solve() {
         let mut seed = 11u64;
-        let m = builtin("seed001_dual_arm").unwrap();
+        let m = builtin("naveen_dual_arm").unwrap();
         let mut d = Data::new(&m);
         for _ in 0..10 {
             let (q, rates) = random_state(&m, &mut seed);
@@ -190,7 +191,7 @@ mod tests {
 
     #[test]
     fn bad_arguments_are_errors() {
-        let m = builtin("seed001_dual_arm").unwrap();
+        let m = builtin("naveen_dual_arm").unwrap();
         let mut d = Data::new(&m);
         let (q, rates) = random_state(&m, &mut 3u64);
         assert!(base_twist_for_momentum(&m, &mut d, &q[1..], &rates, &[0.0; 6]).is_err());

@@ -51,7 +51,7 @@ pub struct BodySpec {
     /// Free-form tags (e.g. `base`, `wheel`, `target`, `nonphysical`).
     pub tags: Vec<String>,
     /// Skip the physical-consistency check for this body (published data that is itself
-    /// inconsistent, e.g. seed 001's Table 2). Finite values and mass ≥ 0 are still required.
+    /// inconsistent, e.g. Naveen, Shah, Misra's Table 2). Finite values and mass ≥ 0 are still required.
     pub allow_nonphysical: bool,
 }
 

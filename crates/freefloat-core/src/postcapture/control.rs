@@ -1,4 +1,4 @@
-//! The paper's controllers (seed 000, eqs. 39-40) as a generalized-force law for the whole robot.
+//! The paper's controllers (Zhang, Yue, Yuan 2020, eqs. 39-40) as a generalized-force law for the whole robot.
 
 use crate::data::Data;
 use crate::dynamics::{crba_unchecked, rnea_unchecked};
@@ -8,11 +8,11 @@ use crate::model::{JointType, Model};
 use crate::spatial::{rot_from_quat, so3_log, M3, V3};
 use nalgebra::{DMatrix, DVector};
 
-/// Seed 000, eq. (40) per component: `−max` if `K x ≤ −max`, `K x` in between, `+max` above.
+/// Zhang 2020, eq. (40) per component: `−max` if `K x ≤ −max`, `K x` in between, `+max` above.
 /// The paper writes it with thresholds on x (`P_max`, `L_max`); with its numbers
 /// (|K| x_max = max) both are the same law. For the velocity sweep (F_max = 0.1 N, P_max unchanged)
 /// the printed thresholds would make the law jump from 0.1 N to 10 N at |P| = 10; the clip is the
-/// continuous reading (digest §8, docs/postcapture.md).
+/// continuous reading (docs/postcapture.md, "Corrections to the printed paper").
 #[inline]
 pub fn saturate(gain: f64, x: f64, max: f64) -> f64 {
     (gain * x).clamp(-max, max)
@@ -26,7 +26,8 @@ pub struct PostcaptureControl {
     /// Gain K_F of the thrust law, eq. (40).
     pub k_f: f64,
     /// eq. (40): couple `M = clip(K_M L_G, ±M_max)` per inertial axis, L_G = angular momentum about
-    /// the system CoM (digest §11: about the CoM, so that translation does not feed the couple)
+    /// the system CoM (the paper does not say about which point; our choice is the CoM, so that
+    /// translation does not feed the couple)
     pub m_max: f64,
     /// Gain K_M of the couple law, eq. (40).
     pub k_m: f64,

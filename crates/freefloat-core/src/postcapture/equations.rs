@@ -1,4 +1,4 @@
-//! Seed 000's identification equations (Zhang, Yue, Yuan 2020, "An online one-step method to identify
+//! The identification equations of Zhang, Yue, Yuan 2020 ("An online one-step method to identify
 //! inertial parameters of the base and the target simultaneously for space robots in postcapture", IEEE
 //! Access 8), one regression block per sample, for the base (body 1, reference point = base sensor) and
 //! the captured target (body n, reference point = capture point), the arm links known.
@@ -172,7 +172,7 @@ impl Layout {
         match m.joint_types[0] {
             JointType::Free => Ok(Layout { planar: false }),
             JointType::Planar => Ok(Layout { planar: true }),
-            _ => Err(FfError::arg("model", "seed 000's equations need a free or planar base")),
+            _ => Err(FfError::arg("model", "the post-capture equations need a free or planar base")),
         }
     }
     /// Rows of the linear (momentum/force) equations used.
@@ -287,7 +287,7 @@ impl Measurements<'_> {
     }
 }
 
-/// Seed 000's regression in the modified-RLS form (eqs. 34-35): per sample `A` (nl × nμ), `b` (nl),
+/// Zhang 2020's regression in the modified-RLS form (eqs. 34-35): per sample `A` (nl × nμ), `b` (nl),
 /// `Φ` (na × nθ), `y` (na), `Ψ` (na × nD), all row-major with a leading sample axis.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct PaperRows {

@@ -1,4 +1,4 @@
-//! RK4 simulation of the post-capture scenario (seed 000 §V: RK4, step 10⁻³ s).
+//! RK4 simulation of the post-capture scenario (Zhang, Yue, Yuan 2020, Sec. V: RK4, step 10⁻³ s).
 
 use super::control::{Controller, PostcaptureControl};
 use crate::error::Result;
@@ -48,10 +48,10 @@ mod tests {
     }
 
     /// The arm realises eq. (39) exactly: the base yaw follows the closed-form damped oscillation
-    /// θ(t) = (θ̇0/ω_d) e^{−σt} sin(ω_d t), σ = K_D/2, ω_d = √(K_P − σ²) (digest §8), to RK4 accuracy.
+    /// θ(t) = (θ̇0/ω_d) e^{−σt} sin(ω_d t), σ = K_D/2, ω_d = √(K_P − σ²), to RK4 accuracy.
     #[test]
     fn planar_attitude_follows_eq_39() {
-        let m = crate::model::builtin::load("seed000_2d_medium").unwrap();
+        let m = crate::model::builtin::load("zhang2020_2d_medium").unwrap();
         let d = std::f64::consts::PI / 180.0;
         let q0 = [0.0, 0.0, 0.0, 30.0 * d, 45.0 * d, 45.0 * d];
         let v0 = [1.0, 2.0, 0.1, 0.0, 0.0, 0.0];
@@ -71,7 +71,7 @@ mod tests {
     #[test]
     fn spatial_run_is_stabilised() {
         const T: f64 = 8.0;
-        let m = crate::model::builtin::load("seed000_3d").unwrap();
+        let m = crate::model::builtin::load("zhang2020_3d").unwrap();
         let d = std::f64::consts::PI / 180.0;
         let mut q0 = vec![0.0; m.nq];
         q0[6] = 1.0;

@@ -15,10 +15,10 @@ use nalgebra::{Dyn, StorageMut};
 /// block in the body frame, `aᵢ` including the fictitious base acceleration `−g` as in RNEA). Carried
 /// to the inertial frame, it loads every joint j on the path to the root: rows of j get
 /// `oSⱼᵀ (oX*ᵢ Yᵢ)`. Fixed bodies own their columns through their ancestors' rows. The per-body
-/// block `Y(aᵢ) + vᵢ ×* Y(vᵢ)` is the thesis' per-body regressor `R = r(ω̇ˢ) + [ω]× r(ωˢ)` (Eqs. 4.3
-/// and 9.7; digest `thesis_ch4_ch9_concurrent_learning.md` §2.3) in spatial vectors, i.e. the time
-/// derivative of seed 001's link kinematic matrix (Eq. 10), in our ten-parameter order; seed 001
-/// (§A.10 of its digest) uses such a regressor for torque prediction.
+/// block `Y(aᵢ) + vᵢ ×* Y(vᵢ)` is Valverde 2018's per-body regressor `R = r(ω̇ˢ) + [ω]× r(ωˢ)` (Eqs. 4.3
+/// and 9.7; (4.3) written with the body's inertial twist and its rate) in spatial vectors, i.e. the time
+/// derivative of the link kinematic matrix of Naveen, Shah, Misra (Eq. 10), in our ten-parameter order;
+/// Naveen et al. (Sec. VI.D) use such a regressor for torque prediction.
 pub fn dynamics_regressor<S: StorageMut<f64, Dyn, Dyn>>(
     m: &Model,
     d: &mut Data,

@@ -10,8 +10,8 @@ use nalgebra::{Dyn, StorageMut};
 /// Momentum regressor `K` (6 × 10·nbodies): `momentum(q, v) == K · vec(P)`, momentum being
 /// `[p; L]` about the inertial origin in the inertial frame.
 ///
-/// This is seed 001's link kinematic matrix `K_i` (Eq. 10; digest `seed001_minimal_params.md`
-/// §A.2–A.5) with the columns in our parameter order. Body i's momentum in its own frame is
+/// This is the link kinematic matrix `K_i` of Naveen, Shah, Misra (Eq. 10) with the columns in our
+/// parameter order. Body i's momentum in its own frame is
 /// `Iᵢ vᵢ = [m v − h × ω; I_o ω + h × v]`, linear in its ten parameters; carried to the inertial
 /// origin and written in inertial-frame quantities (`v_o = R v`, `ω_o = R ω`, `r_k` = column k of
 /// R, `p` the body origin, ω in the body frame) the columns are:

@@ -9,8 +9,8 @@
 //! Planar base, `[vx, vy, ω_z]` in the base frame: `ψ_{k+1} = ψ_k + h_k (ω_k + ω_{k+1}) / 2` and the
 //! position as above with `R(ψ)`.
 //!
-//! Second order; it uses both samples of a step, which is what a sampled measurement gives. (Seed 001's
-//! Appendix C, eqs. 44-47, integrates Euler angles by explicit Euler; we keep the attitude on the group.)
+//! Second order; it uses both samples of a step, which is what a sampled measurement gives. (Naveen, Shah,
+//! Misra's Appendix C, eqs. 44-47, integrates Euler angles by explicit Euler; we keep the attitude on the group.)
 
 use crate::error::{FfError, Result};
 use crate::spatial::{quat_exp, quat_mul, quat_normalize, rot_from_quat, V3};

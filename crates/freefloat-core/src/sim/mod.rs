@@ -58,7 +58,7 @@ pub enum Formulation {
     /// The engine's articulated-body algorithm (hybrid ABA with prescribed joints).
     #[default]
     Aba,
-    /// The dual-quaternion Newton–Euler system of seed 003 ch. 6 (`dqdynamics`); same results to round-off,
+    /// The dual-quaternion Newton–Euler system of Valverde 2018, ch. 6 (`dqdynamics`); same results to round-off,
     /// slower, free or fixed base with revolute, prismatic, spherical and fixed joints only.
     DualQuaternion,
 }
