@@ -5,6 +5,8 @@ from typing import Any, Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
+COMPILED_CPU_FEATURES: list
+
 class DualQuaternion:
     """A dual quaternion `r + ε d`; poses are unit (`q q* = 1`), twists `ω + εv`, wrenches `f + ετ`."""
     def __init__(self, coeffs: ArrayLike) -> None: ...
