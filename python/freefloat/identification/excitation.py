@@ -250,17 +250,7 @@ class ExcitationDesign:
         # SLSQP may end a hair outside a bound: put the result back inside before reporting it.
         lo, hi = np.array(self.bounds()).T
         x = self.feasible_start(dirs, np.clip(x, lo, hi))
-        r = self.evaluate(x, dirs)
-        return StepResult(
-            x=x,
-            objective=float(r["objective"][0]),
-            condition_number=float(r["condition_number"][0]),
-            mean_square=float(r["mean_square"][0]),
-            iterations=int(res.nit),
-            evaluations=count,
-            message=str(res.message),
-            significant=significant(r["singular_values"][0], DELTA),
-        )
+        return _step_result(x, self.evaluate(x, dirs), res, count)
 
     def prune(
         self, x, directions=None, u_max: int = U_MAX, delta: float = DELTA, min_gain: float = MIN_GAIN
@@ -366,17 +356,7 @@ class ExcitationDesign:
 
         res, count = _slsqp(evaluate, c0.ravel(), A, b, None, maxiter, progress)
         x = np.asarray(res.x)
-        r = evaluate(x[None])
-        step = StepResult(
-            x=x,
-            objective=float(r["objective"][0]),
-            condition_number=float(r["condition_number"][0]),
-            mean_square=float(r["mean_square"][0]),
-            iterations=int(res.nit),
-            evaluations=count,
-            message=str(res.message),
-            significant=significant(r["singular_values"][0], DELTA),
-        )
+        step = _step_result(x, evaluate(x[None]), res, count)
         return step, self.fourier(x, dirs, n_terms)
 
     def _run_step(self, desc, dirs, x0, maxiter, progress):
@@ -450,3 +430,17 @@ def _check_physical(guess) -> None:
             f"guess '{guess.name}': non-physical inertias for {', '.join(bad)}; the base response "
             "would be meaningless. Use a physically consistent guess (e.g. naveen_dual_arm_offset)"
         )
+
+
+def _step_result(x: np.ndarray, r: dict, res, count: int) -> StepResult:
+    """The report of one SQP run from its final evaluation `r` (first row) and scipy's result `res`."""
+    return StepResult(
+        x=x,
+        objective=float(r["objective"][0]),
+        condition_number=float(r["condition_number"][0]),
+        mean_square=float(r["mean_square"][0]),
+        iterations=int(res.nit),
+        evaluations=count,
+        message=str(res.message),
+        significant=significant(r["singular_values"][0], DELTA),
+    )
