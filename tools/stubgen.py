@@ -136,16 +136,6 @@ def _annot(name: str, default: str | None) -> str:
     return t
 
 
-def _params(obj, method: bool) -> str:
-    sig = getattr(obj, "__text_signature__", None)
-    if sig is None:
-        return "self" if method else "*args: Any, **kwargs: Any"
-    out = []
-    for p in inspect.signature(obj).parameters.values() if not method else _method_params(sig):
-        out.append(p)
-    return ", ".join(out)
-
-
 def _method_params(sig: str):
     # "($self, other)" or "(name)" for static methods: parse with inspect on a dummy function.
     inner = sig.strip()[1:-1].replace("$self", "self").replace("$cls", "cls")
