@@ -114,3 +114,16 @@ def test_type_stub_matches_the_compiled_module():
     assert (PKG / "_core.pyi").is_file() and (PKG / "py.typed").is_file()
     spec = importlib.util.find_spec("freefloat._core")
     assert spec is not None and spec.origin and Path(spec.origin).parent == PKG
+
+
+def test_load_trajectory_takes_a_file_or_a_built_in_name():
+    import pytest
+
+    from freefloat.io.trajectory_files import load_trajectory
+
+    with data.path("trajectories", "naveen_exciting_trajectory") as p:
+        by_file, joints_f = load_trajectory(p)
+    by_name, joints_n = load_trajectory("naveen_exciting_trajectory")
+    assert joints_n == joints_f and by_name.n_intervals == by_file.n_intervals == 63
+    with pytest.raises(ff.InputError, match="neither a file nor a built-in trajectory.*naveen_exciting_trajectory"):
+        load_trajectory("no_such_trajectory")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import data, models
+from . import models
 from .constants import PAPER_RATE_NOISE
 from .io.results import summarize, summary_text, write_run
 from .io.trajectory_files import load_trajectory
@@ -80,8 +80,7 @@ def run(out="freefloat-demo", t_final: float = 20.0, echo=print, progress: bool 
     from .identification import identify as idf
     from .identification.validation import identified_model, predict
 
-    with data.path("trajectories", TRAJECTORY) as p:
-        designed, joints = load_trajectory(p)
+    designed, joints = load_trajectory(TRAJECTORY)
     echo(
         f"\nidentification: the designed exciting trajectory ({designed.n_intervals} intervals, `freefloat excite`) "
         "with the paper's rate noise (50 µm/s, 80 µrad/s, 50 µrad/s)"

@@ -9,6 +9,7 @@ from pathlib import Path
 import click
 import numpy as np
 
+from .._core import InputError
 from ._common import load_model, parse_vector
 
 
@@ -136,20 +137,12 @@ def identify_minimal_cmd(
         click.echo(f"simulating {n_sim} excitation intervals of {m.name} with the paper's rate noise ...")
         data, _ = idf.excitation_data(m, n_intervals=n_sim, progress=True)
     if traj_file is not None:
-        from ..io import data as shipped
         from ..io.trajectory_files import load_trajectory
 
-        if Path(traj_file).is_file():
+        try:
             trajectory, joints = load_trajectory(traj_file)
-        elif shipped.exists("trajectories", traj_file):
-            with shipped.path("trajectories", traj_file) as p:
-                trajectory, joints = load_trajectory(p)
-        else:
-            raise click.BadParameter(
-                f"'{traj_file}' is neither a file nor a built-in trajectory "
-                f"(built-in: {', '.join(shipped.names('trajectories'))})",
-                param_hint="--trajectory",
-            )
+        except InputError as e:
+            raise click.BadParameter(str(e), param_hint="--trajectory") from None
         click.echo(f"simulating {m.name} along {traj_file} ({trajectory.duration:g} s) with the paper's rate noise ...")
         data, _ = idf.trajectory_data(m, trajectory, joints, progress=True)
     if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results

@@ -57,9 +57,20 @@ def _traj_from_dict(d: dict, where: str):
     raise InputError(f"{where}: unknown trajectory kind {kind!r} (expected 'cycloidal', 'fourier' or 'stacked')")
 
 
-def load_trajectory(path):
-    """(trajectory, joint names) from a file written by `save_trajectory` / `freefloat excite`."""
-    p = Path(path)
+def load_trajectory(spec):
+    """(trajectory, joint names) from a file written by `save_trajectory` / `freefloat excite`, or from a built-in
+    trajectory by name (`freefloat.data`, e.g. "naveen_exciting_trajectory"; earlier names are aliases)."""
+    from . import data
+
+    p = Path(spec)
+    if not p.is_file():
+        if not data.exists("trajectories", str(spec)):
+            raise InputError(
+                f"'{spec}' is neither a file nor a built-in trajectory "
+                f"(built-in: {', '.join(data.names('trajectories'))})"
+            )
+        with data.path("trajectories", str(spec)) as shipped:
+            return load_trajectory(shipped)
     try:
         d = json.loads(p.read_text())
     except (OSError, json.JSONDecodeError) as e:
