@@ -26,7 +26,9 @@ def finite(x, where: str) -> float:
 
 
 def check_scenarios(path: str) -> None:
-    lines = [ln for ln in open(path, encoding="utf-8").read().splitlines() if ln.strip() and not ln.startswith(" ")]
+    lines = [
+        ln for ln in open(path, encoding="utf-8").read().splitlines() if ln.strip() and not ln.startswith((" ", "#"))
+    ]
     if len(lines) < 5:
         fail(
             f"`freefloat scenarios` listed {len(lines)} entries, expected the built-in ones (>= 5):\n"

@@ -13,6 +13,8 @@
 pub mod check;
 /// Configuration-space geometry (tangent rates, retraction, dexp⁻¹) used by the integrators.
 pub mod config;
+/// Controllers and on-line estimators (Valverde 2018, ch. 4, 8, 9).
+pub mod control;
 /// `Data`: every work buffer of the algorithms, allocated once per model.
 pub mod data;
 /// Dual-quaternion multibody dynamics with joint reaction wrenches (Valverde 2018, ch. 5–6).

@@ -1,7 +1,8 @@
 """Command line: `freefloat --help` lists the commands; each has its own `--help`.
 
 One module per command group, each a thin layer over the library: `models`, `simulate`, `reactions`, `demo`,
-`params`, `identify` (+ `postcapture` for `identify postcapture` and `scenarios`), `excite`. A new command goes
+`params`, `identify` (+ `postcapture` for `identify postcapture` and `scenarios`), `excite`, `control`
+(the group; one module per controller). A new command goes
 in its own module and is registered below.
 """
 
@@ -12,7 +13,7 @@ import sys
 import click
 
 from .. import _core
-from . import demo, excite, identify, models, params, postcapture, reactions, simulate
+from . import control, demo, excite, identify, models, params, postcapture, reactions, simulate
 
 
 class FriendlyGroup(click.Group):
@@ -44,5 +45,6 @@ main.add_command(identify.identify_group)
 identify.identify_group.add_command(postcapture.identify_postcapture_cmd)
 main.add_command(excite.excite_cmd)
 main.add_command(postcapture.scenarios_cmd)
+main.add_command(control.control_group)
 
 __all__ = ["main"]

@@ -107,18 +107,24 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
 
 @click.command("scenarios")
 def scenarios_cmd():
-    """List the built-in scenarios, one per line with what it reproduces: the post-capture scenarios (Zhang, Yue,
-    Yuan 2020) and the shipped joint trajectories (the exciting trajectory designed for Naveen, Shah, Misra's robot).
+    """List the built-in scenarios and shipped trajectories, one per line: name, what it reproduces, and the
+    command that runs it.
 
-    A scenario file (YAML; the built-in ones ship inside the package) names the robot, the captured target, the
-    controller gains, the initial velocities and the identification settings. Run one with
-    `freefloat identify postcapture NAME --out DIR`; identify along a trajectory with
-    `freefloat identify minimal naveen_dual_arm --trajectory NAME`."""
-    from .. import postcapture as pc
+    A scenario file (YAML; the built-in ones ship inside the package) says what to run: the robot, the initial
+    state, the gains and the settings. Its `kind` key names the command that runs it (no `kind` means a
+    post-capture identification scenario, Zhang, Yue, Yuan 2020). Copy one, edit it, and pass the file path
+    instead of the name. The shipped joint trajectories (the exciting trajectory designed for Naveen, Shah,
+    Misra's robot) are used with `freefloat identify minimal naveen_dual_arm --trajectory NAME`."""
     from ..io import data as shipped
+    from ..io import scenario_files
 
-    for name, desc in pc.list_scenarios():
-        click.echo(f"{name:<28} {desc}")
+    kind = None
+    for s in scenario_files.listing():
+        if s.kind != kind:
+            kind = s.kind
+            click.echo(f"# {scenario_files.KINDS[kind]} NAME --out DIR")
+        click.echo(f"{s.name:<28} {s.description}")
+    click.echo("# trajectories: freefloat identify minimal naveen_dual_arm --trajectory NAME")
     for name in shipped.names("trajectories"):
         click.echo(f"{name:<28} {_trajectory_summary(shipped, name)}")
 

@@ -8,12 +8,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from .. import algorithms as alg
-from .. import data, models
+from .. import models
 from .._core import InputError
 from ..algorithms import quat_to_matrix
+from ..io import scenario_files
 
 # Noise study levels (the paper has no noise): white, per sample. Velocities [m/s, rad/s] and accelerations
 # [m/s², rad/s²] at the 10 Hz samples; thrust [N, N·m] at the 1 kHz step rate before integration.
@@ -56,25 +56,13 @@ class Scenario:
 
 
 def list_scenarios() -> list[tuple[str, str]]:
-    """Built-in scenarios (name, description), shipped inside the package (`freefloat.data`)."""
-    out = []
-    for name in data.names("scenarios"):
-        d = yaml.safe_load(data.read_text("scenarios", name))
-        out.append((name, str(d.get("description", "")).strip()))
-    return out
+    """Built-in post-capture scenarios (name, description), shipped inside the package (`freefloat.data`)."""
+    return [(s.name, s.description) for s in scenario_files.listing() if s.kind == "postcapture"]
 
 
 def load_scenario(spec: str | Path) -> Scenario:
-    """A scenario by built-in name or file path."""
-    p = Path(spec)
-    if not p.suffix and data.exists("scenarios", str(spec)):
-        text, source = data.read_text("scenarios", str(spec)), f"built-in scenario '{spec}'"
-    elif p.suffix and p.is_file():
-        text, source = p.read_text(), str(p)
-    else:
-        names = ", ".join(data.names("scenarios"))
-        raise InputError(f"scenario '{spec}' not found (built-in scenarios: {names})")
-    d = yaml.safe_load(text)
+    """A post-capture scenario by built-in name or file path."""
+    d, source = scenario_files.read(spec, kind="postcapture")
     try:
         return _parse(d, source)
     except KeyError as e:

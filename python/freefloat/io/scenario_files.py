@@ -1,0 +1,90 @@
+"""Scenario files: YAML that says what to run (robot, initial state, gains, settings) for one command.
+
+Every scenario file has a `kind` (absent means `postcapture`, the first kind there was), and each kind belongs to
+one command. This module finds a scenario by built-in name or file path, parses it with errors that name the file
+and line, and checks it is of the kind the calling command runs; each command parses its own keys.
+
+    from freefloat.io import scenario_files
+    d, source = scenario_files.read("valverde_ch4_example_a", kind="control_adaptive")
+    for s in scenario_files.listing(): print(s.name, s.kind, s.command)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import yaml
+
+from .._core import InputError
+from . import data
+
+#: kind -> the command that runs scenarios of that kind
+KINDS = {
+    "postcapture": "freefloat identify postcapture",
+    "control_adaptive": "freefloat control adaptive",
+    "identify_cl": "freefloat identify cl",
+    "control_ddp": "freefloat control ddp",
+}
+DEFAULT_KIND = "postcapture"
+
+
+@dataclass(frozen=True)
+class ScenarioEntry:
+    """One built-in scenario as `freefloat scenarios` lists it."""
+
+    name: str
+    kind: str
+    description: str
+
+    @property
+    def command(self) -> str:
+        return f"{KINDS[self.kind]} {self.name}"
+
+
+def _parse_yaml(text: str, source: str) -> dict:
+    try:
+        d = yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(e, "problem", None) or str(e)
+        raise InputError(f"{source}:{where}: not valid YAML ({problem})") from None
+    if not isinstance(d, dict):
+        raise InputError(f"{source}: a scenario file must be a YAML mapping of keys, got {type(d).__name__}")
+    kind = d.get("kind", DEFAULT_KIND)
+    if kind not in KINDS:
+        raise InputError(f"{source}: key 'kind': unknown scenario kind '{kind}' (one of: {', '.join(KINDS)})")
+    return d
+
+
+def read(spec: str | Path, kind: str) -> tuple[dict, str]:
+    """The parsed scenario `spec` (a built-in name or a file path) and a description of where it came from.
+
+    Raises InputError when it is not found, is not valid YAML, or is of another kind than `kind` (naming the
+    command that runs it)."""
+    if kind not in KINDS:
+        raise ValueError(f"unknown scenario kind {kind!r}")
+    p = Path(spec)
+    if not p.suffix and data.exists("scenarios", str(spec)):
+        text, source = data.read_text("scenarios", str(spec)), f"built-in scenario '{spec}'"
+    elif p.suffix and p.is_file():
+        text, source = p.read_text(encoding="utf-8"), str(p)
+    else:
+        own = ", ".join(s.name for s in listing() if s.kind == kind) or "none"
+        raise InputError(f"scenario '{spec}' not found (built-in {kind} scenarios: {own}; or give a .yaml file path)")
+    d = _parse_yaml(text, source)
+    found = d.get("kind", DEFAULT_KIND)
+    if found != kind:
+        raise InputError(f"{source} is a '{found}' scenario, not '{kind}': run it with `{KINDS[found]} {spec}`")
+    return d, source
+
+
+def listing() -> list[ScenarioEntry]:
+    """Every built-in scenario, sorted by kind (in the order of KINDS) and name."""
+    out = []
+    for name in data.names("scenarios"):
+        d = _parse_yaml(data.read_text("scenarios", name), f"built-in scenario '{name}'")
+        out.append(ScenarioEntry(name, d.get("kind", DEFAULT_KIND), str(d.get("description", "")).strip()))
+    order = list(KINDS)
+    return sorted(out, key=lambda s: (order.index(s.kind), s.name))
