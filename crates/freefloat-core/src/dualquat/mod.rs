@@ -13,10 +13,12 @@ pub mod inertia;
 pub mod kinematics;
 pub mod orbital;
 pub mod pose;
+pub mod realisable;
 mod quaternion;
 pub mod screw;
 
 pub use dual_quaternion::{swap_matrix, DualQuat, M8, UNIT_TOL, V8};
 pub use inertia::DualInertia;
 pub use quaternion::{Quat, M4, V4};
+pub use realisable::{realisability, Realisability};
 pub use screw::{exp, log, screw_exp, screw_log, Screw};
