@@ -15,10 +15,12 @@ pub mod orbital;
 pub mod pose;
 pub mod realisable;
 mod quaternion;
+pub mod regressor;
 pub mod screw;
 
 pub use dual_quaternion::{swap_matrix, DualQuat, M8, UNIT_TOL, V8};
 pub use inertia::DualInertia;
 pub use quaternion::{Quat, M4, V4};
 pub use realisable::{realisability, Realisability};
+pub use regressor::{body_regressor, h_vector, r_matrix, relative_regressor, M87, V7};
 pub use screw::{exp, log, screw_exp, screw_log, Screw};
