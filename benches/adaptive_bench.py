@@ -148,7 +148,9 @@ class Peer:
         cr = dcross(wd_b, w)
         vec_e = e * np.array([0, 1, 1, 1, 0, 1, 1, 1.0])
         f = -vec_e - kds + dcross(wbi, mstar(vh, swap(wbi))) + mstar(vh, swap(wdd_b) + swap(cr) - kpedot)
-        rhs = f - dcross(wbi, mstar(self.truth, swap(wbi))) - mstar(self.truth, swap(wdd_b)) - mstar(self.truth, swap(cr))
+        rhs = (
+            f - dcross(wbi, mstar(self.truth, swap(wbi))) - mstar(self.truth, swap(wdd_b)) - mstar(self.truth, swap(cr))
+        )
         y = np.concatenate([[rhs[0]], rhs[1:4] / self.m, [rhs[4]], self.inert_inv @ rhs[5:8]])
         wdot = swap(y)
         adapt = -h_of(swap(dcross(s, wbi)), swap(wbi)) - h_of(ss, swap(wdd_b) + swap(cr) - kpedot)
@@ -241,6 +243,14 @@ def peer_example_b(sc, alpha, t_final, dt):
 # ---------------------------------------------------------------------------------------------------------------
 
 
+def _row(title, med, spread, k):
+    f, n = f"ff_{k}", f"np_{k}"
+    return (
+        f"| {title} | {med[f]:.3f} s ({spread[f][0]:.3f}-{spread[f][1]:.3f}) | "
+        f"{med[n]:.2f} s ({spread[n][0]:.2f}-{spread[n][1]:.2f}) | {med[n] / med[f]:.0f}x |"
+    )
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="benches/results")
@@ -309,11 +319,9 @@ def main(argv=None) -> int:
         "",
         "| run | freefloat | numpy/scipy | ratio |",
         "|---|---|---|---|",
-        f"| example A (continuous CL, DOPRI5 1e-10) | {med['ff_a']:.3f} s ({spread['ff_a'][0]:.3f}-{spread['ff_a'][1]:.3f}) | "
-        f"{med['np_a']:.2f} s ({spread['np_a'][0]:.2f}-{spread['np_a'][1]:.2f}) | {med['np_a'] / med['ff_a']:.0f}x |",
-        f"| example B (discrete CL N_s = 50, RK4 0.01 s) | {med['ff_b']:.3f} s ({spread['ff_b'][0]:.3f}-{spread['ff_b'][1]:.3f}) | "
-        f"{med['np_b']:.2f} s ({spread['np_b'][0]:.2f}-{spread['np_b'][1]:.2f}) | {med['np_b'] / med['ff_b']:.0f}x |",
-    ]  # fmt: skip
+        _row("example A (continuous CL, DOPRI5 1e-10)", med, spread, "a"),
+        _row("example B (discrete CL N_s = 50, RK4 0.01 s)", med, spread, "b"),
+    ]
     (out / "adaptive_bench.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0

@@ -17,6 +17,7 @@ import pytest
 from click.testing import CliRunner
 
 import freefloat as ff
+from freefloat.cli import main as cli_main
 from freefloat._core import InputError
 from freefloat.control import AdaptivePoseController, realisability
 from freefloat.control import adaptive as ad
@@ -61,7 +62,7 @@ def test_thesis_truth_is_flagged_not_rejected():
 def test_scenarios_are_listed():
     names = [n for n, _ in ad.list_scenarios()]
     assert names == ["valverde_ch4_example_a", "valverde_ch4_example_b"]
-    out = CliRunner().invoke(ff.cli.main, ["scenarios"]).output
+    out = CliRunner().invoke(cli_main, ["scenarios"]).output
     assert "valverde_ch4_example_a" in out and "freefloat control adaptive" in out
 
 
@@ -253,7 +254,7 @@ def test_example_b_baseline_converges_only_i12_and_i13(example_b):
 
 @pytest.mark.slow
 def test_cli_writes_results_and_figures(tmp_path):
-    res = CliRunner().invoke(ff.cli.main, ["control", "adaptive", "valverde_ch4_example_b", "--out", str(tmp_path)])
+    res = CliRunner().invoke(cli_main, ["control", "adaptive", "valverde_ch4_example_b", "--out", str(tmp_path)])
     assert res.exit_code == 0, res.output
     d = json.loads((tmp_path / "results.json").read_text())
     assert d["truth"] == TRUTH.tolist() and len(d["final_estimate"]) == 7
@@ -267,9 +268,9 @@ def test_cli_writes_results_and_figures(tmp_path):
 
 
 def test_cli_help_and_baseline_flag(tmp_path):
-    out = CliRunner().invoke(ff.cli.main, ["control", "adaptive", "--help"]).output
+    out = CliRunner().invoke(cli_main, ["control", "adaptive", "--help"]).output
     assert "--baseline" in out and "--alpha" in out and "Valverde 2018" in out
-    bad = CliRunner().invoke(ff.cli.main, ["control", "adaptive", "valverde_ch4_example_b", "--alpha", "-1"])
+    bad = CliRunner().invoke(cli_main, ["control", "adaptive", "valverde_ch4_example_b", "--alpha", "-1"])
     assert bad.exit_code != 0 and "--alpha" in bad.output
-    missing = CliRunner().invoke(ff.cli.main, ["control", "adaptive", "no_such_scenario"])
+    missing = CliRunner().invoke(cli_main, ["control", "adaptive", "no_such_scenario"])
     assert missing.exit_code != 0 and "not found" in missing.output

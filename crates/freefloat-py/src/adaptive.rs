@@ -68,8 +68,15 @@ fn gain7(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<M7> {
     }
 }
 
-fn gains(k_r: &Bound<'_, PyAny>, k_q: &Bound<'_, PyAny>, k_v: &Bound<'_, PyAny>, k_w: &Bound<'_, PyAny>, k_i: &Bound<'_, PyAny>) -> PyResult<Gains> {
-    let (kr, kq, kv, kw, ki) = (gain3(k_r, "k_r")?, gain3(k_q, "k_q")?, gain3(k_v, "k_v")?, gain3(k_w, "k_w")?, gain7(k_i, "k_i")?);
+fn gains(
+    k_r: &Bound<'_, PyAny>,
+    k_q: &Bound<'_, PyAny>,
+    k_v: &Bound<'_, PyAny>,
+    k_w: &Bound<'_, PyAny>,
+    k_i: &Bound<'_, PyAny>,
+) -> PyResult<Gains> {
+    let (kr, kq, kv, kw, ki) =
+        (gain3(k_r, "k_r")?, gain3(k_q, "k_q")?, gain3(k_v, "k_v")?, gain3(k_w, "k_w")?, gain7(k_i, "k_i")?);
     guard(|| Gains::new(kr, kq, kv, kw, ki))
 }
 
@@ -100,7 +107,10 @@ fn law(form: &str) -> PyResult<LawForm> {
 
 /// A reference from `(angular, linear)` harmonics (each a (4, 3) array: offset, amplitude, frequency, phase)
 /// or a table (`times` (N,), `twists` (N, 6) = [ω̄, v̄]).
-fn reference(harmonic: Option<(&Bound<'_, PyAny>, &Bound<'_, PyAny>)>, table: Option<(&Bound<'_, PyAny>, &Bound<'_, PyAny>)>) -> PyResult<Reference> {
+fn reference(
+    harmonic: Option<(&Bound<'_, PyAny>, &Bound<'_, PyAny>)>,
+    table: Option<(&Bound<'_, PyAny>, &Bound<'_, PyAny>)>,
+) -> PyResult<Reference> {
     let h3 = |obj: &Bound<'_, PyAny>, name: &str| -> PyResult<Harmonic3> {
         let v = floats(obj, name, &[4, 3])?;
         let row = |k: usize| V3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
@@ -288,7 +298,12 @@ pub struct PyAdaptivePoseController {
 }
 
 impl PyAdaptivePoseController {
-    fn reference_at(&self, t: f64, w_di: Option<&Bound<'_, PyAny>>, wdot_di: Option<&Bound<'_, PyAny>>) -> PyResult<(DualQuat, DualQuat)> {
+    fn reference_at(
+        &self,
+        t: f64,
+        w_di: Option<&Bound<'_, PyAny>>,
+        wdot_di: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<(DualQuat, DualQuat)> {
         let (rw, rwd) = self.reference.eval(t);
         Ok((
             match w_di {

@@ -148,8 +148,12 @@ def _harmonic(d: dict, source: str, where: str) -> np.ndarray:
         raise InputError(f"{source}: '{where}' must be a mapping (offset, amplitude, frequency, phase)")
     unknown = set(d) - {"offset", "amplitude", "frequency", "phase"}
     if unknown:
-        raise InputError(f"{source}: unknown key(s) {sorted(unknown)} in '{where}' (offset, amplitude, frequency, phase)")
-    return np.array([_vec(d, k, 3, source, where + ".", default=[0, 0, 0]) for k in ("offset", "amplitude", "frequency", "phase")])
+        raise InputError(
+            f"{source}: unknown key(s) {sorted(unknown)} in '{where}' (offset, amplitude, frequency, phase)"
+        )
+    return np.array(
+        [_vec(d, k, 3, source, where + ".", default=[0, 0, 0]) for k in ("offset", "amplitude", "frequency", "phase")]
+    )
 
 
 def _reference(d: dict, source: str) -> dict:
@@ -166,7 +170,9 @@ def _reference(d: dict, source: str) -> dict:
         else:
             arr = np.asarray(tb, float)
         if arr.ndim != 2 or arr.shape[1] != 7:
-            raise InputError(f"{source}: key 'reference.table' must be rows [t, wx, wy, wz, vx, vy, vz], got shape {arr.shape}")
+            raise InputError(
+                f"{source}: key 'reference.table' must be rows [t, wx, wy, wz, vx, vy, vz], got shape {arr.shape}"
+            )
         return {"reference_times": arr[:, 0].copy(), "reference_twists": arr[:, 1:].copy()}
     return {
         "reference_angular": _harmonic(d.get("angular"), source, "reference.angular"),
@@ -191,7 +197,9 @@ def load_scenario(spec: str | Path) -> Scenario:
     alphas = [_num({"alpha": a}, "alpha", source, "learning.", lo=0.0) for a in alphas]
     n_s = le.get("n_s", 50)
     if not isinstance(n_s, int) or n_s < 2:
-        raise InputError(f"{source}: key 'learning.n_s' must be an integer >= 2 (each sample has rank <= 6), got {n_s!r}")
+        raise InputError(
+            f"{source}: key 'learning.n_s' must be an integer >= 2 (each sample has rank <= 6), got {n_s!r}"
+        )
     method = sim.get("method", "dopri5")
     if method not in ("dopri5", "rk4"):
         raise InputError(f"{source}: key 'simulation.method' must be 'dopri5' or 'rk4', got {method!r}")
@@ -207,7 +215,12 @@ def load_scenario(spec: str | Path) -> Scenario:
         truth=_vec(d, "truth", 7, source, ""),
         q0=_pose(_vec(ini, "attitude", 4, source, "initial."), _vec(ini, "position", 3, source, "initial."), source),
         w0=np.concatenate(
-            [[0], _vec(ini, "angular_velocity", 3, source, "initial."), [0], _vec(ini, "linear_velocity", 3, source, "initial.")]
+            [
+                [0],
+                _vec(ini, "angular_velocity", 3, source, "initial."),
+                [0],
+                _vec(ini, "linear_velocity", 3, source, "initial."),
+            ]
         ),
         estimate0=_vec(ini, "estimate", 7, source, "initial.", default=np.zeros(7)),
         gains={k: _gain(g, k, 7 if k == "K_i" else 3, source) for k in ("K_r", "K_q", "K_v", "K_w", "K_i")},
@@ -370,9 +383,19 @@ class AdaptiveResult:
             "final_attitude_error_deg": p["final_attitude_error_deg"],
             "learning": {
                 "mode": sc.mode,
-                **({"n_s": sc.n_s, "sigma_stop": sc.sigma_stop, "selection": sc.selection, "seed": sc.seed} if sc.mode == "discrete" else {}),
+                **(
+                    {"n_s": sc.n_s, "sigma_stop": sc.sigma_stop, "selection": sc.selection, "seed": sc.seed}
+                    if sc.mode == "discrete"
+                    else {}
+                ),
             },
-            "integration": {"method": sc.method, "dt": sc.dt, "rtol": sc.rtol, "atol": sc.atol, "output_dt": sc.output_dt},
+            "integration": {
+                "method": sc.method,
+                "dt": sc.dt,
+                "rtol": sc.rtol,
+                "atol": sc.atol,
+                "output_dt": sc.output_dt,
+            },
             "duration_s": sc.duration,
             "runs": runs,
             "paper": sc.paper,
@@ -386,7 +409,8 @@ class AdaptiveResult:
         for k, r in self.runs.items():
             lines.append(f"  {k:<14}" + "".join(f"{x:>9.4g}" for x in r.final_estimate))
         lines.append("")
-        hdr = f"  {'run':<14}{'within 1 % from':>17}{'pos. err [m]':>14}{'att. err [deg]':>16}{'rank 7 at':>11}{'sv_min>=0.1':>13}{'steps':>8}{'wall [s]':>10}"
+        hdr = f"  {'run':<14}{'within 1 % from':>17}{'pos. err [m]':>14}{'att. err [deg]':>16}"
+        hdr += f"{'rank 7 at':>11}{'sv_min>=0.1':>13}{'steps':>8}{'wall [s]':>10}"
         lines.append(hdr)
         for k, r in self.runs.items():
             s = r.summary(tr)
@@ -400,7 +424,9 @@ class AdaptiveResult:
             )
         rz = realisability(tr)
         if not rz["realisable"]:
-            lines.append(f"  note: the true mass properties are not a realisable rigid body: {'; '.join(rz['failures'])}")
+            lines.append(
+                f"  note: the true mass properties are not a realisable rigid body: {'; '.join(rz['failures'])}"
+            )
         for k, r in self.runs.items():
             f = realisability(r.final_estimate)
             if not f["realisable"]:

@@ -13,8 +13,8 @@ pub mod inertia;
 pub mod kinematics;
 pub mod orbital;
 pub mod pose;
-pub mod realisable;
 mod quaternion;
+pub mod realisable;
 pub mod regressor;
 pub mod screw;
 

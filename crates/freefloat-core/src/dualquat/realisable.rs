@@ -51,9 +51,7 @@ impl Realisability {
             out.push(format!("inertia is not positive definite (eigenvalues {l1:.4}, {l2:.4}, {l3:.4})"));
         }
         if !self.triangle_inequality {
-            out.push(format!(
-                "principal moments violate the triangle inequality ({l3:.4} > {l1:.4} + {l2:.4})"
-            ));
+            out.push(format!("principal moments violate the triangle inequality ({l3:.4} > {l1:.4} + {l2:.4})"));
         }
         out
     }

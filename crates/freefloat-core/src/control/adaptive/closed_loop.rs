@@ -126,7 +126,14 @@ pub(crate) fn regressor_of(ev: &Eval, x: &[f64; NX]) -> M87 {
 }
 
 /// The state rate at (t, x) into `dx`. `stack` holds the discrete-CL sums (ignored in continuous CL).
-pub(crate) fn rhs(s: &Setup, m: &DualInertia, t: f64, x: &[f64; NX], stack: Option<&DataStack>, dx: &mut [f64; NX]) -> Eval {
+pub(crate) fn rhs(
+    s: &Setup,
+    m: &DualInertia,
+    t: f64,
+    x: &[f64; NX],
+    stack: Option<&DataStack>,
+    dx: &mut [f64; NX],
+) -> Eval {
     let ev = plant_eval(s, m, t, x);
     put_dq(dx, IQ, &ev.err.q_dot);
     put_dq(dx, IW, &ev.w_dot);

@@ -9,7 +9,6 @@ use super::law::{control_force, estimate_rate, LawForm};
 use super::reference::check_vector;
 use super::stack::{singular_values_psd, DataStack};
 use super::tracking::{error_state, ErrorState};
-use crate::dualquat::pose::checked_pose;
 use crate::dualquat::realisable::{realisability, Realisability};
 use crate::dualquat::regressor::{relative_regressor, V7};
 use crate::dualquat::DualQuat;
@@ -34,9 +33,26 @@ pub struct AdaptivePoseController {
     memory: Memory,
 }
 
+/// Largest unit defect `max |q q* − 1|` of a measured pose the controller accepts.
+pub const POSE_TOL: f64 = 1e-6;
+
 /// A measured state: unit pose error `q_{B/D}` and twist `ω^B_{B/D}`, with the reference `(ω^D_{D/I}, ω̇^D_{D/I})`.
 fn checked_state(q: &DualQuat, w: &DualQuat, w_di: &DualQuat, wdot_di: &DualQuat) -> Result<()> {
-    checked_pose("q_bd", q)?;
+    // a pose integrated by the user's own loop drifts off the unit constraint by round-off and truncation
+    // (RK4 at 0.01 s: ~1e-9 after a second); the law is defined for any q, so accept a small defect as it is
+    // and reject only a pose that is not unit at all (wrong layout, unnormalised data)
+    if !q.is_finite() {
+        return Err(FfError::arg("q_bd", "has non-finite entries"));
+    }
+    let defect = q.unit_defect();
+    if !(defect <= POSE_TOL) {
+        return Err(FfError::arg(
+            "q_bd",
+            format!(
+                "is not a unit dual quaternion (max |q q* − 1| = {defect:.3e} > {POSE_TOL:e}; layout [w x y z | w x y z], normalise it with (2.30))"
+            ),
+        ));
+    }
     check_vector("w_bd", w)?;
     check_vector("w_di", w_di)?;
     check_vector("wdot_di", wdot_di)

@@ -22,9 +22,9 @@ pub mod law;
 pub mod reference;
 pub mod simulate;
 pub mod stack;
-pub mod tracking;
 #[cfg(test)]
 mod tests;
+pub mod tracking;
 
 pub use closed_loop::{Learning, Setup};
 pub use controller::AdaptivePoseController;

@@ -41,7 +41,12 @@ impl Harmonic3 {
         (x, dx)
     }
     fn check(&self, name: &str) -> Result<()> {
-        for (what, v) in [("offset", self.offset), ("amplitude", self.amplitude), ("frequency", self.frequency), ("phase", self.phase)] {
+        for (what, v) in [
+            ("offset", self.offset),
+            ("amplitude", self.amplitude),
+            ("frequency", self.frequency),
+            ("phase", self.phase),
+        ] {
             if v.iter().any(|x| !x.is_finite()) {
                 return Err(FfError::arg(&format!("{name}.{what}"), "has non-finite entries"));
             }
@@ -66,7 +71,11 @@ impl Table {
         if t.len() < 2 || t.len() != x.len() {
             return Err(FfError::arg(
                 "reference",
-                format!("a table needs at least 2 samples and one twist per time ({} times, {} twists)", t.len(), x.len()),
+                format!(
+                    "a table needs at least 2 samples and one twist per time ({} times, {} twists)",
+                    t.len(),
+                    x.len()
+                ),
             ));
         }
         if let Some(k) = t.iter().position(|v| !v.is_finite()) {
@@ -110,7 +119,8 @@ impl Table {
         let (u2, u3) = (u * u, u * u * u);
         // cubic Hermite basis and its derivative
         let (h00, h10, h01, h11) = (2.0 * u3 - 3.0 * u2 + 1.0, u3 - 2.0 * u2 + u, -2.0 * u3 + 3.0 * u2, u3 - u2);
-        let (d00, d10, d01, d11) = (6.0 * u2 - 6.0 * u, 3.0 * u2 - 4.0 * u + 1.0, -6.0 * u2 + 6.0 * u, 3.0 * u2 - 2.0 * u);
+        let (d00, d10, d01, d11) =
+            (6.0 * u2 - 6.0 * u, 3.0 * u2 - 4.0 * u + 1.0, -6.0 * u2 + 6.0 * u, 3.0 * u2 - 2.0 * u);
         let (mut x, mut dx) = ([0.0; 6], [0.0; 6]);
         for j in 0..6 {
             let (p0, p1, m0, m1) = (self.x[k][j], self.x[k + 1][j], self.m[k][j] * h, self.m[k + 1][j] * h);
@@ -207,7 +217,8 @@ mod tests {
 
     #[test]
     fn harmonic_rate_is_exact() {
-        let a = Harmonic3 { amplitude: V3::new(0.0, 1.0, 0.0), frequency: V3::new(0.0, 1.0, 0.0), ..Default::default() };
+        let a =
+            Harmonic3 { amplitude: V3::new(0.0, 1.0, 0.0), frequency: V3::new(0.0, 1.0, 0.0), ..Default::default() };
         let r = Reference::harmonic(a, Harmonic3::constant(V3::new(1.0, 0.0, 0.0))).unwrap();
         let (w, dw) = r.eval(0.7);
         assert!((w.r.v.y - 0.7f64.sin()).abs() < 1e-15 && (dw.r.v.y - 0.7f64.cos()).abs() < 1e-15);

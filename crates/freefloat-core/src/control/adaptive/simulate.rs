@@ -3,8 +3,10 @@
 //! callback in simulated seconds that can stop the run (what was finished is kept), and the discrete-CL stack
 //! updated once per step, at the step's start (the Simulink major time step), frozen within the step.
 
-use super::closed_loop::{plant, plant_eval, regressor_of, rhs, Eval, Learning, Setup, IP, IQ, IQQ, IV, IW, NX, N_CORE};
 use super::closed_loop::{dq_at, m7_at, put_dq, v7_at};
+use super::closed_loop::{
+    plant, plant_eval, regressor_of, rhs, Eval, Learning, Setup, IP, IQ, IQQ, IV, IW, NX, N_CORE,
+};
 use super::law::lyapunov;
 use super::reference::check_vector;
 use super::stack::{singular_values_psd, DataStack};
@@ -101,7 +103,10 @@ fn check_setup(s: &Setup, o: &RunOptions) -> Result<DualInertia> {
         return Err(FfError::arg("estimate0", "has non-finite entries"));
     }
     if !(s.alpha >= 0.0) || !s.alpha.is_finite() {
-        return Err(FfError::arg("alpha", format!("must be finite and ≥ 0 (0 = no concurrent learning), got {}", s.alpha)));
+        return Err(FfError::arg(
+            "alpha",
+            format!("must be finite and ≥ 0 (0 = no concurrent learning), got {}", s.alpha),
+        ));
     }
     if !(o.t_final > 0.0) || !o.t_final.is_finite() {
         return Err(FfError::arg("t_final", format!("must be positive and finite, got {}", o.t_final)));
@@ -226,7 +231,8 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
         Learning::Discrete { n_s, sigma_stop, rule, seed } => Some(DataStack::new(n_s, sigma_stop, rule, seed)?),
         Learning::Continuous => None,
     };
-    let mut d = Driver { s: setup, m, stack, run: Run::default(), rank_tol: opts.rank_tol, evals: 0, was_admissible: false };
+    let mut d =
+        Driver { s: setup, m, stack, run: Run::default(), rank_tol: opts.rank_tol, evals: 0, was_admissible: false };
     let n_active = if matches!(setup.learning, Learning::Continuous) { NX } else { N_CORE };
     let x0 = initial_state(setup);
     let mut stop = false;
@@ -381,14 +387,18 @@ fn dopri5(
             h * acc / (atol + rtol * x[i].abs().max(xn[i].abs()))
         });
         if !err.is_finite() {
-            return Err(FfError::Numerical(format!("the closed loop diverged near t = {t:.6} s (non-finite step error)")));
+            return Err(FfError::Numerical(format!(
+                "the closed loop diverged near t = {t:.6} s (non-finite step error)"
+            )));
         }
         if err > 1.0 {
             d.run.rejected += 1;
             h *= (0.9 * err.powf(-0.2)).max(0.2);
             rejected_last = true;
             if h < 1e-14 * tf.max(1.0) {
-                return Err(FfError::Numerical(format!("step size underflow at t = {t}: the tolerances cannot be met")));
+                return Err(FfError::Numerical(format!(
+                    "step size underflow at t = {t}: the tolerances cannot be met"
+                )));
             }
             continue;
         }
