@@ -179,7 +179,7 @@ def test_user_loop_with_the_controller_object_learns_the_mass():
     assert np.allclose(c.estimate, TRUTH, rtol=1e-3)
 
 
-# ---- the thesis' examples (long runs) ---------------------------------------------------------------------------
+# ---- the thesis' examples (50 s simulated; < 1 s each in the engine) ---------------------------------------------------------------------------
 
 
 @pytest.fixture(scope="module")
@@ -192,7 +192,6 @@ def example_b():
     return ad.run("valverde_ch4_example_b")
 
 
-@pytest.mark.slow
 def test_example_a_continuous_cl(example_a):
     r = example_a.runs["alpha=1"]
     t, est, sv = r.t, r.estimate, r.singular_values
@@ -212,7 +211,6 @@ def test_example_a_continuous_cl(example_a):
     assert abs(r.lyapunov[0] - 26.774) < 0.01
 
 
-@pytest.mark.slow
 def test_example_a_baseline_misses_the_unexcited_parameters(example_a):
     b = example_a.runs["baseline"].final_estimate
     # B5: PE fails for I11, I13, I33 (W_rbᵀW_rb has zeros there); I22 is excited
@@ -220,7 +218,6 @@ def test_example_a_baseline_misses_the_unexcited_parameters(example_a):
     assert abs(b[3] - 5) < 0.1
 
 
-@pytest.mark.slow
 def test_example_b_discrete_cl(example_b):
     for lab in ("alpha=0.005", "alpha=0.0005"):
         r = example_b.runs[lab]
@@ -242,7 +239,6 @@ def test_example_b_discrete_cl(example_b):
     assert err.max() <= 0.6 and not np.all(err[:6] <= 0.01 * TRUTH[:6])
 
 
-@pytest.mark.slow
 def test_example_b_baseline_converges_only_i12_and_i13(example_b):
     b = example_b.runs["baseline"].final_estimate
     rel = np.abs(b - TRUTH) / TRUTH
