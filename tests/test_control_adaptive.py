@@ -17,8 +17,8 @@ import pytest
 from click.testing import CliRunner
 
 import freefloat as ff
-from freefloat.cli import main as cli_main
 from freefloat._core import InputError
+from freefloat.cli import main as cli_main
 from freefloat.control import AdaptivePoseController, realisability
 from freefloat.control import adaptive as ad
 
@@ -127,6 +127,20 @@ def test_engine_rejects_a_non_unit_initial_pose_and_bad_integrator_settings():
         ad.simulate(sc, 1.0)
 
 
+def test_progress_can_stop_a_run_and_keeps_what_was_done():
+    sc = _short("valverde_ch4_example_b", 10.0)
+    seen = []
+    r = ad.simulate(sc, 0.005, progress=lambda t: seen.append(t) or t < 1.0)
+    assert r.interrupted and 1.0 <= r.t[-1] < 10 and len(r.t) == len(r.estimate) == len(r.force)
+    assert seen == sorted(seen)
+
+
+def test_divergence_is_an_error_not_nan():
+    sc = _short("valverde_ch4_example_b", 1.0)
+    with pytest.raises(ff.NumericalError, match="non-finite"):
+        ad.simulate(sc, 1e5)  # α·K_i·σ_max·dt far beyond RK4's stability limit
+
+
 # ---- against the independent numpy closed loop -----------------------------------------------------------------
 
 
@@ -179,7 +193,7 @@ def test_user_loop_with_the_controller_object_learns_the_mass():
     assert np.allclose(c.estimate, TRUTH, rtol=1e-3)
 
 
-# ---- the thesis' examples (50 s simulated; < 1 s each in the engine) ---------------------------------------------------------------------------
+# ---- the thesis' examples (50 s simulated; < 1 s each in the engine) ----------------------------------------
 
 
 @pytest.fixture(scope="module")

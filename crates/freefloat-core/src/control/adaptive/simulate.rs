@@ -180,7 +180,10 @@ impl Driver<'_> {
 
     fn record(&mut self, t: f64, x: &[f64; NX]) -> Result<()> {
         if let Some(k) = x[..IQQ + 7].iter().position(|v| !v.is_finite()) {
-            return Err(FfError::Numerical(format!("closed-loop state {k} became non-finite at t = {t:.6} s")));
+            return Err(FfError::Numerical(format!(
+                "closed-loop state {k} became non-finite at t = {t:.6} s (the integration diverged: reduce the step \
+                 or the gains; with RK4 the CL rate α·K_i·σ_max(ΣRᵀR) times dt must stay below ~2.8)"
+            )));
         }
         let ev = plant_eval(self.s, &self.m, t, x);
         let r = &mut self.run;
