@@ -236,6 +236,19 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
     };
     let mut d =
         Driver { s: setup, m, stack, run: Run::default(), rank_tol: opts.rank_tol, evals: 0, was_admissible: false };
+    // the histories are sized once (bounded by the recording grid), so the stepping loop does not reallocate
+    let n_out = ((opts.t_final / opts.output_dt).ceil() as usize).saturating_add(2).min(50_000_000);
+    let r = &mut d.run;
+    r.t.reserve(n_out);
+    r.q.reserve(8 * n_out);
+    r.w.reserve(8 * n_out);
+    r.estimate.reserve(7 * n_out);
+    r.force.reserve(8 * n_out);
+    r.singular_values.reserve(7 * n_out);
+    r.lyapunov.reserve(n_out);
+    r.position_error.reserve(3 * n_out);
+    r.attitude_error.reserve(n_out);
+    r.stack_len.reserve(n_out);
     let n_active = if matches!(setup.learning, Learning::Continuous) { NX } else { N_CORE };
     let x0 = initial_state(setup);
     let mut stop = false;
