@@ -56,6 +56,32 @@ def test_thesis_truth_is_flagged_not_rejected():
         realisability([1, 2, 3])
 
 
+# ---- persistency of excitation of the two references (A6-A8): which parameters the baseline can learn ----------
+
+
+def _wrb(w, wdot):
+    """W_rb(t) = R(0, 0, ω̇_D, ω_D, 1) (Remark 14, eq. 4.44)."""
+    z = np.zeros(8)
+    return ff.dq.relative_regressor(z, z, wdot, w, [1, 0, 0, 0, 0, 0, 0, 0])
+
+
+def test_pe_matrix_of_example_a_has_rank_4():
+    for t in (0.3, 1.1, 2.5):
+        w = np.array([0, 0, np.sin(t), 0, 0, 1, 0, 0.0])
+        wd = np.array([0, 0, np.cos(t), 0, 0, 0, 0, 0.0])
+        W = _wrb(w, wd)
+        G = W.T @ W
+        c, s = np.cos(t), np.sin(t)
+        # the thesis prints the last entry as sin²t + 1; with v_D constant in D it is sin²t (digest note 13)
+        assert np.allclose(G, np.diag([0, c * c + s**4, 0, c * c, c * c + s**4, 0, s * s]), atol=1e-14)
+        assert np.linalg.matrix_rank(G) == 4
+
+
+def test_pe_matrix_of_example_b_has_rank_2():
+    W = _wrb(np.array([0, 1, 0, 0, 0, 1, 0, 0.0]), np.zeros(8))
+    assert np.allclose(W.T @ W, np.diag([0, 1, 1, 0, 0, 0, 0]), atol=1e-14)
+
+
 # ---- scenarios and bad input -----------------------------------------------------------------------------------
 
 
