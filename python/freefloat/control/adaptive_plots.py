@@ -58,7 +58,8 @@ def plot_all(res, out: Path) -> list[Path]:
         ax.set_title(f"{lab}: singular values of {'P' if res.scenario.mode == 'continuous' else 'Σ R_kᵀR_k'}")
         ax.set_xlabel("t [s]")
         ax.grid(alpha=0.3)
-    fig.suptitle(f"{name}: singular values (Fig. 4.3)")
+    which = "Fig. 4.3" if res.scenario.mode == "continuous" else "not plotted in the thesis for the discrete case"
+    fig.suptitle(f"{name}: singular values ({which})")
     paths.append(_save(plt, fig, out / "singular_values.png"))
 
     fig, axes = plt.subplots(2, 3, figsize=(13, 6), sharex=True, constrained_layout=True)
