@@ -5,6 +5,41 @@ from typing import Any, Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
+class AdaptivePoseController:
+    """Adaptive dual-quaternion pose tracking with concurrent learning (Valverde 2018, ch. 4), to drive from your
+own loop: `control(t, q_bd, w_bd)` gives the dual force `f + ετ` (8,), `update(t, dt, q_bd, w_bd, w_bd_dot,
+force)` records the sample and advances the estimate by dt; `estimate` is `[I11, I12, I13, I22, I23, I33, m]`.
+    """
+    def __init__(self, k_r: ArrayLike, k_q: ArrayLike, k_v: ArrayLike, k_w: ArrayLike, k_i: ArrayLike, alpha: float, learning: ArrayLike = 'continuous', n_s: ArrayLike = 50, sigma_stop: ArrayLike = Ellipsis, selection: ArrayLike = 'elementwise', seed: ArrayLike = 0, law_form: ArrayLike = 'corrected', estimate0: ArrayLike | None = None, reference_angular: ArrayLike | None = None, reference_linear: ArrayLike | None = None, reference_times: ArrayLike | None = None, reference_twists: ArrayLike | None = None) -> None: ...
+    @property
+    def cl_matrix(self) -> Any:
+        """The CL matrix (7, 7): P (continuous) or Σ R_kᵀR_k (discrete)."""
+    @property
+    def cl_vector(self) -> Any:
+        """The CL vector (7,): Q (continuous) or Σ R_kᵀf_k (discrete)."""
+    def control(self, t: ArrayLike, q_bd: ArrayLike, w_bd: ArrayLike, w_di: ArrayLike | None = None, wdot_di: ArrayLike | None = None) -> Any:
+        """The dual control force `f_c^B = f + ετ` (8,) at the pose error `q_bd` (unit) and twist `w_bd`."""
+    @property
+    def estimate(self) -> Any:
+        """The present estimate `[I11, I12, I13, I22, I23, I33, m]`."""
+    def estimate_rate(self, t: ArrayLike, q_bd: ArrayLike, w_bd: ArrayLike, w_di: ArrayLike | None = None, wdot_di: ArrayLike | None = None) -> Any:
+        """`d v(M̂)/dt` (7,) of the update law at this state with the present memory."""
+    def realisability(self) -> Any:
+        """Whether the present estimate is a realisable rigid body (see `inertia_realisability`)."""
+    def reference(self, t: ArrayLike) -> Any:
+        """The desired frame's twist and its rate at t, `(w_di, wdot_di)`, each (8,) in D axes."""
+    @property
+    def singular_values(self) -> Any:
+        """Singular values of the CL matrix (P or Σ R_kᵀR_k), descending."""
+    @property
+    def stack_len(self) -> Any:
+        """Samples in the stack (discrete CL) or None (continuous CL)."""
+    def update(self, t: ArrayLike, dt: float, q_bd: ArrayLike, w_bd: ArrayLike, w_bd_dot: ArrayLike | None = None, force: ArrayLike | None = None, w_di: ArrayLike | None = None, wdot_di: ArrayLike | None = None) -> Any:
+        """One sample period: when `w_bd_dot` (measured ω̇^B_{B/D}) and `force` (the applied dual force) are given,
+record the sample (continuous CL: P += dt RᵀR, Q += dt Rᵀf; discrete CL: offer it to the stack), then
+advance the estimate by dt (forward Euler). Returns the new estimate (7,).
+        """
+
 COMPILED_CPU_FEATURES: list
 
 class DualQuaternion:
@@ -202,6 +237,15 @@ class RecursiveLS:
 def aba(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
     """Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`."""
 
+def adaptive_simulate(truth: ArrayLike, q0: ArrayLike, w0: ArrayLike, estimate0: ArrayLike, k_r: ArrayLike, k_q: ArrayLike, k_v: ArrayLike, k_w: ArrayLike, k_i: ArrayLike, alpha: float, t_final: float, learning: ArrayLike = 'continuous', n_s: ArrayLike = 50, sigma_stop: ArrayLike = Ellipsis, selection: ArrayLike = 'elementwise', seed: ArrayLike = 0, law_form: ArrayLike = 'corrected', reference_angular: ArrayLike | None = None, reference_linear: ArrayLike | None = None, reference_times: ArrayLike | None = None, reference_twists: ArrayLike | None = None, method: str = 'dopri5', dt: float = 0.01, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = Ellipsis, output_dt: ArrayLike = 0.01, max_steps: int = 50000000, rank_tol: ArrayLike = 1e-08, progress: Callable[[float], Any] | None = None) -> Any:
+    """Simulate the closed loop of Valverde 2018 ch. 4 (relative pose-error dynamics (2.58) of a spacecraft with
+mass properties `truth`, adaptive law (4.9) corrected, update law (4.13) or (4.29)) in the engine, and
+return the recorded histories: `t`, `q`, `w`, `estimate`, `force`, `singular_values`, `lyapunov`,
+`position_error`, `attitude_error`, `stack_len`, plus `steps`, `rejected`, `evaluations`, `rank7_time`,
+`stack_changes`, `left_admissible_at`, `admissible_since`, `interrupted`. `progress(t)` is called with the
+simulated time every 200 steps; returning False (or Ctrl-C) stops the run and keeps what was done.
+    """
+
 def base_twist_for_momentum(model: Model, q: ArrayLike, joint_rates: ArrayLike, momentum: ArrayLike | None = None) -> Any:
     """Base velocity (…, nb) — a free base's twist [v; ω] in the base frame, a planar base's [vx, vy, yaw
 rate] — that gives the total momentum `momentum` (6: [p; L about the inertial origin], inertial frame;
@@ -342,6 +386,13 @@ def inertia_com_form(params: ArrayLike) -> Any:
 def inertia_project_consistent(params: ArrayLike, eps: ArrayLike = 1e-09) -> Any:
     """Nearest physically consistent standard parameters (…, 10) (pseudo-inertia eigenvalues clipped at
 `eps`·max; `postcapture::equations::project_consistent`).
+    """
+
+def inertia_realisability(v: ArrayLike) -> Any:
+    """Whether `v = [I11, I12, I13, I22, I23, I33, m]` is the mass and inertia of a rigid body: a dict with
+`realisable`, `admissible` (m > 0 and Ī > 0, enough for the dual inertia to be invertible), `mass_positive`,
+`positive_definite`, `triangle_inequality` (λ_max ≤ sum of the other two principal moments),
+`triangle_margin`, `principal_moments` (ascending) and `failures` (the failing conditions in words).
     """
 
 def inertia_standard_form(mass: ArrayLike, com: ArrayLike, inertia: ArrayLike) -> Any:

@@ -1,6 +1,7 @@
 //! Python bindings of the freefloat engine (module `freefloat._core`). Only conversion and
 //! validation live here; every number is computed in freefloat-core.
 
+mod adaptive;
 mod algorithms;
 mod batch;
 mod cpu;
@@ -76,5 +77,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dq::dq_body_regressor, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_relative_regressor, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_inertia_params, m)?)?;
+    m.add_function(wrap_pyfunction!(adaptive::adaptive_simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(adaptive::inertia_realisability, m)?)?;
+    m.add_class::<adaptive::PyAdaptivePoseController>()?;
     Ok(())
 }

@@ -2,3 +2,5 @@
 //! tracking with concurrent learning (ch. 4), differential dynamic programming for the end effector (ch. 8) and
 //! concurrent-learning mass estimation (ch. 9). Each lives in its own submodule; the numbers they share (the
 //! dual-inertia regressor) are in `dualquat`.
+
+pub mod adaptive;

@@ -4,7 +4,7 @@
 
 mod base_poses;
 mod inputs;
-mod tableau;
+pub(crate) mod tableau;
 mod trajectory;
 
 pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
