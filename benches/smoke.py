@@ -4,7 +4,7 @@ numbers it recorded are checked. Exits non-zero if a script fails (each one abor
 its peer disagree) or a recorded number is out of bounds. Timings are not judged here (a loaded CI machine
 says nothing about speed); the full runs and their tables are in benches/results/.
 
-    python benches/smoke.py                 # all four
+    python benches/smoke.py                 # all of them
     python benches/smoke.py identify dq     # a subset, by name
 
 Pinocchio and Crocoddyl (the `[test]` extra) are needed for compare_pinocchio and excitation_bench; without them
@@ -70,12 +70,21 @@ def _check_dq(out: Path) -> list[str]:
     return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
 
 
+def _check_derivatives(out: Path) -> list[str]:
+    res = json.loads((out / "derivatives_bench.json").read_text())
+    bad = [f"agreement {k} = {v:.3g} > 1e-8" for k, v in res["agreement_max_rel_error"].items() if not v < 1e-8]
+    if set(res["results"]) != {"ch8_spacecraft_wrist", "random_tree_26"}:
+        bad.append(f"unexpected models {sorted(res['results'])}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
     "excitation": ("excitation_bench.py", [], ("pinocchio", "scipy"), _check_excitation),
     "identify": ("identify_vs_numpy.py", ["--repeats", "1"], (), _check_identify),
     "dq": ("dq_dynamics.py", [], (), _check_dq),
+    "derivatives": ("derivatives_bench.py", [], ("pinocchio", "crocoddyl"), _check_derivatives),
 }
 
 

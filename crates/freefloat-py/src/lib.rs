@@ -4,6 +4,7 @@
 mod algorithms;
 mod batch;
 mod cpu;
+mod derivatives;
 mod dq;
 mod dqdynamics;
 mod errors;
@@ -40,6 +41,16 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(algorithms::crba, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::aba, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::hybrid_dynamics, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::aba_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::rnea_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::step, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::step_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::integrate, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::difference, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::integrate_jacobians, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::difference_jacobians, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::frame_log_error_derivatives, m)?)?;
+    m.add_function(wrap_pyfunction!(derivatives::frame_dq_pose_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;

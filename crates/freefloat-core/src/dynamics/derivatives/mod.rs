@@ -84,6 +84,7 @@ pub struct Derivatives {
     pub(crate) doa: Vec<Motion>,
     pub(crate) dff: Vec<Force>,
     pub(crate) in_sub: Vec<bool>,
+    pub(crate) ic: Vec<Inertia>,
     pub(crate) chol: DMatrix<f64>,
     // ---- scratch of the step derivatives
     pub(crate) rk: step::StepWork,
@@ -119,10 +120,18 @@ impl Derivatives {
             doa: vec![Motion::ZERO; n],
             dff: vec![Force::ZERO; n],
             in_sub: vec![false; n],
+            ic: vec![Inertia::zero(); n],
             chol: z(),
             rk: step::StepWork::new(m),
             model_id: m.id(),
         }
+    }
+}
+
+impl Derivatives {
+    /// Identity of the model this workspace was made for (`Model::id`).
+    pub fn model_id(&self) -> u64 {
+        self.model_id
     }
 }
 

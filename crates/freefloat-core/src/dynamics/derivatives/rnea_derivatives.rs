@@ -148,10 +148,45 @@ pub(crate) fn rnea_derivatives_core(
         for c in 0..m.nvs[j] {
             let col_idx = m.idx_v[j] + c;
             let psi = col(&d.os[j], c);
-            direction(m, w, j, psi, true);
-            write_column(m, d, w, j, Some(psi), col_idx, true);
+            if m.parents[j].is_none() {
+                root_q_column(m, d, w, psi, ag, col_idx);
+            } else {
+                direction(m, w, j, psi, true);
+                write_column(m, d, w, j, Some(psi), col_idx, true);
+            }
             direction(m, w, j, psi, false);
             write_column(m, d, w, j, None, col_idx, false);
+        }
+    }
+}
+
+/// ∂τ/∂q along a root-joint direction ψ, in closed form. The whole tree moves rigidly, so every
+/// inertial-frame quantity is covariant (`d x = ψ × x`) except the gravity acceleration a_g, which
+/// stays put: `dFᵢ = ψ ×* Fᵢ − Icᵢ (ψ × a_g)` with Icᵢ the composite inertia of i's subtree, and since
+/// `(ψ × S)ᵀ F + Sᵀ (ψ ×* F) = 0`, `dτᵢ = −Sᵢᵀ Icᵢ (ψ × a_g)`: zero without gravity (orbital robots).
+fn root_q_column(m: &Model, d: &Data, w: &mut Derivatives, psi: Motion, ag: Motion, c: usize) {
+    let n = m.nbodies();
+    let ga = psi.cross_motion(&ag);
+    if c == m.idx_v[0] && ag.lin.norm_squared() + ag.ang.norm_squared() > 0.0 {
+        // composite inertias once per call (first root column), only with gravity
+        for i in 0..n {
+            w.ic[i] = w.oi[i];
+        }
+        for i in (1..n).rev() {
+            if let Some(p) = m.parents[i] {
+                w.ic[p] = w.ic[p].add(&w.ic[i]);
+            }
+        }
+    }
+    let mut colm = w.dtau_dq.column_mut(c);
+    colm.fill(0.0);
+    if ga.lin.norm_squared() + ga.ang.norm_squared() == 0.0 {
+        return;
+    }
+    for i in 0..n {
+        let f = w.ic[i].mul_motion(&ga).to_v6();
+        for r in 0..m.nvs[i] {
+            colm[m.idx_v[i] + r] = -d.os[i].column(r).dot(&f);
         }
     }
 }
