@@ -72,7 +72,7 @@ def random_bodies(n, seed):
                 list(rng.uniform(-3, 3, size=3)),
                 float(rng.uniform(1, 5)),
                 list(rng.uniform(-0.3, 0.3, size=3)),
-                list(rng.uniform(0.2, 0.5, size=3)),
+                list(rng.uniform(0.3, 0.5, size=3)),
             )
         )
     return bodies, (200.0, [40.0, 50.0, 60.0])

@@ -373,3 +373,73 @@ fn bad_arguments_are_rejected() {
     let e = aba_derivatives(&mu, &mut du, &mut wu, &qu, &vu, &vu, None).unwrap_err();
     assert!(err(e).contains("universal"));
 }
+
+/// Per-call times of the derivative routines on the ch. 8 spacecraft (RRR + Z-Y-X wrist, nv = 12), for
+/// profiling: `cargo test --release --test derivatives -- --ignored --nocapture timing`. The benchmark
+/// with peers is benches/derivatives_bench.py.
+#[test]
+#[ignore]
+fn timing_profile() {
+    use freefloat_core::model::{BodySpec, JointLimits, ModelBuilder};
+    use freefloat_core::spatial::{Inertia, M3};
+    let i3 = M3::identity();
+    let mut b =
+        ModelBuilder::new("ch8", "base", JointType::Free, Inertia::from_com(50.0, V3::zeros(), i3 * 10.0)).unwrap();
+    let rx = rpy_to_rot(&V3::new(std::f64::consts::FRAC_PI_2, 0.0, 0.0));
+    let chain = [
+        (V3::z(), Se3::new(M3::identity(), V3::new(0.0, 0.0, 1.0)), 5.0, V3::new(0.0, 0.0, 1.0), i3),
+        (V3::z(), Se3::new(rx, V3::new(0.75, 0.0, 4.0)), 5.0, V3::new(1.5, 0.0, 0.0), i3),
+        (V3::z(), Se3::new(M3::identity(), V3::new(3.0, 0.0, 0.0)), 5.0, V3::new(1.5, 0.0, 0.0), i3),
+        (V3::z(), Se3::new(M3::identity(), V3::new(3.0, 0.0, 0.0)), 0.1, V3::zeros(), i3 * 0.01),
+        (V3::y(), Se3::identity(), 0.1, V3::zeros(), i3 * 0.01),
+        (V3::x(), Se3::identity(), 0.1, V3::zeros(), i3 * 0.01),
+    ];
+    for (k, (axis, pl, mass, com, ic)) in chain.into_iter().enumerate() {
+        b.add_body(BodySpec {
+            name: format!("b{k}"),
+            parent: k,
+            joint_name: format!("j{k}"),
+            joint_type: JointType::Revolute,
+            axis,
+            axis2: V3::x(),
+            placement: pl,
+            inertia: Inertia::from_com(mass, com, ic),
+            limits: JointLimits::default(),
+            tags: vec![],
+            allow_nonphysical: false,
+        })
+        .unwrap();
+    }
+    let m = b.build().unwrap();
+    let mut r = rng(2);
+    let (mut d, mut w) = (Data::new(&m), Derivatives::new(&m));
+    let q = random_q(&m, &mut r);
+    let v = random_vec(m.nv, &mut r);
+    let tau = random_vec(m.nv, &mut r);
+    let n = 20000;
+    let time = |label: &str, f: &mut dyn FnMut()| {
+        let mut best = f64::INFINITY;
+        for _ in 0..5 {
+            let t0 = std::time::Instant::now();
+            for _ in 0..n {
+                f();
+            }
+            best = best.min(t0.elapsed().as_secs_f64() / n as f64 * 1e6);
+        }
+        println!("{label:32} {best:7.2} µs");
+    };
+    time("aba", &mut || aba(&m, &mut d, &q, &v, &tau, None).unwrap());
+    time("rnea_derivatives", &mut || rnea_derivatives(&m, &mut d, &mut w, &q, &v, &tau, None).unwrap());
+    time("aba_derivatives", &mut || aba_derivatives(&m, &mut d, &mut w, &q, &v, &tau, None).unwrap());
+    time("step_derivatives euler", &mut || {
+        step_derivatives(&m, &mut d, &mut w, &q, &v, &tau, 0.05, Scheme::Euler).unwrap()
+    });
+    time("step_derivatives rk4", &mut || {
+        step_derivatives(&m, &mut d, &mut w, &q, &v, &tau, 0.05, Scheme::Rk4).unwrap()
+    });
+    let (mut e, mut jac) = ([0.0; 6], DMatrix::zeros(6, m.nv));
+    let target = Se3::new(rpy_to_rot(&V3::new(0.1, 0.2, 0.3)), V3::new(1.0, 2.0, 3.0));
+    time("frame_log_error_derivatives", &mut || {
+        frame_log_error_derivatives(&m, &mut d, &q, 6, &Se3::identity(), &target, &mut e, &mut jac).unwrap()
+    });
+}

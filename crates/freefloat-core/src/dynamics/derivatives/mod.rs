@@ -162,7 +162,7 @@ pub(crate) fn check_supported(m: &Model) -> Result<()> {
 
 /// `c = α a b + β c` without allocating (nalgebra's dynamic `gemm` packs through a heap buffer);
 /// zero entries of `b` are skipped, which the block-diagonal Jacobians of ⊕ have many of.
-pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn>>(
+pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RStride = nalgebra::U1>>(
     c: &mut nalgebra::Matrix<f64, nalgebra::Dyn, nalgebra::Dyn, S>,
     alpha: f64,
     a: &DMatrix<f64>,
@@ -176,20 +176,19 @@ pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn>>(
     let kk = a.ncols();
     for j in 0..p {
         let mut cj = c.column_mut(j);
+        let cs = cj.as_mut_slice();
         if beta == 0.0 {
-            cj.fill(0.0);
+            cs.fill(0.0);
         } else if beta != 1.0 {
-            cj *= beta;
+            cs.iter_mut().for_each(|x| *x *= beta);
         }
-        for k in 0..kk {
-            let bkj = bsl[j * kk + k];
+        for (k, &bkj) in bsl[j * kk..(j + 1) * kk].iter().enumerate() {
             if bkj == 0.0 {
                 continue;
             }
             let s = alpha * bkj;
-            let ak = &asl[k * n..(k + 1) * n];
-            for i in 0..n {
-                cj[i] += ak[i] * s;
+            for (ci, ai) in cs.iter_mut().zip(&asl[k * n..(k + 1) * n]) {
+                *ci += ai * s;
             }
         }
     }

@@ -280,40 +280,50 @@ fn write_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, psi: Option<
 pub(crate) fn cholesky_inverse(a: &DMatrix<f64>, l: &mut DMatrix<f64>, inv: &mut DMatrix<f64>) -> bool {
     let n = a.nrows();
     l.copy_from(a);
+    // Left-looking, column-major: column j -= Σ_{k<j} L[j,k] L[j.., k], then scale by 1/√pivot.
+    let ls = l.as_mut_slice();
     for j in 0..n {
-        let mut s = l[(j, j)];
         for k in 0..j {
-            s -= l[(j, k)] * l[(j, k)];
+            let ljk = ls[k * n + j];
+            if ljk == 0.0 {
+                continue;
+            }
+            let (left, right) = ls.split_at_mut(j * n);
+            let ck = &left[k * n + j..k * n + n];
+            for (x, y) in right[j..n].iter_mut().zip(ck) {
+                *x -= ljk * y;
+            }
         }
+        let s = ls[j * n + j];
         if !(s > 0.0) || !s.is_finite() {
             return false;
         }
         let dj = s.sqrt();
-        l[(j, j)] = dj;
-        for i in j + 1..n {
-            let mut t = l[(i, j)];
-            for k in 0..j {
-                t -= l[(i, k)] * l[(j, k)];
-            }
-            l[(i, j)] = t / dj;
+        let inv_d = 1.0 / dj;
+        ls[j * n + j] = dj;
+        for x in ls[j * n + j + 1..(j + 1) * n].iter_mut() {
+            *x *= inv_d;
         }
     }
-    // inv = L⁻ᵀ L⁻¹, column by column: L y = e_c, then Lᵀ x = y.
+    // inv = L⁻ᵀ L⁻¹, column by column: L y = e_c (forward, by columns), then Lᵀ x = y (dot products).
+    let ls = l.as_slice();
+    let is = inv.as_mut_slice();
     for c in 0..n {
-        let mut x = inv.column_mut(c);
-        for i in 0..n {
-            let mut t = if i == c { 1.0 } else { 0.0 };
-            for k in c..i {
-                t -= l[(i, k)] * x[k];
+        let x = &mut is[c * n..(c + 1) * n];
+        x.fill(0.0);
+        x[c] = 1.0;
+        for k in c..n {
+            let yk = x[k] / ls[k * n + k];
+            x[k] = yk;
+            if yk != 0.0 {
+                for (xi, li) in x[k + 1..].iter_mut().zip(&ls[k * n + k + 1..(k + 1) * n]) {
+                    *xi -= yk * li;
+                }
             }
-            x[i] = if i < c { 0.0 } else { t / l[(i, i)] };
         }
         for i in (0..n).rev() {
-            let mut t = x[i];
-            for k in i + 1..n {
-                t -= l[(k, i)] * x[k];
-            }
-            x[i] = t / l[(i, i)];
+            let t: f64 = x[i + 1..].iter().zip(&ls[i * n + i + 1..(i + 1) * n]).map(|(a, b)| a * b).sum();
+            x[i] = (x[i] - t) / ls[i * n + i];
         }
     }
     true
