@@ -83,7 +83,12 @@ AXES = {"x": [1, 0, 0], "y": [0, 1, 0], "z": [0, 0, 1]}
 
 def to_yaml(name, bodies, base):
     bm, bi = base
-    lines = [f"name: {name}", "base: free", "bodies:", f"  - {{name: base, inertial: {{mass: {bm}, com: [0, 0, 0], inertia: {bi}}}}}"]
+    lines = [
+        f"name: {name}",
+        "base: free",
+        "bodies:",
+        f"  - {{name: base, inertial: {{mass: {bm}, com: [0, 0, 0], inertia: {bi}}}}}",
+    ]
     names = ["base"] + [b[0] for b in bodies]
     for nm, parent, ax, xyz, rpy, mass, com, inertia in bodies:
         lines.append(
@@ -147,9 +152,23 @@ def crocoddyl_problem(pm, dt, n, rk4, with_costs, refs):
         if with_costs:
             # the baseline's terms: frame placement (weighted), base twist (state residual), control
             wp = np.r_[[156 / 4] * 3, [312 / 4] * 3]
-            costs.addCost("ee", croc.CostModelResidual(state, croc.ActivationModelWeightedQuad(wp), croc.ResidualModelFramePlacement(state, fid, refs[k], act.nu)), 1.0)
+            costs.addCost(
+                "ee",
+                croc.CostModelResidual(
+                    state,
+                    croc.ActivationModelWeightedQuad(wp),
+                    croc.ResidualModelFramePlacement(state, fid, refs[k], act.nu),
+                ),
+                1.0,
+            )
             wx = np.r_[np.zeros(pm.nv), [2.0] * 6, np.zeros(pm.nv - 6)]
-            costs.addCost("vel", croc.CostModelResidual(state, croc.ActivationModelWeightedQuad(wx), croc.ResidualModelState(state, act.nu)), 1.0)
+            costs.addCost(
+                "vel",
+                croc.CostModelResidual(
+                    state, croc.ActivationModelWeightedQuad(wx), croc.ResidualModelState(state, act.nu)
+                ),
+                1.0,
+            )
             costs.addCost("u", croc.CostModelResidual(state, croc.ResidualModelControl(state, act.nu)), 1e-3)
         return croc.DifferentialActionModelFreeFwdDynamics(state, act, costs)
 
@@ -164,8 +183,108 @@ def crocoddyl_problem(pm, dt, n, rk4, with_costs, refs):
     return problem
 
 
+def bench_model(name, bodies, base, n, reps, rng, have_croc, results, agreement, md):
+    """Check against Pinocchio, then time one model; fills results, agreement and md."""
+    import pinocchio as pin
+
+    m = ff.Model.from_yaml_string(to_yaml(name, bodies, base))
+    pm = to_pinocchio(bodies, base)
+    pd = pm.createData()
+    nv = m.nv
+    Q, V, T = states(nv, n, rng)
+    # agreement with Pinocchio first
+    worst = 0.0
+    for k in range(min(n, 20)):
+        ours = D.aba_derivatives(m, Q[k], V[k], T[k])
+        theirs = pin.computeABADerivatives(pm, pd, Q[k], V[k], T[k])
+        for a, b in zip(ours, theirs):
+            b = np.asarray(b)
+            if b is theirs[2]:
+                b = np.triu(b) + np.triu(b, 1).T
+            worst = max(worst, float(np.abs(a - b).max() / max(1.0, np.abs(b).max())))
+    agreement[name] = worst
+    if not worst < 1e-8:
+        sys.exit(f"{name}: freefloat's ABA derivatives differ from Pinocchio's by {worst:.3g} (relative)")
+
+    timings = {
+        k: [] for k in ("ff_aba_derivatives_call", "pin_computeABADerivatives_call", "ff_aba_derivatives_stacked")
+    }
+    croc_runs = {}
+    if name.startswith("ch8"):
+        dt = 0.05
+        refs = []
+        for k in range(n + 1):
+            pin.framesForwardKinematics(pm, pd, Q[k % n])
+            refs.append(pd.oMf[pm.getFrameId("ee")].copy())
+        target = np.array([pin.SE3ToXYZQUAT(refs[k]) for k in range(n)])
+        for k in ("ff_euler_block_stacked", "ff_rk4_block_stacked"):
+            timings[k] = []
+        if have_croc:
+            xs = [np.r_[Q[k % n], V[k % n]] for k in range(n + 1)]
+            us = [T[k] for k in range(n)]
+            for label, rk4, costs in (
+                ("euler_costs", False, True),
+                ("euler_nocost", False, False),
+                ("rk4_costs", True, True),
+            ):
+                prob = crocoddyl_problem(pm, dt, n, rk4, costs, refs)
+                prob.calc(xs, us)
+                croc_runs[label] = prob
+                timings[f"croc_calcDiff_{label}"] = []
+
+    for _ in range(reps):
+        timings["ff_aba_derivatives_call"].append(
+            per_item(lambda: [D.aba_derivatives(m, Q[k], V[k], T[k]) for k in range(n)], n)
+        )
+        timings["pin_computeABADerivatives_call"].append(
+            per_item(lambda: [pin.computeABADerivatives(pm, pd, Q[k], V[k], T[k]) for k in range(n)], n)
+        )
+        timings["ff_aba_derivatives_stacked"].append(per_item(lambda: D.aba_derivatives(m, Q, V, T), n))
+        if name.startswith("ch8"):
+            timings["ff_euler_block_stacked"].append(
+                per_item(
+                    lambda: (D.step_derivatives(m, Q, V, T, dt), D.frame_log_error_derivatives(m, Q, "ee", target)), n
+                )
+            )
+            timings["ff_rk4_block_stacked"].append(
+                per_item(
+                    lambda: (
+                        D.step_derivatives(m, Q, V, T, dt, method="rk4"),
+                        D.frame_log_error_derivatives(m, Q, "ee", target),
+                    ),
+                    n,
+                )
+            )
+            for label, prob in croc_runs.items():
+                # calc before calcDiff is what a DDP iteration does; only calcDiff is timed
+                timings[f"croc_calcDiff_{label}"].append(per_item(lambda p=prob: p.calcDiff(xs, us), n + 1))
+    res = {k: stats(v) for k, v in timings.items()}
+    results[name] = {"nv": nv, "timings": res}
+    med = {k: v["median_us"] for k, v in res.items()}
+    ratios = {
+        "ff_call_over_pin_call": med["ff_aba_derivatives_call"] / med["pin_computeABADerivatives_call"],
+        "ff_stacked_over_pin_call": med["ff_aba_derivatives_stacked"] / med["pin_computeABADerivatives_call"],
+    }
+    if "croc_calcDiff_euler_costs" in med:
+        ratios["ff_euler_block_over_croc_calcDiff"] = med["ff_euler_block_stacked"] / med["croc_calcDiff_euler_costs"]
+        ratios["ff_euler_block_over_croc_calcDiff_nocost"] = (
+            med["ff_euler_block_stacked"] / med["croc_calcDiff_euler_nocost"]
+        )
+        ratios["ff_rk4_block_over_croc_rk4_calcDiff"] = med["ff_rk4_block_stacked"] / med["croc_calcDiff_rk4_costs"]
+    results[name]["ratios"] = ratios
+    md.append(f"\n### {name} (nv = {nv}), {n} states x {reps} repeats, µs per state: median (min-max)\n")
+    md.append("| call | median | min | max |\n|---|---:|---:|---:|")
+    for k, v in res.items():
+        md.append(f"| `{k}` | {v['median_us']:.2f} | {v['min_us']:.2f} | {v['max_us']:.2f} |")
+    md.append("\n" + ", ".join(f"{k} = {v:.2f}" for k, v in ratios.items()))
+    print(f"{name}: " + ", ".join(f"{k} {v['median_us']:.2f} µs" for k, v in res.items()))
+    print("   ratios: " + ", ".join(f"{k} {v:.2f}" for k, v in ratios.items()))
+
+
 def main(argv=None):
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap = argparse.ArgumentParser(
+        description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     ap.add_argument("--quick", action="store_true", help="few states and repeats (a smoke run, not a measurement)")
     ap.add_argument("--states", type=int, default=None, help="states per repeat (default 640, quick 40)")
     ap.add_argument("--repeats", type=int, default=None, help="interleaved repeats (default 7, quick 2)")
@@ -186,74 +305,14 @@ def main(argv=None):
     models = {"ch8_spacecraft_wrist": ch8_bodies(), "random_tree_26": random_bodies(20, 1)}
     results, agreement, md = {}, {}, []
     for name, (bodies, base) in models.items():
-        m = ff.Model.from_yaml_string(to_yaml(name, bodies, base))
-        pm = to_pinocchio(bodies, base)
-        pd = pm.createData()
-        nv = m.nv
-        Q, V, T = states(nv, n, rng)
-        # agreement with Pinocchio first
-        worst = 0.0
-        for k in range(min(n, 20)):
-            ours = D.aba_derivatives(m, Q[k], V[k], T[k])
-            theirs = pin.computeABADerivatives(pm, pd, Q[k], V[k], T[k])
-            for a, b in zip(ours, theirs):
-                b = np.asarray(b)
-                if b is theirs[2]:
-                    b = np.triu(b) + np.triu(b, 1).T
-                worst = max(worst, float(np.abs(a - b).max() / max(1.0, np.abs(b).max())))
-        agreement[name] = worst
-        if not worst < 1e-8:
-            sys.exit(f"{name}: freefloat's ABA derivatives differ from Pinocchio's by {worst:.3g} (relative)")
-
-        timings = {k: [] for k in ("ff_aba_derivatives_call", "pin_computeABADerivatives_call", "ff_aba_derivatives_stacked")}
-        croc_runs = {}
-        if name.startswith("ch8"):
-            dt = 0.05
-            refs = []
-            for k in range(n + 1):
-                pin.framesForwardKinematics(pm, pd, Q[k % n])
-                refs.append(pd.oMf[pm.getFrameId("ee")].copy())
-            target = np.array([pin.SE3ToXYZQUAT(refs[k]) for k in range(n)])
-            for k in ("ff_euler_block_stacked", "ff_rk4_block_stacked"):
-                timings[k] = []
-            if have_croc:
-                xs = [np.r_[Q[k % n], V[k % n]] for k in range(n + 1)]
-                us = [T[k] for k in range(n)]
-                for label, rk4, costs in (("euler_costs", False, True), ("euler_nocost", False, False), ("rk4_costs", True, True)):
-                    prob = crocoddyl_problem(pm, dt, n, rk4, costs, refs)
-                    prob.calc(xs, us)
-                    croc_runs[label] = prob
-                    timings[f"croc_calcDiff_{label}"] = []
-
-        for _ in range(reps):
-            timings["ff_aba_derivatives_call"].append(per_item(lambda: [D.aba_derivatives(m, Q[k], V[k], T[k]) for k in range(n)], n))
-            timings["pin_computeABADerivatives_call"].append(per_item(lambda: [pin.computeABADerivatives(pm, pd, Q[k], V[k], T[k]) for k in range(n)], n))
-            timings["ff_aba_derivatives_stacked"].append(per_item(lambda: D.aba_derivatives(m, Q, V, T), n))
-            if name.startswith("ch8"):
-                timings["ff_euler_block_stacked"].append(per_item(lambda: (D.step_derivatives(m, Q, V, T, dt), D.frame_log_error_derivatives(m, Q, "ee", target)), n))
-                timings["ff_rk4_block_stacked"].append(per_item(lambda: (D.step_derivatives(m, Q, V, T, dt, method="rk4"), D.frame_log_error_derivatives(m, Q, "ee", target)), n))
-                for label, prob in croc_runs.items():
-                    # calc before calcDiff is what a DDP iteration does; only calcDiff is timed
-                    timings[f"croc_calcDiff_{label}"].append(per_item(lambda p=prob: p.calcDiff(xs, us), n + 1))
-        res = {k: stats(v) for k, v in timings.items()}
-        results[name] = {"nv": nv, "timings": res}
-        med = {k: v["median_us"] for k, v in res.items()}
-        ratios = {"ff_call_over_pin_call": med["ff_aba_derivatives_call"] / med["pin_computeABADerivatives_call"], "ff_stacked_over_pin_call": med["ff_aba_derivatives_stacked"] / med["pin_computeABADerivatives_call"]}
-        if "croc_calcDiff_euler_costs" in med:
-            ratios["ff_euler_block_over_croc_calcDiff"] = med["ff_euler_block_stacked"] / med["croc_calcDiff_euler_costs"]
-            ratios["ff_euler_block_over_croc_calcDiff_nocost"] = med["ff_euler_block_stacked"] / med["croc_calcDiff_euler_nocost"]
-            ratios["ff_rk4_block_over_croc_rk4_calcDiff"] = med["ff_rk4_block_stacked"] / med["croc_calcDiff_rk4_costs"]
-        results[name]["ratios"] = ratios
-        md.append(f"\n### {name} (nv = {nv}), {n} states x {reps} repeats, µs per state: median (min-max)\n")
-        md.append("| call | median | min | max |\n|---|---:|---:|---:|")
-        for k, v in res.items():
-            md.append(f"| `{k}` | {v['median_us']:.2f} | {v['min_us']:.2f} | {v['max_us']:.2f} |")
-        md.append("\n" + ", ".join(f"{k} = {v:.2f}" for k, v in ratios.items()))
-        print(f"{name}: " + ", ".join(f"{k} {v['median_us']:.2f} µs" for k, v in res.items()))
-        print("   ratios: " + ", ".join(f"{k} {v:.2f}" for k, v in ratios.items()))
+        bench_model(name, bodies, base, n, reps, rng, have_croc, results, agreement, md)
 
     out = {
-        "machine": {"python": sys.version.split()[0], "platform": platform.platform(), "processor": platform.processor()},
+        "machine": {
+            "python": sys.version.split()[0],
+            "platform": platform.platform(),
+            "processor": platform.processor(),
+        },
         "versions": {"freefloat": ff.__version__, "pinocchio": pin.__version__},
         "states": n,
         "repeats": reps,
@@ -264,7 +323,9 @@ def main(argv=None):
     if args.out:
         args.out.mkdir(parents=True, exist_ok=True)
         (args.out / "derivatives_bench.json").write_text(json.dumps(out, indent=2))
-        (args.out / "derivatives_bench.md").write_text("# freefloat dynamics derivatives vs Pinocchio and Crocoddyl\n" + "\n".join(md) + "\n")
+        (args.out / "derivatives_bench.md").write_text(
+            "# freefloat dynamics derivatives vs Pinocchio and Crocoddyl\n" + "\n".join(md) + "\n"
+        )
     return 0
 
 

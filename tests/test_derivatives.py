@@ -32,7 +32,9 @@ SEEDS = range(24)
 def case(seed):
     rng = np.random.default_rng(7_000 + seed)
     base = rt.BASE_TYPES[seed % 3]
-    d = rt.random_tree(rng, name=f"deriv_tree_{seed}", base=base, joint_types=NO_UNIVERSAL, joint_p=(0.35, 0.15, 0.15, 0.15, 0.2))
+    d = rt.random_tree(
+        rng, name=f"deriv_tree_{seed}", base=base, joint_types=NO_UNIVERSAL, joint_p=(0.35, 0.15, 0.15, 0.15, 0.2)
+    )
     return d, ff.Model.from_yaml_string(d.to_yaml()), rt.build_pinocchio(d)
 
 
@@ -92,7 +94,10 @@ def test_tangent_convention_matches_pinocchio_to_first_order(seed):
     tau = rng.normal(size=d.nv)
     da_dq, _, _ = D.aba_derivatives(m, q, rng.normal(size=d.nv) * 0, tau)
     h = 1e-6
-    fd = (ff.aba(m, D.integrate(m, q, h * dv), np.zeros(d.nv), tau) - ff.aba(m, D.integrate(m, q, -h * dv), np.zeros(d.nv), tau)) / (2 * h)
+    fd = (
+        ff.aba(m, D.integrate(m, q, h * dv), np.zeros(d.nv), tau)
+        - ff.aba(m, D.integrate(m, q, -h * dv), np.zeros(d.nv), tau)
+    ) / (2 * h)
     assert_close(da_dq @ dv, fd, rtol=1e-6, atol=1e-8, what="da/dq along a tangent vector")
 
 
@@ -128,7 +133,8 @@ bodies:
   - {name: base, inertial: {mass: 50, com: [0, 0, 0], inertia: [10, 10, 10]}}
   - {name: waist, parent: base, joint: {type: revolute, axis: [0, 0, 1]}, origin: {xyz: [0, 0, 1]},
      inertial: {mass: 5, com: [0, 0, 1], inertia: [1, 1, 1]}}
-  - {name: shoulder, parent: waist, joint: {type: revolute, axis: [0, 0, 1]}, origin: {xyz: [0.75, 0, 4], rpy: [1.5707963267948966, 0, 0]},
+  - {name: shoulder, parent: waist, joint: {type: revolute, axis: [0, 0, 1]},
+     origin: {xyz: [0.75, 0, 4], rpy: [1.5707963267948966, 0, 0]},
      inertial: {mass: 5, com: [1.5, 0, 0], inertia: [1, 1, 1]}}
   - {name: elbow, parent: shoulder, joint: {type: revolute, axis: [0, 0, 1]}, origin: {xyz: [3, 0, 0]},
      inertial: {mass: 5, com: [1.5, 0, 0], inertia: [1, 1, 1]}}
@@ -218,7 +224,9 @@ def test_euler_step_derivatives_match_crocoddyl(dt):
 
 def test_euler_step_derivatives_match_crocoddyl_exactly_on_a_fixed_base():
     rng = np.random.default_rng(5)
-    d = rt.random_tree(rng, name="fixed_chain", base="fixed", n_children=6, joint_types=("revolute", "prismatic"), joint_p=(0.7, 0.3))
+    d = rt.random_tree(
+        rng, name="fixed_chain", base="fixed", n_children=6, joint_types=("revolute", "prismatic"), joint_p=(0.7, 0.3)
+    )
     for i, b in enumerate(d.bodies[1:], start=1):
         b.parent = i - 1  # a chain: Pinocchio's depth-first order is ours
     m, p = ff.Model.from_yaml_string(d.to_yaml()), rt.build_pinocchio(d)
@@ -250,9 +258,16 @@ def test_step_derivatives_match_finite_differences(method):
     for k in range(nv):
         e = np.zeros(nv)
         e[k] = h
-        fd_x[:, k] = (err(*D.step(m, D.integrate(m, q, e), v, tau, dt, method=method)) - err(*D.step(m, D.integrate(m, q, -e), v, tau, dt, method=method))) / (2 * h)
-        fd_x[:, nv + k] = (err(*D.step(m, q, v + e, tau, dt, method=method)) - err(*D.step(m, q, v - e, tau, dt, method=method))) / (2 * h)
-        fd_u[:, k] = (err(*D.step(m, q, v, tau + e, dt, method=method)) - err(*D.step(m, q, v, tau - e, dt, method=method))) / (2 * h)
+        fd_x[:, k] = (
+            err(*D.step(m, D.integrate(m, q, e), v, tau, dt, method=method))
+            - err(*D.step(m, D.integrate(m, q, -e), v, tau, dt, method=method))
+        ) / (2 * h)
+        fd_x[:, nv + k] = (
+            err(*D.step(m, q, v + e, tau, dt, method=method)) - err(*D.step(m, q, v - e, tau, dt, method=method))
+        ) / (2 * h)
+        fd_u[:, k] = (
+            err(*D.step(m, q, v, tau + e, dt, method=method)) - err(*D.step(m, q, v, tau - e, dt, method=method))
+        ) / (2 * h)
     assert_close(Fx, fd_x, rtol=1e-6, atol=1e-8, what=f"Fx ({method})")
     assert_close(Fu, fd_u, rtol=1e-6, atol=1e-8, what=f"Fu ({method})")
 

@@ -416,7 +416,7 @@ fn timing_profile() {
     let q = random_q(&m, &mut r);
     let v = random_vec(m.nv, &mut r);
     let tau = random_vec(m.nv, &mut r);
-    let n = 20000;
+    let n = 2000;
     let time = |label: &str, f: &mut dyn FnMut()| {
         let mut best = f64::INFINITY;
         for _ in 0..5 {

@@ -143,7 +143,43 @@ pub(crate) fn rnea_derivatives_core(
         }
     }
 
-    // One forward-mode pass per tangent direction (joint j, column c).
+    // ∂τ/∂v in closed form. A unit rate e = Sⱼ,c of joint j adds e to every twist of j's subtree
+    // (dvᵢ = e) and changes the accelerations by daᵢ = e × (vᵢ − wⱼ), wⱼ = v_λ(j) + vⱼ (the chain rule
+    // through aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ). So dfᵢ = Bᵢ e − Iᵢ (e × wⱼ) with the per-body linear map
+    // Bᵢ e = Iᵢ (e × vᵢ) + e ×* (Iᵢ vᵢ) + vᵢ ×* (Iᵢ e), and summed over a subtree
+    // dFₖ = Bcₖ e − Icₖ (e × wⱼ) with the composites Bc, Ic: dτᵢ = Sᵢᵀ dF_{i or j, the deeper}.
+    for i in 0..n {
+        let (ov, h, oi) = (w.ov[i], w.h[i], w.oi[i]);
+        for k in 0..6 {
+            let mut e = Motion::ZERO;
+            if k < 3 {
+                e.lin[k] = 1.0;
+            } else {
+                e.ang[k - 3] = 1.0;
+            }
+            let b = oi.mul_motion(&e.cross_motion(&ov)) + e.cross_force(&h) + ov.cross_force(&oi.mul_motion(&e));
+            w.bc[i].set_column(k, &b.to_v6());
+        }
+        w.ic[i] = oi;
+    }
+    for i in (1..n).rev() {
+        if let Some(p) = m.parents[i] {
+            let b = w.bc[i];
+            w.bc[p] += b;
+            w.ic[p] = w.ic[p].add(&w.ic[i]);
+        }
+    }
+    for i in 0..n {
+        for r in 0..m.nvs[i] {
+            let s = col(&d.os[i], r);
+            let sb = w.bc[i].transpose() * s.to_v6();
+            w.sb[i].set_column(r, &sb);
+            let si = w.ic[i].mul_motion(&s).to_v6();
+            w.si[i].set_column(r, &si);
+        }
+    }
+
+    // ∂τ/∂q: one forward-mode pass per tangent direction (joint j, column c).
     for j in 0..n {
         for c in 0..m.nvs[j] {
             let col_idx = m.idx_v[j] + c;
@@ -151,12 +187,42 @@ pub(crate) fn rnea_derivatives_core(
             if m.parents[j].is_none() {
                 root_q_column(m, d, w, psi, ag, col_idx);
             } else {
-                direction(m, w, j, psi, true);
-                write_column(m, d, w, j, Some(psi), col_idx, true);
+                direction(m, w, j, psi);
+                write_column(m, d, w, j, psi, col_idx);
             }
-            direction(m, w, j, psi, false);
-            write_column(m, d, w, j, None, col_idx, false);
+            dtau_dv_column(m, d, w, j, psi, col_idx);
         }
+    }
+}
+
+/// Column of ∂τ/∂v for the unit rate along e = Sⱼ,c (see the closed form above).
+fn dtau_dv_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, e: Motion, c: usize) {
+    let n = m.nbodies();
+    let wj = match m.parents[j] {
+        Some(p) => w.ov[p] + w.ov[j],
+        None => w.ov[j],
+    };
+    let z = e.cross_motion(&wj).to_v6();
+    let e6 = e.to_v6();
+    let mut colm = w.dtau_dv.column_mut(c);
+    colm.fill(0.0);
+    for i in j..n {
+        let inside = i == j || m.parents[i].is_some_and(|p| p >= j && w.in_sub[p]);
+        w.in_sub[i] = inside;
+        if !inside {
+            continue;
+        }
+        for r in 0..m.nvs[i] {
+            colm[m.idx_v[i] + r] = w.sb[i].column(r).dot(&e6) - w.si[i].column(r).dot(&z);
+        }
+    }
+    let xj = w.bc[j] * e6 - w.ic[j].mul_motion(&Motion::from_v6(&z)).to_v6();
+    let mut k = m.parents[j];
+    while let Some(p) = k {
+        for r in 0..m.nvs[p] {
+            colm[m.idx_v[p] + r] = d.os[p].column(r).dot(&xj);
+        }
+        k = m.parents[p];
     }
 }
 
@@ -167,17 +233,7 @@ pub(crate) fn rnea_derivatives_core(
 fn root_q_column(m: &Model, d: &Data, w: &mut Derivatives, psi: Motion, ag: Motion, c: usize) {
     let n = m.nbodies();
     let ga = psi.cross_motion(&ag);
-    if c == m.idx_v[0] && ag.lin.norm_squared() + ag.ang.norm_squared() > 0.0 {
-        // composite inertias once per call (first root column), only with gravity
-        for i in 0..n {
-            w.ic[i] = w.oi[i];
-        }
-        for i in (1..n).rev() {
-            if let Some(p) = m.parents[i] {
-                w.ic[p] = w.ic[p].add(&w.ic[i]);
-            }
-        }
-    }
+    // w.ic holds the composite inertias (computed with the ∂τ/∂v maps)
     let mut colm = w.dtau_dq.column_mut(c);
     colm.fill(0.0);
     if ga.lin.norm_squared() + ga.ang.norm_squared() == 0.0 {
@@ -191,11 +247,11 @@ fn root_q_column(m: &Model, d: &Data, w: &mut Derivatives, psi: Motion, ag: Moti
     }
 }
 
-/// Forward-mode sweep over the subtree of `j` for one direction: `wrt_q` = perturbation of joint j's
-/// configuration along ψ (the subtree moves rigidly with twist ψ), else a unit rate along ψ.
-/// Leaves the subtree-summed force derivatives in `w.dff` (subtree of j only).
+/// Forward-mode sweep over the subtree of `j` for a perturbation of joint j's configuration along
+/// ψ (the subtree moves rigidly with twist ψ). Leaves the subtree-summed force derivatives in
+/// `w.dff` (subtree of j only).
 #[inline]
-fn direction(m: &Model, w: &mut Derivatives, j: usize, psi: Motion, wrt_q: bool) {
+fn direction(m: &Model, w: &mut Derivatives, j: usize, psi: Motion) {
     let n = m.nbodies();
     for i in j..n {
         let inside = i == j || m.parents[i].is_some_and(|p| p >= j && w.in_sub[p]);
@@ -210,27 +266,18 @@ fn direction(m: &Model, w: &mut Derivatives, j: usize, psi: Motion, wrt_q: bool)
         let (ov, vj, oa) = (w.ov[i], w.vj[i], w.oa[i]);
         let oi = &w.oi[i];
         let h = w.h[i];
-        let df;
-        let (dov, doa);
-        if wrt_q {
-            // Everything fixed to body i turns with ψ: d(Sq̇) = ψ × Sq̇, d(Sq̈) = ψ × Sq̈,
-            // d(I x) = ψ ×* (I x) − I (ψ × x), d(fext) = ψ ×* fext.
-            let dvj = psi.cross_motion(&vj);
-            let daj = psi.cross_motion(&w.aj[i]);
-            dov = dvp + dvj;
-            doa = dap + daj + dov.cross_motion(&vj) + ov.cross_motion(&dvj);
-            let dh = psi.cross_force(&h) + oi.mul_motion(&(dov - psi.cross_motion(&ov)));
-            df = psi.cross_force(&w.g[i])
-                + oi.mul_motion(&(doa - psi.cross_motion(&oa)))
-                + dov.cross_force(&h)
-                + ov.cross_force(&dh)
-                - psi.cross_force(&w.fe[i]);
-        } else {
-            let dvj = if i == j { psi } else { Motion::ZERO };
-            dov = dvp + dvj;
-            doa = dap + dov.cross_motion(&vj) + ov.cross_motion(&dvj);
-            df = oi.mul_motion(&doa) + dov.cross_force(&h) + ov.cross_force(&oi.mul_motion(&dov));
-        }
+        // Everything fixed to body i turns with ψ: d(Sq̇) = ψ × Sq̇, d(Sq̈) = ψ × Sq̈,
+        // d(I x) = ψ ×* (I x) − I (ψ × x), d(fext) = ψ ×* fext.
+        let dvj = psi.cross_motion(&vj);
+        let daj = psi.cross_motion(&w.aj[i]);
+        let dov = dvp + dvj;
+        let doa = dap + daj + dov.cross_motion(&vj) + ov.cross_motion(&dvj);
+        let dh = psi.cross_force(&h) + oi.mul_motion(&(dov - psi.cross_motion(&ov)));
+        let df = psi.cross_force(&w.g[i])
+            + oi.mul_motion(&(doa - psi.cross_motion(&oa)))
+            + dov.cross_force(&h)
+            + ov.cross_force(&dh)
+            - psi.cross_force(&w.fe[i]);
         w.dov[i] = dov;
         w.doa[i] = doa;
         w.dff[i] = df;
@@ -244,11 +291,11 @@ fn direction(m: &Model, w: &mut Derivatives, j: usize, psi: Motion, wrt_q: bool)
     }
 }
 
-/// Write one column of ∂τ/∂q (`psi` given) or ∂τ/∂v from the sweep's force derivatives:
+/// Write one column of ∂τ/∂q from the sweep's force derivatives:
 /// `dτᵢ = (ψ × Sᵢ)ᵀ Fᵢ + Sᵢᵀ dFᵢ` in the subtree, `Sᵢᵀ dFⱼ` on the ancestors of j, 0 elsewhere.
-fn write_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, psi: Option<Motion>, c: usize, wrt_q: bool) {
+fn write_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, psi: Motion, c: usize) {
     let n = m.nbodies();
-    let out = if wrt_q { &mut w.dtau_dq } else { &mut w.dtau_dv };
+    let out = &mut w.dtau_dq;
     let mut colm = out.column_mut(c);
     colm.fill(0.0);
     for i in j..n {
@@ -258,11 +305,7 @@ fn write_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, psi: Option<
         let df = w.dff[i].to_v6();
         for r in 0..m.nvs[i] {
             let s = col(&d.os[i], r);
-            let mut x = s.to_v6().dot(&df);
-            if let Some(psi) = psi {
-                x += psi.cross_motion(&s).dot(&w.ff[i]);
-            }
-            colm[m.idx_v[i] + r] = x;
+            colm[m.idx_v[i] + r] = s.to_v6().dot(&df) + psi.cross_motion(&s).dot(&w.ff[i]);
         }
     }
     let dfj = w.dff[j].to_v6();
