@@ -80,6 +80,14 @@ def _check_adaptive(out: Path) -> list[str]:
     return bad
 
 
+def _check_derivatives(out: Path) -> list[str]:
+    res = json.loads((out / "derivatives_bench.json").read_text())
+    bad = [f"agreement {k} = {v:.3g} > 1e-8" for k, v in res["agreement_max_rel_error"].items() if not v < 1e-8]
+    if set(res["results"]) != {"ch8_spacecraft_wrist", "random_tree_26"}:
+        bad.append(f"unexpected models {sorted(res['results'])}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -87,6 +95,7 @@ BENCHES = {
     "identify": ("identify_vs_numpy.py", ["--repeats", "1"], (), _check_identify),
     "dq": ("dq_dynamics.py", [], (), _check_dq),
     "adaptive": ("adaptive_bench.py", [], ("scipy",), _check_adaptive),
+    "derivatives": ("derivatives_bench.py", [], ("pinocchio", "crocoddyl"), _check_derivatives),
 }
 
 

@@ -16,7 +16,7 @@ from . import _cpu
 
 _cpu.check()  # before anything loads the engine: a clear ImportError on too old a processor, not SIGILL
 
-from . import constants, control, dq, identification, io, models, trajectories, viz
+from . import constants, control, derivatives, dq, identification, io, models, trajectories, viz
 from ._core import InputError, ModelError, NumericalError
 from .algorithms import (
     aba,
@@ -42,6 +42,7 @@ from .algorithms import (
     rnea,
     skew,
 )
+from .derivatives import aba_derivatives, rnea_derivatives, step_derivatives
 from .dq import reactions
 from .identification import (
     IdentificationResult,
@@ -65,6 +66,10 @@ __all__ = [
     "Trajectory",
     "models",
     "dq",
+    "derivatives",
+    "aba_derivatives",
+    "rnea_derivatives",
+    "step_derivatives",
     "online",
     "reactions",
     "simulate",

@@ -5,12 +5,18 @@
 //! the cost of N steps). Every count must be 0.
 
 use freefloat_core::dqdynamics::{dq_dynamics, dq_hybrid_dynamics};
+use freefloat_core::dynamics::derivatives::{
+    aba_derivatives, frame_dq_pose_derivatives, frame_log_error_derivatives, rnea_derivatives, step, step_derivatives,
+    Derivatives, Scheme,
+};
 use freefloat_core::dynamics::{aba, crba, hybrid_aba, rnea, Prescribed};
 use freefloat_core::model::builtin;
 use freefloat_core::sim::{simulate_with, Formulation, Inputs, Method, SimOptions, TorqueSource};
+use freefloat_core::spatial::Se3;
 use freefloat_core::Data;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
+use std::cell::RefCell;
 
 struct Counting;
 
@@ -107,6 +113,33 @@ fn hot_paths_allocate_nothing() {
         });
         run("dq_dynamics locked", &mut d, &|d, (q, v, u)| {
             dq_dynamics(&m, d, q, v, u, None, Some(&mask)).expect("dq locked");
+        });
+        let w = RefCell::new(Derivatives::new(&m));
+        run("aba_derivatives", &mut d, &|d, (q, v, u)| {
+            aba_derivatives(&m, d, &mut w.borrow_mut(), q, v, u, Some(&fext)).expect("aba derivatives")
+        });
+        run("rnea_derivatives", &mut d, &|d, (q, v, u)| {
+            rnea_derivatives(&m, d, &mut w.borrow_mut(), q, v, u, None).expect("rnea derivatives")
+        });
+        for scheme in [Scheme::Euler, Scheme::Rk4] {
+            run(&format!("step_derivatives {scheme:?}"), &mut d, &|d, (q, v, u)| {
+                step_derivatives(&m, d, &mut w.borrow_mut(), q, v, u, 0.01, scheme).expect("step derivatives")
+            });
+            run(&format!("step {scheme:?}"), &mut d, &|d, (q, v, u)| {
+                step(&m, d, &mut w.borrow_mut(), q, v, u, 0.01, scheme).expect("step")
+            });
+        }
+        let jac6 = RefCell::new(nalgebra::DMatrix::zeros(6, m.nv));
+        let jac8 = RefCell::new(nalgebra::DMatrix::zeros(8, m.nv));
+        let tip = m.nbodies() - 1;
+        run("frame_log_error_derivatives", &mut d, &|d, (q, _, _)| {
+            let mut e = [0.0; 6];
+            let r = Se3::identity();
+            frame_log_error_derivatives(&m, d, q, tip, &r, &r, &mut e, &mut jac6.borrow_mut()).expect("log error")
+        });
+        run("frame_dq_pose_derivatives", &mut d, &|d, (q, _, _)| {
+            let mut x = [0.0; 8];
+            frame_dq_pose_derivatives(&m, d, q, tip, &Se3::identity(), &mut x, &mut jac8.borrow_mut()).expect("dq pose")
         });
         run("dq_hybrid_dynamics", &mut d, &|d, (q, v, u)| {
             dq_hybrid_dynamics(&m, d, q, v, u, None, &mask, &ddq).expect("dq hybrid");

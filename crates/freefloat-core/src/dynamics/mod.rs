@@ -3,6 +3,7 @@
 
 mod aba;
 mod crba;
+pub mod derivatives;
 mod rnea;
 
 pub(crate) use aba::hybrid_aba_unchecked;
