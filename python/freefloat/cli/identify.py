@@ -27,9 +27,14 @@ def identify_group():
 @click.option(
     "--data",
     type=click.Path(),
-    help="Telemetry file (.parquet or .csv) with columns t, q.<label>, v.<label> "
-    "(labels as in a `freefloat simulate` output) and optionally momentum.px ... momentum.Lz "
-    "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).",
+    help="Telemetry file (.parquet or .csv) with columns t [s], q.<label>, v.<label> (labels as in a "
+    "`freefloat simulate` output: base.x .. base.qw, base.vx .. base.wz, then joint names). "
+    "Orders and frames: q = base position (inertial frame), base quaternion x, y, z, w (w LAST), joint "
+    "angles; v = base linear velocity and base angular velocity both in the BASE (body) frame, then joint "
+    "rates. Optionally momentum.px ... momentum.Lz (total momentum, inertial frame, angular about the "
+    "inertial origin) or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the "
+    "origin); without them the momentum is conserved (h0, zero by default). MuJoCo states (w-first "
+    "quaternion, world-frame linear velocity) must first go through `freefloat convert --from mujoco`.",
 )
 @click.option(
     "--simulate",
@@ -99,10 +104,19 @@ def identify_group():
     help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).",
 )
 @click.option(
+    "--check",
+    type=click.Choice(["error", "warn", "off"]),
+    default="error",
+    show_default=True,
+    help="Convention check before identifying: fit the momentum model to the data as written and with the usual "
+    "mistakes corrected (quaternion w-first, base velocities in the world frame). 'error' stops when a mistake "
+    "explains the data and names it; 'warn' only warns; 'off' skips the check.",
+)
+@click.option(
     "--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf)."
 )
 def identify_minimal_cmd(
-    model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, out
+    model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, check, out
 ):
     """Estimate the minimal inertial parameters of MODEL from motion data.
 
@@ -148,7 +162,11 @@ def identify_minimal_cmd(
     if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results
         Path(out).mkdir(parents=True, exist_ok=True)
         data.to_parquet(Path(out) / "telemetry.parquet")
-    res = idf.identify_minimal(m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig)
+    res = idf.identify_minimal(
+        m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig, check=check
+    )
+    if res.conventions is not None:
+        click.echo(res.conventions.message())
     click.echo(res.table(truth=m if truth else None))
     summary = res.to_dict(truth=m if truth else None)
     if out:

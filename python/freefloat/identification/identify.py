@@ -24,6 +24,7 @@ from .._core import InputError
 from ..constants import TABLE3_RANGE_RAD, TABLE3_START_DEG  # noqa: F401  (re-exported)
 from ..io.telemetry import Telemetry
 from .estimation import LeastSquaresResult, absolute_columns, known_parameters, least_squares, relative_errors
+from .conventions import ConventionReport, check_conventions
 from .minimal import MinimalParameters, minimal_parameters
 
 
@@ -34,6 +35,7 @@ class IdentificationResult:
     mp: MinimalParameters
     fit: LeastSquaresResult
     samples: int
+    conventions: ConventionReport | None = None
 
     @property
     def names(self) -> list[str]:
@@ -97,6 +99,8 @@ class IdentificationResult:
             "solver": self.fit.method,
             "known_bodies": [self.mp.model.body_names[i] for i in self.mp.known],
         }
+        if self.conventions is not None:
+            d["convention_check"] = self.conventions.to_dict()
         if truth is not None:
             d["truth"] = self.truth_values(truth).tolist()
             d.update(self.errors(truth))
@@ -113,7 +117,14 @@ class IdentificationResult:
 
 
 def identify_minimal(
-    model, data, known=None, method: str = "closed-form", h0=None, weights=None, rate_noise=None
+    model,
+    data,
+    known=None,
+    method: str = "closed-form",
+    h0=None,
+    weights=None,
+    rate_noise=None,
+    check: str = "error",
 ) -> IdentificationResult:
     """Identify the minimal parameters of `model` from motion data.
 
@@ -128,7 +139,13 @@ def identify_minimal(
     component's residual variance, and solve again with their inverses (two-step feasible weighted LS).
     rate_noise: standard deviations of the white noise on the measured rates — (nv,) per velocity component, or
     the triple (base linear, base angular, joint) like `telemetry.add_noise` — to remove the errors-in-variables
-    bias of least squares (`bias_compensated`).  Unweighted only."""
+    bias of least squares (`bias_compensated`).  Unweighted only.
+    check: the convention check before identifying (`conventions.check_conventions`: does the momentum model fit
+    the data as written, or only with the quaternion reordered / a velocity rotated?). "error" (default) refuses
+    data that a usual convention mistake explains, naming it, and warns when nothing fits; "warn" only warns;
+    "off" skips it.  Simulated data (a `Trajectory`) are written by freefloat itself and are not checked."""
+    if check not in ("error", "warn", "off"):
+        raise InputError(f"argument `check`: expected 'error', 'warn' or 'off', got {check!r}")
     t, q, v, h = _read(model, data, h0)
     if method == "closed-form":
         try:
@@ -137,6 +154,13 @@ def identify_minimal(
             raise InputError(f"{e} (use method='numeric')") from None
     else:
         mp = minimal_parameters(model, method, known)
+    report = None
+    if check != "off" and not hasattr(data, "ddq") and len(q) > 0:
+        report = check_conventions(mp, q, v, h)
+        if report.cause and check == "error":
+            raise InputError(f"argument `data`: {report.message()} (to identify anyway: check='off', on the command line --check off)")
+        if not report.ok:
+            warnings.warn(report.message(), stacklevel=2)
     if isinstance(weights, str):
         if weights != "auto":
             raise InputError(f"argument `weights`: expected six inverse variances or 'auto', got {weights!r}")
@@ -149,7 +173,7 @@ def identify_minimal(
                 "arguments `weights` and `rate_noise`: the bias compensation is for unweighted least squares"
             )
         fit = bias_compensated(mp, q, v, fit, _rate_sigmas(model, rate_noise))
-    return IdentificationResult(mp=mp, fit=fit, samples=len(t))
+    return IdentificationResult(mp=mp, fit=fit, samples=len(t), conventions=report)
 
 
 #: bias compensation is refused when the rate noise makes up more than this share of the regressor's energy in
