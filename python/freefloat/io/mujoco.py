@@ -36,6 +36,8 @@ from .telemetry import Telemetry
 
 #: MJCF custom text elements carrying freefloat's body tags (wheel, known, ...) through a round trip
 TAG_PREFIX = "freefloat.tags."
+#: ... and the names of fixed joints, which have no MJCF element
+FIXED_PREFIX = "freefloat.fixed_joint."
 
 
 def mujoco_module():
@@ -149,13 +151,15 @@ def _spec_from_mjmodel(mj, text: str, where: str, name: str | None) -> dict:
             f"{where}: expected one body tree under <worldbody>, found {len(roots)} root bodies "
             f"({', '.join(nm(B, b) or str(b) for b in roots)})"
         )
-    tags = {}
+    tags, fixed_names = {}, {}
     for k in range(mj.ntext):
         tn = nm(mujoco.mjtObj.mjOBJ_TEXT, k)
+        a = mj.text_adr[k]
+        raw = bytes(mj.text_data[a : a + mj.text_size[k]]).split(b"\0")[0].decode()
         if tn.startswith(TAG_PREFIX):
-            a = mj.text_adr[k]
-            raw = bytes(mj.text_data[a : a + mj.text_size[k]]).split(b"\0")[0]
-            tags[tn[len(TAG_PREFIX) :]] = raw.decode().split()
+            tags[tn[len(TAG_PREFIX) :]] = raw.split()
+        elif tn.startswith(FIXED_PREFIX):
+            fixed_names[tn[len(FIXED_PREFIX) :]] = raw.strip()
 
     def fmt(x):
         return [float(v) for v in np.asarray(x, dtype=float)]
@@ -193,6 +197,8 @@ def _spec_from_mjmodel(mj, text: str, where: str, name: str | None) -> dict:
                 raise ModelError(f"{where}: body '{bname}': joints {where_j} have different anchors (pos)")
             offset[b] = np.array(anchors.pop()) if anchors else np.zeros(3)
             joint = _joint_spec(mj, js, types, jnames, bname, where, where_j)
+            if not js and fixed_names.get(bname):
+                joint["name"] = fixed_names[bname]
             if joint["name"] in used_names:
                 joint["name"] = f"{bname}_joint"
             used_names.add(joint["name"])
@@ -334,8 +340,9 @@ def state_layout(model, mj) -> list:
             if b < 0 and i == 0 and jt == "free":  # an unnamed free base: the model's only free joint
                 frees = [k for k in range(mj.njnt) if mj.jnt_type[k] == T.mjJNT_FREE]
                 ids = frees if len(frees) == 1 else ids
-            elif b >= 0:
-                ids = list(range(mj.body_jntadr[b], mj.body_jntadr[b] + mj.body_jntnum[b]))
+            elif b >= 0:  # only unnamed MuJoCo joints: a named one with another name is a mismatch to report
+                cand = list(range(mj.body_jntadr[b], mj.body_jntadr[b] + mj.body_jntnum[b]))
+                ids = cand if cand and not any(mujoco.mj_id2name(mj, J, k) for k in cand) else ids
         if len(ids) != len(want) or any(k < 0 for k in ids):
             errors.append(f"'{jn}' ({jt}, body '{bn}')")
             layout.append(None)
@@ -392,6 +399,15 @@ def telemetry_from_mujoco(model, mjmodel, t, qpos, qvel) -> Telemetry:
         if not ids:
             continue
         a, d = mj.jnt_qposadr[ids[0]], mj.jnt_dofadr[ids[0]]
+        if jt in ("free", "spherical"):
+            o = a + (3 if jt == "free" else 0)
+            n = np.linalg.norm(qpos[:, o : o + 4], axis=1)
+            if np.any(np.abs(n - 1) > 1e-6):
+                r = int(np.argmax(np.abs(n - 1) > 1e-6))
+                raise InputError(
+                    f"argument `qpos`: row {r}, columns {o}..{o + 3} (quaternion of joint '{model.joint_names[i]}'): "
+                    f"norm {n[r]:.6g}, not a unit quaternion"
+                )
         if jt == "free":
             q[:, iq : iq + 3] = qpos[:, a : a + 3]
             q[:, iq + 3 : iq + 7] = _xyzw(qpos[:, a + 3 : a + 7])

@@ -24,7 +24,8 @@
 //!   engine does not enforce them either (an enforced limit would add constraint forces);
 //! - a `motor` per 1-DoF joint (gear 1, unlimited), so `ctrl` applies joint torques/forces;
 //! - frames as `site`s; body tags as `<custom><text name="freefloat.tags.BODY" data="t1 t2"/>`, read
-//!   back by `Model.from_mjcf` so wheels and known bodies survive the round trip.
+//!   back by `Model.from_mjcf` so wheels and known bodies survive the round trip (and the names of fixed
+//!   joints, which have no MJCF element, as `freefloat.fixed_joint.BODY`).
 //!
 //! A body MuJoCo would refuse (a moving body with no mass, or an inertia that is not physical: MuJoCo
 //! checks positivity and the triangle inequality) is refused here with the body's name.
@@ -109,8 +110,18 @@ pub fn to_mjcf_string(m: &Model, with_gravity: bool) -> Result<String> {
         let _ = writeln!(s, "  </actuator>");
     }
     let tagged: Vec<usize> = (0..m.nbodies()).filter(|&i| !m.tags[i].is_empty()).collect();
-    if !tagged.is_empty() {
+    // A fixed joint has no MJCF element: its name travels in a custom text like the tags.
+    let fixed: Vec<usize> = (1..m.nbodies()).filter(|&i| m.joint_types[i] == JointType::Fixed).collect();
+    if !tagged.is_empty() || !fixed.is_empty() {
         let _ = writeln!(s, "  <custom>");
+        for &i in &fixed {
+            let _ = writeln!(
+                s,
+                "    <text name=\"freefloat.fixed_joint.{}\" data=\"{}\"/>",
+                xml_escape(&m.body_names[i]),
+                xml_escape(&m.joint_names[i])
+            );
+        }
         for i in tagged {
             let _ = writeln!(
                 s,
