@@ -153,7 +153,8 @@ def test_mujoco_free_joint_conventions():
     R = Rotation.from_quat(np.r_[wxyz[1:], wxyz[0]]).as_matrix()
     np.testing.assert_allclose(d.xmat[1].reshape(3, 3), R, atol=1e-14)
     assert not np.allclose(Rotation.from_quat(wxyz).as_matrix(), R, atol=1e-3)  # the other order is wrong
-    # velocities: mj_objectVelocity (XBODY: the body frame, not the CoM) gives [angular; linear], world (0) or local (1) axes
+    # velocities: mj_objectVelocity (XBODY: at the body frame, not the CoM) gives [angular; linear],
+    # in world (0) or local (1) axes
     world, local = np.zeros(6), np.zeros(6)
     mujoco.mj_objectVelocity(mj, d, mujoco.mjtObj.mjOBJ_XBODY, 1, world, 0)
     mujoco.mj_objectVelocity(mj, d, mujoco.mjtObj.mjOBJ_XBODY, 1, local, 1)

@@ -11,9 +11,7 @@ from ._common import MODEL_HELP, load_model
 
 @click.command("convert", context_settings={"help_option_names": ["-h", "--help"]})
 @click.argument("states", type=click.Path(dir_okay=False))
-@click.option(
-    "--from", "source", type=click.Choice(["mujoco"]), required=True, help="Where STATES come from (MuJoCo)."
-)
+@click.option("--from", "source", type=click.Choice(["mujoco"]), required=True, help="Where STATES come from (MuJoCo).")
 @click.option("--model", "model_spec", required=True, help="The robot: " + MODEL_HELP + ".")
 @click.option(
     "--mjcf",
@@ -51,9 +49,7 @@ def convert_cmd(states, source, model_spec, mjcf_path, out):
         telem.to_parquet(o)
     else:
         telem.to_csv(o)
-    click.echo(
-        f"{len(telem)} samples, t = {telem.t[0]:g} .. {telem.t[-1]:g} s, model {m.name} (nq={m.nq}, nv={m.nv})"
-    )
+    click.echo(f"{len(telem)} samples, t = {telem.t[0]:g} .. {telem.t[-1]:g} s, model {m.name} (nq={m.nq}, nv={m.nv})")
     try:
         import numpy as np
 

@@ -20,7 +20,10 @@ from ._common import MODEL_HELP, load_model
     help="MJCF: write the model's gravity (default zero gravity: an orbiting robot).",
 )
 def export_cmd(model, mjcf_path, urdf_path, gravity):
-    """Write MODEL (""" + MODEL_HELP + """) for another simulator.
+    (
+        """Write MODEL ("""
+        + MODEL_HELP
+        + """) for another simulator.
 
     MJCF: the base gets a free joint, inertias are written at full precision as centre of mass + full inertia
     about it, the compiler neither fuses static bodies nor recomputes or balances inertias, gravity is zero
@@ -28,6 +31,7 @@ def export_cmd(model, mjcf_path, urdf_path, gravity):
     frames become sites. Read the MuJoCo states back with `freefloat convert --from mujoco`.
 
     Example: freefloat export naveen_dual_arm_consistent --mjcf robot.xml"""
+    )
     if not mjcf_path and not urdf_path:
         raise click.UsageError("give --mjcf FILE and/or --urdf FILE")
     m = load_model(model)

@@ -162,9 +162,7 @@ def identify_minimal_cmd(
     if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results
         Path(out).mkdir(parents=True, exist_ok=True)
         data.to_parquet(Path(out) / "telemetry.parquet")
-    res = idf.identify_minimal(
-        m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig, check=check
-    )
+    res = idf.identify_minimal(m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig, check=check)
     if res.conventions is not None:
         click.echo(res.conventions.message())
     click.echo(res.table(truth=m if truth else None))

@@ -63,7 +63,10 @@ class ConventionReport:
 
     @property
     def ok(self) -> bool:
-        return self.cause is None and not self.as_given > RESIDUAL_WARN
+        """No misreading named and the data as given fit (an unexcited fit, residual inf, is left to the
+        identification, which names the unexcited parameters)."""
+        g = self.as_given
+        return self.cause is None and not (np.isfinite(g) and g > RESIDUAL_WARN)
 
     def message(self) -> str:
         g = self.as_given

@@ -23,8 +23,8 @@ import scipy.linalg
 from .._core import InputError
 from ..constants import TABLE3_RANGE_RAD, TABLE3_START_DEG  # noqa: F401  (re-exported)
 from ..io.telemetry import Telemetry
-from .estimation import LeastSquaresResult, absolute_columns, known_parameters, least_squares, relative_errors
 from .conventions import ConventionReport, check_conventions
+from .estimation import LeastSquaresResult, absolute_columns, known_parameters, least_squares, relative_errors
 from .minimal import MinimalParameters, minimal_parameters
 
 
@@ -158,7 +158,10 @@ def identify_minimal(
     if check != "off" and not hasattr(data, "ddq") and len(q) > 0:
         report = check_conventions(mp, q, v, h)
         if report.cause and check == "error":
-            raise InputError(f"argument `data`: {report.message()} (to identify anyway: check='off', on the command line --check off)")
+            raise InputError(
+                f"argument `data`: {report.message()} "
+                "(to identify anyway: check='off', on the command line --check off)"
+            )
         if not report.ok:
             warnings.warn(report.message(), stacklevel=2)
     if isinstance(weights, str):

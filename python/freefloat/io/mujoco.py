@@ -107,7 +107,8 @@ def _spec_from_mjmodel(mj, text: str, where: str, name: str | None) -> dict:
     J, B = mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY
     problems = []
     if mj.ntendon:
-        problems.append(f"{mj.ntendon} tendon(s) ({', '.join(nm(mujoco.mjtObj.mjOBJ_TENDON, i) or str(i) for i in range(mj.ntendon))})")
+        tendons = ", ".join(nm(mujoco.mjtObj.mjOBJ_TENDON, i) or str(i) for i in range(mj.ntendon))
+        problems.append(f"{mj.ntendon} tendon(s) ({tendons})")
     if mj.neq:
         problems.append(f"{mj.neq} equality constraint(s) (closed loops, welds, couplings)")
     if getattr(mj, "nflex", 0):
@@ -122,8 +123,8 @@ def _spec_from_mjmodel(mj, text: str, where: str, name: str | None) -> dict:
         ]
         problems.append(
             f"{len(hits)} geom(s) with contact enabled ({', '.join(names)}{', ...' if len(hits) > 5 else ''}); "
-            "freefloat has no contact model: set contype=\"0\" conaffinity=\"0\" on them, or "
-            "<option><flag contact=\"disable\"/></option>"
+            'freefloat has no contact model: set contype="0" conaffinity="0" on them, or '
+            '<option><flag contact="disable"/></option>'
         )
     arm = [j for j in range(mj.njnt) if mj.dof_armature[mj.jnt_dofadr[j]] != 0]
     if arm:
@@ -277,7 +278,11 @@ def _joint_spec(mj, js, types, jnames, bname, where, where_j) -> dict:
             out.update(limits(js[0]))
         return out
     if len(types) == 2 and types == [T.mjJNT_HINGE, T.mjJNT_SLIDE] and np.allclose(axes[0], axes[1], atol=1e-12):
-        return {"name": _stem(jnames, (".theta", ".d"), bname), "type": "cylindrical", "axis": list(map(float, axes[0]))}
+        return {
+            "name": _stem(jnames, (".theta", ".d"), bname),
+            "type": "cylindrical",
+            "axis": list(map(float, axes[0])),
+        }
     if len(types) == 2 and types == [T.mjJNT_HINGE, T.mjJNT_HINGE] and abs(float(axes[0] @ axes[1])) <= 1e-9:
         return {
             "name": _stem(jnames, (".theta1", ".theta2"), bname),
@@ -365,7 +370,9 @@ def state_layout(model, mj) -> list:
         if extra:
             msg.append(f"MuJoCo joints model '{model.name}' does not have: {', '.join(extra)}")
         names = [mujoco.mj_id2name(mj, J, k) or f"#{k}" for k in range(mj.njnt)]
-        raise InputError("; ".join(msg) + f" (MuJoCo joints: {', '.join(names)}). Is this the model that was simulated?")
+        raise InputError(
+            "; ".join(msg) + f" (MuJoCo joints: {', '.join(names)}). Is this the model that was simulated?"
+        )
     return layout
 
 
@@ -422,9 +429,7 @@ def telemetry_from_mujoco(model, mjmodel, t, qpos, qvel) -> Telemetry:
                 a, d = mj.jnt_qposadr[jid], mj.jnt_dofadr[jid]
                 q[:, iq + k] = qpos[:, a] - mj.qpos0[a]
                 v[:, iv + k] = qvel[:, d]
-    return Telemetry(
-        t=t.copy(), q=q, v=v, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels()
-    )
+    return Telemetry(t=t.copy(), q=q, v=v, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels())
 
 
 def read_states(path) -> tuple:
