@@ -174,7 +174,6 @@ def _read_rate_noise(p: Path):
     return None if r is None else [float(x) for x in r]
 
 
-
 def _read_parquet(p: Path) -> dict:
     import pyarrow as pa
     import pyarrow.parquet as pq
