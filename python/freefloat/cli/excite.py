@@ -114,4 +114,5 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
         summary["comparison"] = exc.compare(m, res, progress=True, extra=extra)
         click.echo(exc.comparison_table(summary["comparison"]))
         Path(out, "results.json").write_text(json.dumps(summary, indent=2))
-    click.echo(f"wrote {out}/trajectory.json, {out}/results.json and {out}/fig4.png")
+    o = Path(out)
+    click.echo(f"wrote {o / 'trajectory.json'}, {o / 'results.json'} and {o / 'fig4.png'}")

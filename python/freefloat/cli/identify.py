@@ -193,6 +193,7 @@ def identify_minimal_cmd(
     if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results
         Path(out).mkdir(parents=True, exist_ok=True)
         data.to_parquet(Path(out) / "telemetry.parquet")
+        click.echo(f"wrote {Path(out) / 'telemetry.parquet'} (the simulated telemetry, with its rate noise declared)")
     if truth_model is not None:
         truth_ref = load_model(truth_model)
     elif truth if truth is not None else data_is_simulated:
@@ -237,7 +238,7 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
     }
     if out:
         c.model(m).to_urdf(Path(out) / "identified.urdf")
-        click.echo(f"  wrote {out}/identified.urdf")
+        click.echo(f"  wrote {Path(out) / 'identified.urdf'}")
     if validate:
         click.echo(
             f"prediction along the Fourier trajectory of Sec. VI.D (40 s, both robots); identified robot: {how} ..."
@@ -247,5 +248,5 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
         extra["prediction"] = pred.to_dict() | {"identified_robot": how}
         if out:
             pred.save(out)
-            click.echo(f"  wrote {out}/prediction.json and {out}/prediction_errors.png")
+            click.echo(f"  wrote {Path(out) / 'prediction.json'} and {Path(out) / 'prediction_errors.png'}")
     return extra
