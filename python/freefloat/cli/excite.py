@@ -92,6 +92,7 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
             fstep, ftraj = design.fourier_baseline(
                 res.directions, maxiter=maxiter, progress=lambda it, c: (bar.update(1), bar.set_postfix(C=f"{c:.4g}"))
             )
+            bar.update(bar.total - bar.n)  # converged before maxiter: the finished optimiser fills its bar
         finally:
             bar.close()
         click.echo(
