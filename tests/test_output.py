@@ -58,3 +58,16 @@ def test_simulate_warns_when_integration_error_is_visible():
     assert "integration error is visible" in out.output and "rk45" in out.output
     quiet = r.invoke(main, ["simulate", "naveen_dual_arm", "--t-final", "1"])
     assert "integration error is visible" not in quiet.output
+
+
+def test_readme_dual_quaternion_snippet_runs_as_written():
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).parent.parent / "README.md").read_text()
+    section = readme[readme.index("## Dual quaternions") :]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    ns: dict = {}
+    exec(compile(code, "README.md (dual quaternions)", "exec"), ns)
+    m, q, v, tau = ns["m"], ns["q"], ns["v"], ns["tau"]
+    np.testing.assert_allclose(ns["a"], ff.aba(m, q, v, tau), atol=1e-9)
