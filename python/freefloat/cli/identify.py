@@ -172,7 +172,7 @@ def identify_minimal_cmd(
 
         rate_noise = f"{SIGMA_LIN},{SIGMA_ANG},{SIGMA_JOINT}"
     if rn in ("data", "none"):
-        sig = "data" if rn == "data" else None
+        sig = rn
     else:
         sig = parse_vector(rate_noise, 3, "--rate-noise", None)
         if w is not None:

@@ -165,8 +165,8 @@ def identify_minimal(
     component's residual variance, and solve again with their inverses (two-step feasible weighted LS).
     rate_noise: standard deviations of the white noise on the measured rates — (nv,) per velocity component, or
     the triple (base linear, base angular, joint) like `telemetry.add_noise` — to remove the errors-in-variables
-    bias of least squares (`bias_compensated`), or "data": the levels the telemetry declares (`Telemetry.rate_noise`,
-    set by `add_noise` and kept in its files), if any.  None: plain least squares (a warning says so when the data
+    bias of least squares (`bias_compensated`), "none" (plain least squares, deliberately), or "data": the levels
+    the telemetry declares (`Telemetry.rate_noise`, set by `add_noise` and kept in its files), if any.  None: plain least squares (a warning says so when the data
     declare their noise).  Unweighted only: with `weights`, declared levels are not used (a warning says so).
     check: the convention check before identifying (`conventions.check_conventions`: does the momentum model fit
     the data as written, or only with the quaternion reordered / a velocity rotated?). "error" (default) refuses
@@ -178,6 +178,8 @@ def identify_minimal(
         data = Telemetry.from_file(data, model)
     declared = getattr(data, "rate_noise", None)
     source = "given"
+    if isinstance(rate_noise, str) and rate_noise == "none":  # plain least squares, deliberately: no warning
+        rate_noise, declared = None, None
     if isinstance(rate_noise, str):
         if rate_noise != "data":
             raise InputError(f"argument `rate_noise`: expected standard deviations, 'data' or None, got {rate_noise!r}")

@@ -209,3 +209,24 @@ fn write_body(s: &mut String, m: &Model, children: &[Vec<usize>], i: usize, dept
     }
     let _ = writeln!(s, "{ind}</body>");
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::builtin;
+
+    #[test]
+    fn writes_free_joint_full_precision_and_refuses_nonphysical_bodies() {
+        let m = builtin::load("naveen_dual_arm_consistent").unwrap();
+        let s = to_mjcf_string(&m, false).unwrap();
+        assert!(s.contains("<freejoint name=\"root_joint\"/>"));
+        assert!(s.contains("fusestatic=\"false\"") && s.contains("gravity=\"0.0 0.0 0.0\""));
+        // the shortest round-trip decimal of each mass: parsing it back gives the same f64
+        for i in 0..m.nbodies() {
+            assert!(s.contains(&format!("mass=\"{:?}\"", m.inertias[i].mass)));
+        }
+        let bad = builtin::load("naveen_dual_arm").unwrap();
+        let e = to_mjcf_string(&bad, false).unwrap_err().to_string();
+        assert!(e.contains("'L1'") && e.contains("MuJoCo refuses"), "{e}");
+    }
+}
