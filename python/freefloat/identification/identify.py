@@ -167,7 +167,8 @@ def identify_minimal(
     the triple (base linear, base angular, joint) like `telemetry.add_noise` — to remove the errors-in-variables
     bias of least squares (`bias_compensated`), "none" (plain least squares, deliberately), or "data": the levels
     the telemetry declares (`Telemetry.rate_noise`, set by `add_noise` and kept in its files), if any.
-    None: plain least squares (a warning says so when the data declare their noise).  Unweighted only: with `weights`, declared levels are not used (a warning says so).
+    None: plain least squares (a warning says so when the data declare their noise).
+    Unweighted only: with `weights`, declared levels are not used (a warning says so).
     check: the convention check before identifying (`conventions.check_conventions`: does the momentum model fit
     the data as written, or only with the quaternion reordered / a velocity rotated?). "error" (default) refuses
     data that a usual convention mistake explains, naming it, and warns when nothing fits; "warn" only warns;
