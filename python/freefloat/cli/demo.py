@@ -17,9 +17,7 @@ import click
     "noise, plain least squares, --case1-rate sampling), then each of freefloat's improvements as its own row "
     "(1 kHz samples, errors-in-variables removal, designed excitation). Minutes: it simulates 67 s and more.",
 )
-@click.option(
-    "--case1-rate", type=float, default=100.0, show_default=True, help="--case1: sampling rate of row 1 [Hz]."
-)
+@click.option("--case1-rate", type=float, default=20.0, show_default=True, help="--case1: sampling rate of row 1 [Hz].")
 def demo_cmd(out, t_final, case1, case1_rate):
     """Run the main job on its built-in default, on the Naveen, Shah, Misra dual-arm robot with three reaction wheels.
 
