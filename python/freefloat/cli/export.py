@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from ._common import MODEL_HELP, load_model
+from ._common import load_model
 
 
 @click.command("export", context_settings={"help_option_names": ["-h", "--help"]})
@@ -21,17 +21,14 @@ from ._common import MODEL_HELP, load_model
 )
 def export_cmd(model, mjcf_path, urdf_path, gravity):
     (
-        """Write MODEL ("""
-        + MODEL_HELP
-        + """) for another simulator.
+        """Write MODEL (a built-in robot name, or a .yaml / .urdf / MJCF .xml file) for another simulator.
 
     MJCF: the base gets a free joint, inertias are written at full precision as centre of mass + full inertia
     about it, the compiler neither fuses static bodies nor recomputes or balances inertias, gravity is zero
     unless --gravity, the integrator RK4 with a 1 ms step, each 1-DoF joint a motor (ctrl = joint torque),
-    frames become sites. Read the MuJoCo states back with `freefloat convert --from mujoco`.
+    frames become sites, body tags are kept. Read the MuJoCo states back with `freefloat convert --from mujoco`.
 
     Example: freefloat export naveen_dual_arm_consistent --mjcf robot.xml"""
-    )
     if not mjcf_path and not urdf_path:
         raise click.UsageError("give --mjcf FILE and/or --urdf FILE")
     m = load_model(model)
