@@ -20,8 +20,7 @@ from ._common import load_model
     help="MJCF: write the model's gravity (default zero gravity: an orbiting robot).",
 )
 def export_cmd(model, mjcf_path, urdf_path, gravity):
-    (
-        """Write MODEL (a built-in robot name, or a .yaml / .urdf / MJCF .xml file) for another simulator.
+    """Write MODEL (a built-in robot name, or a .yaml / .urdf / MJCF .xml file) for another simulator.
 
     MJCF: the base gets a free joint, inertias are written at full precision as centre of mass + full inertia
     about it, the compiler neither fuses static bodies nor recomputes or balances inertias, gravity is zero
