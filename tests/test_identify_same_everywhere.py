@@ -110,15 +110,14 @@ def test_zero_true_values_are_reported_by_absolute_error(noisy, tmp_path):
 
 
 @pytest.mark.slow
-def test_no_known_body_explains_the_unobservable_scale(noisy):
+def test_no_known_body_explains_the_unobservable_scale(noisy, tmp_path):
     m, telem, *_ = noisy
     with pytest.raises(InputError, match="overall scale.*unobservable.*--known"):
         ff.identify_minimal(m, telem, known=[], rate_noise="data")
     urdf = ff.models.load(ROBOT).to_urdf()  # as a URDF from elsewhere: no freefloat tags, so no known body
     r = CliRunner()
-    with r.isolated_filesystem():
-        open("robot.urdf", "w").write(urdf.replace("<freefloat tags", "<ignored tags"))
-        out = r.invoke(main, ["params", "minimal", "robot.urdf"])
+    (tmp_path / "robot.urdf").write_text(urdf.replace("<freefloat tags", "<ignored tags"))
+    out = r.invoke(main, ["params", "minimal", str(tmp_path / "robot.urdf")])
     assert out.exit_code == 0, out.output
     assert "overall scale" in out.output and "--known" in out.output
 
