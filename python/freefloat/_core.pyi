@@ -184,6 +184,10 @@ about each body-frame origin, body axes.
     @property
     def tags(self) -> Any:
         ...
+    def to_mjcf_string(self, with_gravity: ArrayLike = False) -> Any:
+        """The model as MJCF (MuJoCo XML): free joint on the base, inertias at full precision, no fusing
+of static bodies, zero gravity unless `with_gravity`.
+        """
     def to_urdf_string(self) -> str:
         ...
     @property

@@ -61,6 +61,29 @@ class Model:
             Path(path).write_text(text)
         return text
 
+    @classmethod
+    def from_mjcf(cls, path, name: str | None = None) -> Model:
+        """Load a MuJoCo MJCF file (needs `pip install freefloat[mujoco]`). MuJoCo's own compiler reads it
+        (defaults, angle units, orientations, inertia from geoms are what MuJoCo makes of them); a free joint
+        at the root becomes the free base, no joint there a fixed base; hinge -> revolute, slide -> prismatic,
+        ball -> spherical, no joint -> fixed, a hinge then a slide on one axis -> cylindrical, two orthogonal
+        hinges -> universal. Tendons, equality constraints, contact-enabled geoms, armature and joint types
+        freefloat lacks are refused with the element's name (and line when it has one). Tags written by
+        `to_mjcf` come back. `path` may also be MJCF text."""
+        from .io.mujoco import model_from_mjcf
+
+        return model_from_mjcf(path, name)
+
+    def to_mjcf(self, path=None, gravity: bool = False) -> str:
+        """Write the model as MuJoCo MJCF (to `path` if given) and return the text: a free joint on the base,
+        inertias at full precision, `fusestatic`, `inertiafromgeom` and `balanceinertia` off (MuJoCo keeps
+        every body and every number as written), zero gravity unless `gravity` (then the model's own), RK4
+        with a 1 ms step, a motor per 1-DoF joint, frames as sites, body tags kept for `from_mjcf`."""
+        text = self._core.to_mjcf_string(bool(gravity))
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
     # -- description --------------------------------------------------------------------------------
     name = property(lambda self: self._core.name)
     nq = property(lambda self: self._core.nq, doc="Size of the configuration q.")

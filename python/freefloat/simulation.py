@@ -44,6 +44,57 @@ class Trajectory:
     def __len__(self) -> int:
         return len(self.t)
 
+    def __repr__(self) -> str:
+        """A summary (model, samples, time span, sizes, conservation), not every array."""
+        if len(self.t) == 0:
+            return f"Trajectory('{self.model_name}': no samples)"
+        d, e = self.momentum_drift(), self.energy_balance()
+        how = ", ".join(f"{k}={self.stats[k]}" for k in ("method", "formulation") if k in self.stats)
+        return (
+            f"Trajectory('{self.model_name}': {len(self.t)} samples, t = {self.t[0]:g} .. {self.t[-1]:g} s, "
+            f"nq={self.q.shape[1]}, nv={self.v.shape[1]}{', ' + how if how else ''}; momentum drift "
+            f"linear {d['linear_rel']:.2g}, angular {d['angular_rel']:.2g} (relative); "
+            f"energy - work {e['rel']:.2g} (relative))"
+        )
+
+    def integration_warning(self, limit: float = 1e-8) -> str | None:
+        """A sentence when the integration error is visible — momentum drift or kinetic energy minus work
+        above `limit` (relative) — suggesting a smaller step or rk45; None when the run stays near round-off."""
+        d, e = self.momentum_drift(), self.energy_balance()
+        worst = max(d["linear_rel"], d["angular_rel"], e["rel"])
+        if worst <= limit:
+            return None
+        dt = self.stats.get("dt")
+        step = f"a smaller step (--dt {dt / 10:g})" if dt else "a smaller step"
+        return (
+            f"integration error is visible: momentum drift (linear {d['linear_rel']:.2g}, angular "
+            f"{d['angular_rel']:.2g}) or energy minus work ({e['rel']:.2g}) exceeds {limit:g} relative; "
+            f"these should stay near round-off. Use {step} or the adaptive integrator (--method rk45); fast "
+            "start-up transients (large accelerations) are the usual cause."
+        )
+
+    def to_csv(self, path) -> None:
+        """Write a comma-separated file with the columns of `to_parquet`, a `# model:` comment first, every
+        number at full double precision (%.17g)."""
+        cols = self._columns()
+        header = f"# model: {self.model_name}\n" + ",".join(cols)
+        np.savetxt(
+            str(path), np.column_stack(list(cols.values())), delimiter=",", fmt="%.17g", header=header, comments=""
+        )
+
+    def _columns(self) -> dict:
+        cols = {"t": self.t}
+        ql = self.q_labels or [str(j) for j in range(self.q.shape[1])]
+        vl = self.v_labels or [str(j) for j in range(self.v.shape[1])]
+        for prefix, arr, labels in (("q", self.q, ql), ("v", self.v, vl), ("ddq", self.ddq, vl), ("tau", self.tau, vl)):
+            for j in range(arr.shape[1]):
+                cols[f"{prefix}.{labels[j]}"] = arr[:, j]
+        for j, n in enumerate(MOMENTUM_NAMES):
+            cols[f"momentum.{n}"] = self.momentum[:, j]
+        cols["kinetic_energy"] = self.kinetic_energy
+        cols["work"] = self.work
+        return cols
+
     def to_numpy(self) -> dict:
         """All recorded arrays by name."""
         return {k: getattr(self, k) for k in ("t", "q", "v", "ddq", "tau", "momentum", "kinetic_energy", "work")}
@@ -187,8 +238,13 @@ def simulate(
     if progress is True:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=1000, desc=f"simulate {model.name}", unit="‰", leave=False)
-        cb = _bar_callback(bar)
+        bar = tqdm(
+            total=float(t_final),
+            desc=f"simulate {model.name}",
+            leave=False,
+            bar_format="{desc}: {percentage:3.0f}%|{bar}| {n:.2f}/{total:.2f} s simulated [{elapsed}<{remaining}]",
+        )
+        cb = _bar_callback(bar, float(t_final))
     else:
         cb = progress if callable(progress) else None
     tt = None if torque_times is None else as_f64(torque_times, "torque_times")
@@ -268,11 +324,11 @@ def simulate_driven(
     )
 
 
-def _bar_callback(bar):
-    """Progress callback that advances a tqdm bar counting per mille."""
+def _bar_callback(bar, total: float):
+    """Progress callback that moves a tqdm bar to the simulated time reached (fraction × total seconds)."""
 
     def cb(frac):
-        bar.update(int(frac * 1000) - bar.n)
+        bar.update(frac * total - bar.n)
         return True
 
     return cb

@@ -2,7 +2,7 @@
 //! allocate their work buffers each time.
 
 use crate::errors::{guard, input_err};
-use freefloat_core::model::{builtin, urdf, yaml, JointType};
+use freefloat_core::model::{builtin, mjcf, urdf, yaml, JointType};
 use freefloat_core::spatial::quat_from_rot;
 use freefloat_core::{Data, Model};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -70,6 +70,13 @@ impl PyModel {
 
     fn to_urdf_string(&self) -> PyResult<String> {
         guard(|| urdf::to_urdf_string(&self.inner))
+    }
+
+    /// The model as MJCF (MuJoCo XML): free joint on the base, inertias at full precision, no fusing
+    /// of static bodies, zero gravity unless `with_gravity`.
+    #[pyo3(signature = (with_gravity = false))]
+    fn to_mjcf_string(&self, with_gravity: bool) -> PyResult<String> {
+        guard(|| mjcf::to_mjcf_string(&self.inner, with_gravity))
     }
 
     #[getter]

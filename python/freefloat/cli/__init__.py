@@ -13,7 +13,7 @@ import sys
 import click
 
 from .. import _core
-from . import adaptive, control, demo, excite, identify, models, params, postcapture, reactions, simulate
+from . import adaptive, control, convert, demo, excite, export, identify, models, params, postcapture, reactions, simulate
 
 
 class FriendlyGroup(click.Group):
@@ -47,5 +47,7 @@ main.add_command(excite.excite_cmd)
 main.add_command(postcapture.scenarios_cmd)
 main.add_command(control.control_group)
 control.control_group.add_command(adaptive.adaptive_cmd)
+main.add_command(export.export_cmd)
+main.add_command(convert.convert_cmd)
 
 __all__ = ["main"]

@@ -25,7 +25,7 @@ __all__ = [
     "write_outputs",
 ]
 
-MODEL_HELP = "a built-in robot name (see `freefloat models`) or a .yaml / .urdf file"
+MODEL_HELP = "a built-in robot name (see `freefloat models`) or a .yaml / .urdf / MJCF (.xml) file"
 
 
 def tqdm_bar(total: int, desc: str):
@@ -46,7 +46,7 @@ def torque_options(m: Model, torques: str, amplitude: float) -> dict:
 
 
 def load_model(spec: str, base: str = "free") -> Model:
-    """A built-in name (or an earlier alias of one), or a path to a YAML or URDF file."""
+    """A built-in name (or an earlier alias of one), or a path to a YAML, URDF or MJCF (.xml, .mjcf) file."""
     p = Path(spec)
     if not p.suffix and models.is_builtin(spec):
         return models.load(spec)
@@ -54,8 +54,11 @@ def load_model(spec: str, base: str = "free") -> Model:
         return Model.from_yaml(p)
     if p.suffix.lower() == ".urdf":
         return Model.from_urdf(p, base=base)
+    if p.suffix.lower() in (".xml", ".mjcf"):
+        return Model.from_mjcf(p)
     raise click.BadParameter(
-        f"'{spec}' is neither a built-in robot ({', '.join(models.names())}) nor a .yaml/.urdf file", param_hint="MODEL"
+        f"'{spec}' is neither a built-in robot ({', '.join(models.names())}) nor a .yaml/.urdf/.xml (MJCF) file",
+        param_hint="MODEL",
     )
 
 

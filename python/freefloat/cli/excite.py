@@ -92,6 +92,7 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
             fstep, ftraj = design.fourier_baseline(
                 res.directions, maxiter=maxiter, progress=lambda it, c: (bar.update(1), bar.set_postfix(C=f"{c:.4g}"))
             )
+            bar.update(bar.total - bar.n)  # converged before maxiter: the finished optimiser fills its bar
         finally:
             bar.close()
         click.echo(
@@ -114,4 +115,5 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
         summary["comparison"] = exc.compare(m, res, progress=True, extra=extra)
         click.echo(exc.comparison_table(summary["comparison"]))
         Path(out, "results.json").write_text(json.dumps(summary, indent=2))
-    click.echo(f"wrote {out}/trajectory.json, {out}/results.json and {out}/fig4.png")
+    o = Path(out)
+    click.echo(f"wrote {o / 'trajectory.json'}, {o / 'results.json'} and {o / 'fig4.png'}")

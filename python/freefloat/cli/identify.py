@@ -27,9 +27,14 @@ def identify_group():
 @click.option(
     "--data",
     type=click.Path(),
-    help="Telemetry file (.parquet or .csv) with columns t, q.<label>, v.<label> "
-    "(labels as in a `freefloat simulate` output) and optionally momentum.px ... momentum.Lz "
-    "or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the origin).",
+    help="Telemetry file (.parquet or .csv) with columns t [s], q.<label>, v.<label> (labels as in a "
+    "`freefloat simulate` output: base.x .. base.qw, base.vx .. base.wz, then joint names). "
+    "Orders and frames: q = base position (inertial frame), base quaternion x, y, z, w (w LAST), joint "
+    "angles; v = base linear velocity and base angular velocity both in the BASE (body) frame, then joint "
+    "rates. Optionally momentum.px ... momentum.Lz (total momentum, inertial frame, angular about the "
+    "inertial origin) or the external wrench wrench.fx ... wrench.mz (inertial frame, moment about the "
+    "origin); without them the momentum is conserved (h0, zero by default). MuJoCo states (w-first "
+    "quaternion, world-frame linear velocity) must first go through `freefloat convert --from mujoco`.",
 )
 @click.option(
     "--simulate",
@@ -47,11 +52,12 @@ def identify_group():
 )
 @click.option(
     "--method",
-    type=click.Choice(["closed-form", "numeric"]),
-    default="closed-form",
+    type=click.Choice(["auto", "closed-form", "numeric"]),
+    default="auto",
     show_default=True,
-    help="Minimal-parameter set: Naveen, Shah, Misra's closed form (revolute trees in modified-DH frames) "
-    "or numeric (any robot).",
+    help="Minimal-parameter set: Naveen, Shah, Misra's closed form (revolute trees in modified-DH frames), "
+    "numeric (any robot), or auto: the closed form where it applies, else numeric (the same default, names and "
+    "order as `freefloat params minimal`).",
 )
 @click.option(
     "--known", help="Comma-separated bodies with known parameters (default: bodies tagged 'known' or 'wheel')."
@@ -68,9 +74,14 @@ def identify_group():
 )
 @click.option(
     "--rate-noise",
-    help="Standard deviations of the white noise on the measured rates, 'base linear, base "
-    "angular, joint' (e.g. 50e-6,80e-6,50e-6, or 'paper' for those): removes the "
-    "errors-in-variables bias of least squares (with --simulate, 'paper' is the default).",
+    default="data",
+    show_default=True,
+    help="Standard deviations of the white noise on the measured rates, 'base linear, base angular, joint' (e.g. "
+    "50e-6,80e-6,50e-6, or 'paper' for those), used to remove the errors-in-variables bias of least squares. "
+    "'data' (default, the same for every source): the levels the telemetry declares; simulated telemetry "
+    "(--simulate, --trajectory, and the OUT/telemetry.parquet they write) declares the paper's noise it carries, "
+    "a file without a declaration gets plain least squares. 'none': plain least squares. The estimator that ran "
+    "is printed.",
 )
 @click.option(
     "--full/--no-full",
@@ -94,15 +105,44 @@ def identify_group():
 )
 @click.option(
     "--truth/--no-truth",
-    default=True,
+    default=None,
+    help="Compare the estimate with MODEL's own parameters (default: on for --simulate/--trajectory, whose data "
+    "come from MODEL; off for --data: real telemetry has no truth unless --truth or --truth-model is given).",
+)
+@click.option(
+    "--truth-model",
+    help="Compare the estimate with this model's parameters (built-in name or file), e.g. the robot a "
+    "--data file was simulated from.",
+)
+@click.option(
+    "--check",
+    type=click.Choice(["error", "warn", "off"]),
+    default="error",
     show_default=True,
-    help="Compare the estimate with the model file's own parameters (right when the data was simulated from it).",
+    help="Convention check before identifying: fit the momentum model to the data as written and with the usual "
+    "mistakes corrected (quaternion w-first, base velocities in the world frame). 'error' stops when a mistake "
+    "explains the data and names it; 'warn' only warns; 'off' skips the check.",
 )
 @click.option(
     "--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf)."
 )
 def identify_minimal_cmd(
-    model, data, n_sim, traj_file, method, known, h0, weights, rate_noise, full, prior, validate, truth, out
+    model,
+    data,
+    n_sim,
+    traj_file,
+    method,
+    known,
+    h0,
+    weights,
+    rate_noise,
+    full,
+    prior,
+    validate,
+    truth,
+    truth_model,
+    check,
+    out,
 ):
     """Estimate the minimal inertial parameters of MODEL from motion data.
 
@@ -126,13 +166,18 @@ def identify_minimal_cmd(
         if weights is None
         else ("auto" if weights.strip() == "auto" else parse_vector(weights, 6, "--weights", None))
     )
-    if rate_noise is None and (n_sim is not None or traj_file is not None) and w is None:
-        rate_noise = "paper"  # the simulated data carries the paper's noise, so its levels are known
-    if rate_noise is not None and rate_noise.strip() == "paper":
+    rn = rate_noise.strip().lower()
+    if rn == "paper":
         from ..constants import SIGMA_ANG, SIGMA_JOINT, SIGMA_LIN
 
         rate_noise = f"{SIGMA_LIN},{SIGMA_ANG},{SIGMA_JOINT}"
-    sig = None if rate_noise is None else parse_vector(rate_noise, 3, "--rate-noise", None)
+    if rn in ("data", "none"):
+        sig = rn
+    else:
+        sig = parse_vector(rate_noise, 3, "--rate-noise", None)
+        if w is not None:
+            raise click.BadParameter("the bias removal is for unweighted least squares: drop --weights", "--rate-noise")
+    data_is_simulated = data is None
     if n_sim is not None:
         click.echo(f"simulating {n_sim} excitation intervals of {m.name} with the paper's rate noise ...")
         data, _ = idf.excitation_data(m, n_intervals=n_sim, progress=True)
@@ -148,12 +193,23 @@ def identify_minimal_cmd(
     if out and (n_sim is not None or traj_file is not None):  # keep the simulated telemetry beside the results
         Path(out).mkdir(parents=True, exist_ok=True)
         data.to_parquet(Path(out) / "telemetry.parquet")
-    res = idf.identify_minimal(m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig)
-    click.echo(res.table(truth=m if truth else None))
-    summary = res.to_dict(truth=m if truth else None)
+        click.echo(f"wrote {Path(out) / 'telemetry.parquet'} (the simulated telemetry, with its rate noise declared)")
+    if truth_model is not None:
+        truth_ref = load_model(truth_model)
+    elif truth if truth is not None else data_is_simulated:
+        truth_ref = m
+    else:
+        truth_ref = None
+    res = idf.identify_minimal(m, data, known=known_list, method=method, h0=h, weights=w, rate_noise=sig, check=check)
+    if res.conventions is not None:
+        click.echo(res.conventions.message())
+    click.echo(f"estimator: {res.estimator}")
+    click.echo(res.table(truth=truth_ref))
+    summary = res.to_dict(truth=truth_ref)
     if out:
-        res.save(out, truth=m if truth else None)
-        click.echo(f"wrote {out}/results.json" + (f" and {out}/minimal_parameters.png" if truth else ""))
+        res.save(out, truth=truth_ref)
+        o = Path(out)
+        click.echo(f"wrote {o / 'results.json'}" + (f" and {o / 'minimal_parameters.png'}" if truth_ref else ""))
     if full or validate:
         summary.update(_full_and_validate(m, res, prior, validate, out))
         if out:
@@ -182,7 +238,7 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
     }
     if out:
         c.model(m).to_urdf(Path(out) / "identified.urdf")
-        click.echo(f"  wrote {out}/identified.urdf")
+        click.echo(f"  wrote {Path(out) / 'identified.urdf'}")
     if validate:
         click.echo(
             f"prediction along the Fourier trajectory of Sec. VI.D (40 s, both robots); identified robot: {how} ..."
@@ -192,5 +248,5 @@ def _full_and_validate(m, res, prior, validate, out) -> dict:
         extra["prediction"] = pred.to_dict() | {"identified_robot": how}
         if out:
             pred.save(out)
-            click.echo(f"  wrote {out}/prediction.json and {out}/prediction_errors.png")
+            click.echo(f"  wrote {Path(out) / 'prediction.json'} and {Path(out) / 'prediction_errors.png'}")
     return extra

@@ -23,11 +23,12 @@ def params_group():
 @click.argument("model")
 @click.option(
     "--method",
-    type=click.Choice(["closed-form", "numeric"]),
-    default="numeric",
+    type=click.Choice(["auto", "closed-form", "numeric"]),
+    default="auto",
     show_default=True,
-    help="'numeric': QR of the momentum regressor over random states (any robot). 'closed-form': seed "
-    "001's grouping rules (revolute joints in modified-DH frames only), numbered like its Table 4.",
+    help="'numeric': QR of the momentum regressor over random states (any robot). 'closed-form': Naveen, Shah, "
+    "Misra's grouping rules (revolute joints in modified-DH frames only), numbered like their Table 4. 'auto': "
+    "the closed form where it applies, else numeric (the same default, names and order as `identify minimal`).",
 )
 @click.option(
     "--known",
@@ -54,9 +55,15 @@ def minimal_cmd(model, method, known, out):
     ex = mp.expressions()
     known_names = [m.body_names[i] for i in mp.known]
     click.echo(
-        f"{m.name}: {mp.n_min} minimal parameters ({method}; rank {mp.rank} of {mp.matrix.shape[1]} "
+        f"{m.name}: {mp.n_min} minimal parameters ({mp.method}; rank {mp.rank} of {mp.matrix.shape[1]} "
         f"standard columns); known bodies: {', '.join(known_names) or 'none'}"
     )
+    if not known_names:
+        click.echo(
+            "  note: no body is known, so the overall scale of the parameters is unobservable from momentum "
+            "(multiplying every parameter by one factor fits the same data): identification needs a body with "
+            "known parameters, such as a reaction wheel. Name it with --known BODY (or tag it 'known')."
+        )
     w = max(len(n) for n in mp.names)
     for n, e, x in zip(mp.names, ex, values):
         click.echo(f"  {n:{w}s} = {x:14.6g}   = {e}")
@@ -65,7 +72,7 @@ def minimal_cmd(model, method, known, out):
         d.mkdir(parents=True, exist_ok=True)
         res = {
             "model": m.name,
-            "method": method,
+            "method": mp.method,
             "rank": mp.rank,
             "n_standard": int(mp.matrix.shape[1]),
             "known_bodies": known_names,

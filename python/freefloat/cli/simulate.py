@@ -48,7 +48,11 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
     show_default=True,
     help="Dynamics: the engine's ABA, or the dual-quaternion Newton-Euler system (Valverde 2018 ch. 6).",
 )
-@click.option("--out", help="FILE.parquet, or a directory (gets trajectory, results.json, figure).")
+@click.option(
+    "--out",
+    help="FILE.parquet or FILE.csv (plus FILE.results.json and FILE.png beside it), or a directory (gets "
+    "trajectory.parquet, results.json, trajectory.png). Every file written is listed.",
+)
 def simulate_cmd(
     model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out
 ):
@@ -79,4 +83,8 @@ def simulate_cmd(
     s = summarize(traj, time.perf_counter() - t0)
     s["model"] = m.name
     print_summary(f"{m.name}: {t_final} s, {method}, {formulation}", s)
+    warn = traj.integration_warning()
+    if warn:
+        click.echo(f"warning: {warn}", err=True)
+        s["integration_warning"] = warn
     write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation")

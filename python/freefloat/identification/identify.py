@@ -23,6 +23,7 @@ import scipy.linalg
 from .._core import InputError
 from ..constants import TABLE3_RANGE_RAD, TABLE3_START_DEG  # noqa: F401  (re-exported)
 from ..io.telemetry import Telemetry
+from .conventions import ConventionReport, check_conventions
 from .estimation import LeastSquaresResult, absolute_columns, known_parameters, least_squares, relative_errors
 from .minimal import MinimalParameters, minimal_parameters
 
@@ -34,6 +35,9 @@ class IdentificationResult:
     mp: MinimalParameters
     fit: LeastSquaresResult
     samples: int
+    conventions: ConventionReport | None = None
+    #: which estimator ran, in words (printed by the CLI, kept in results.json)
+    estimator: str = "least squares"
 
     @property
     def names(self) -> list[str]:
@@ -53,9 +57,23 @@ class IdentificationResult:
         return self.mp.from_standard(P)
 
     def errors(self, truth) -> dict:
-        """Naveen, Shah, Misra's error figures against `truth` (eqs. 38-39), in percent."""
-        med, mx = relative_errors(self.estimate, self.truth_values(truth))
-        return {"median_rel_error_pct": med, "max_rel_error_pct": mx}
+        """Naveen, Shah, Misra's error figures against `truth` (eqs. 38-39), in percent, over the minimal
+        parameters whose true value is not zero; those that are exactly zero (a UR5 has many: symmetric links)
+        have no relative error and are reported by their absolute error instead."""
+        tv = self.truth_values(truth)
+        nz = tv != 0
+        out = {}
+        if nz.any():
+            med, mx = relative_errors(self.estimate[nz], tv[nz])
+            out.update({"median_rel_error_pct": med, "max_rel_error_pct": mx})
+        else:
+            out.update({"median_rel_error_pct": float("nan"), "max_rel_error_pct": float("nan")})
+        if not nz.all():
+            out["zero_truth"] = {
+                "names": [n for n, z in zip(self.names, nz) if not z],
+                "abs_error": [float(abs(x)) for x, z in zip(self.estimate, nz) if not z],
+            }
+        return out
 
     def table(self, truth=None) -> str:
         """The estimate as a printable table, with true values and relative errors when `truth` is given."""
@@ -67,9 +85,10 @@ class IdentificationResult:
             if tv is not None:
                 row += f"{tv[k]:14.6g} "
             row += f"{self.estimate[k]:14.6g} {self.std[k]:11.3g}"
-            if tv is not None:
-                rel = abs((tv[k] - self.estimate[k]) / tv[k]) * 100 if tv[k] != 0 else float("nan")
-                row += f" {rel:10.3g}%"
+            if tv is not None and tv[k] != 0:
+                row += f" {abs((tv[k] - self.estimate[k]) / tv[k]) * 100:10.3g}%"
+            elif tv is not None:  # no relative error of a zero: the absolute one
+                row += f"  abs {abs(self.estimate[k]):.3g}"
             lines.append(row)
         lines.append(
             f"{len(self.names)} minimal parameters from {self.samples} samples ({self.fit.rows} rows); "
@@ -78,9 +97,16 @@ class IdentificationResult:
         )
         if tv is not None:
             e = self.errors(truth)
+            z = e.get("zero_truth")
             lines.append(
                 f"relative error (Naveen, Shah, Misra eqs. 38-39): median {e['median_rel_error_pct']:.3g} %, "
                 f"max {e['max_rel_error_pct']:.3g} %"
+                + (
+                    f" over the {len(self.names) - len(z['names'])} non-zero true values; {len(z['names'])} "
+                    f"true values are exactly 0 (largest absolute error {max(z['abs_error']):.3g})"
+                    if z
+                    else ""
+                )
             )
         return "\n".join(lines)
 
@@ -95,8 +121,11 @@ class IdentificationResult:
             "samples": self.samples,
             "residual_sigma": self.fit.sigma,
             "solver": self.fit.method,
+            "estimator": self.estimator,
             "known_bodies": [self.mp.model.body_names[i] for i in self.mp.known],
         }
+        if self.conventions is not None:
+            d["convention_check"] = self.conventions.to_dict()
         if truth is not None:
             d["truth"] = self.truth_values(truth).tolist()
             d.update(self.errors(truth))
@@ -113,30 +142,90 @@ class IdentificationResult:
 
 
 def identify_minimal(
-    model, data, known=None, method: str = "closed-form", h0=None, weights=None, rate_noise=None
+    model,
+    data,
+    known=None,
+    method: str = "auto",
+    h0=None,
+    weights=None,
+    rate_noise=None,
+    check: str = "error",
 ) -> IdentificationResult:
     """Identify the minimal parameters of `model` from motion data.
 
     data: a `Trajectory`, a `Telemetry`, or a telemetry file (.parquet/.csv with columns t, q.<label>, v.<label>,
     optionally momentum.<px..Lz> or wrench.<fx..mz>). known: bodies whose parameters are known (default: those
     tagged known/wheel).
-    method: "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH frames) or "numeric"
-        (any tree).
+    method: "auto" (default: the closed form where it applies, else numeric — the same default as
+        `freefloat params minimal`), "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in modified-DH
+        frames) or "numeric" (any tree).
     h0: the total momentum at the start (6,). Without momentum columns it is conserved (zero if not given), or,
     with wrench columns, the start of their integral; given explicitly, it overrides a momentum column.
     weights: (6,) inverse variances of the momentum components, or "auto": solve once unweighted, estimate each
     component's residual variance, and solve again with their inverses (two-step feasible weighted LS).
     rate_noise: standard deviations of the white noise on the measured rates — (nv,) per velocity component, or
     the triple (base linear, base angular, joint) like `telemetry.add_noise` — to remove the errors-in-variables
-    bias of least squares (`bias_compensated`).  Unweighted only."""
+    bias of least squares (`bias_compensated`), "none" (plain least squares, deliberately), or "data": the levels
+    the telemetry declares (`Telemetry.rate_noise`, set by `add_noise` and kept in its files), if any.
+    None: plain least squares (a warning says so when the data declare their noise).
+    Unweighted only: with `weights`, declared levels are not used (a warning says so).
+    check: the convention check before identifying (`conventions.check_conventions`: does the momentum model fit
+    the data as written, or only with the quaternion reordered / a velocity rotated?). "error" (default) refuses
+    data that a usual convention mistake explains, naming it, and warns when nothing fits; "warn" only warns;
+    "off" skips it.  Simulated data (a `Trajectory`) are written by freefloat itself and are not checked."""
+    if check not in ("error", "warn", "off"):
+        raise InputError(f"argument `check`: expected 'error', 'warn' or 'off', got {check!r}")
+    if isinstance(data, (str, Path)):
+        data = Telemetry.from_file(data, model)
+    declared = getattr(data, "rate_noise", None)
+    source = "given"
+    if isinstance(rate_noise, str) and rate_noise == "none":  # plain least squares, deliberately: no warning
+        rate_noise, declared = None, None
+    if isinstance(rate_noise, str):
+        if rate_noise != "data":
+            raise InputError(f"argument `rate_noise`: expected standard deviations, 'data' or None, got {rate_noise!r}")
+        rate_noise, source = declared, "declared by the data"
+        if rate_noise is not None and weights is not None:
+            warnings.warn(
+                f"the data declare rate noise {declared} but the errors-in-variables bias removal is for unweighted "
+                "least squares: running weighted least squares without it",
+                stacklevel=2,
+            )
+            rate_noise = None
+    elif rate_noise is None and declared is not None and weights is None:
+        warnings.warn(
+            f"the data declare rate noise {declared} but no errors-in-variables bias removal was asked for: plain "
+            "least squares is biased towards zero (pass rate_noise='data', on the command line the default)",
+            stacklevel=2,
+        )
     t, q, v, h = _read(model, data, h0)
-    if method == "closed-form":
+    if method == "auto":
+        mp = minimal_parameters(model, "auto", known)
+    elif method == "closed-form":
         try:
             mp = minimal_parameters(model, "closed-form", known)
         except Exception as e:  # a model outside the closed form's scope
             raise InputError(f"{e} (use method='numeric')") from None
     else:
         mp = minimal_parameters(model, method, known)
+    # zero momentum up to round-off (a simulated run's momentum column carries ~1e-10): nothing sets the scale
+    if len(mp.known) == 0 and np.allclose(h, 0.0, rtol=0.0, atol=1e-6):
+        raise InputError(
+            f"model '{model.name}': no body has known parameters and the momentum is zero, so the overall scale of the "
+            "parameters is unobservable (every parameter times any factor fits the data equally well; momentum "
+            "identification fixes the scale through a known body, such as a reaction wheel). Name one with "
+            "known=[...] (on the command line --known BODY), or tag it 'known' in the model file"
+        )
+    report = None
+    if check != "off" and not hasattr(data, "ddq") and len(q) > 0:
+        report = check_conventions(mp, q, v, h)
+        if report.cause and check == "error":
+            raise InputError(
+                f"argument `data`: {report.message()} "
+                "(to identify anyway: check='off', on the command line --check off)"
+            )
+        if not report.ok:
+            warnings.warn(report.message(), stacklevel=2)
     if isinstance(weights, str):
         if weights != "auto":
             raise InputError(f"argument `weights`: expected six inverse variances or 'auto', got {weights!r}")
@@ -149,7 +238,16 @@ def identify_minimal(
                 "arguments `weights` and `rate_noise`: the bias compensation is for unweighted least squares"
             )
         fit = bias_compensated(mp, q, v, fit, _rate_sigmas(model, rate_noise))
-    return IdentificationResult(mp=mp, fit=fit, samples=len(t))
+    if rate_noise is not None and "bias compensation" in fit.method and "skipped" not in fit.method:
+        levels = ", ".join(f"{x:.3g}" for x in np.atleast_1d(np.asarray(rate_noise, dtype=float)))
+        estimator = f"least squares + errors-in-variables bias removal (rate noise {levels}, {source})"
+    elif rate_noise is not None:
+        estimator = "least squares (errors-in-variables bias removal skipped: noise-dominated direction)"
+    else:
+        estimator = ("weighted least squares" if weights is not None else "least squares") + " (no rate-noise removal)"
+    return IdentificationResult(
+        mp=mp, fit=fit, samples=len(t), conventions=report, estimator=f"{estimator}; minimal set: {mp.method}"
+    )
 
 
 #: bias compensation is refused when the rate noise makes up more than this share of the regressor's energy in

@@ -106,10 +106,16 @@ class MinimalParameters:
 def minimal_parameters(model, method: str = "numeric", known=None) -> MinimalParameters:
     """Minimal parameters of `model`'s momentum model.
 
-    method: "numeric" (any model) or "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in
-      modified-DH frames).
+    method: "numeric" (any model), "closed-form" (Naveen, Shah, Misra's grouping; revolute trees in
+      modified-DH frames), or "auto": the closed form where it applies, else numeric (the command line's default,
+      and `identify_minimal`'s, so both give the same names in the same order).
     known: body names treated as known (moved to the right-hand side); default: bodies tagged "known" or "wheel".
     """
+    if method == "auto":  # the closed form where it applies (its names follow the paper), else numeric
+        try:
+            return minimal_parameters(model, "closed-form", known)
+        except (ModelError, ValueError):
+            return minimal_parameters(model, "numeric", known)
     unknown, known_idx = _split_bodies(model, known)
     if method == "numeric":
         return _numeric(model, unknown, known_idx)

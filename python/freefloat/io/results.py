@@ -6,16 +6,26 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+#: trajectory file types `--out` accepts; any other suffix is refused (not taken for a directory name)
+TRAJECTORY_SUFFIXES = (".parquet", ".pq", ".csv")
+
 
 def out_paths(out: str | None, stem: str) -> tuple[Path | None, Path | None, Path | None]:
-    """--out FILE.parquet writes FILE.parquet, FILE.results.json and FILE.png; --out DIR writes
-    DIR/<stem>.parquet, DIR/results.json and DIR/<stem>.png."""
+    """--out FILE.parquet (or FILE.csv) writes that file, FILE.results.json and FILE.png; --out DIR writes
+    DIR/<stem>.parquet, DIR/results.json and DIR/<stem>.png. A path with another suffix is an error rather
+    than a directory called, say, run.txt."""
     if out is None:
         return None, None, None
     p = Path(out)
-    if p.suffix == ".parquet":
+    if p.suffix.lower() in TRAJECTORY_SUFFIXES:
         p.parent.mkdir(parents=True, exist_ok=True)
         return p, p.with_suffix(".results.json"), p.with_suffix(".png")
+    if p.suffix and not p.is_dir():
+        from .._core import InputError
+
+        raise InputError(
+            f"--out {out}: expected a trajectory file ({', '.join(TRAJECTORY_SUFFIXES)}) or a directory (no suffix)"
+        )
     p.mkdir(parents=True, exist_ok=True)
     return p / f"{stem}.parquet", p / "results.json", p / f"{stem}.png"
 
@@ -65,7 +75,7 @@ def write_run(traj, summary: dict, out, stem: str, title: str) -> list[Path]:
     pq, js, png = out_paths(out, stem)
     if pq is None:
         return []
-    traj.to_parquet(pq)
+    traj.to_csv(pq) if pq.suffix.lower() == ".csv" else traj.to_parquet(pq)
     conservation(traj, png, title)
     js.write_text(json.dumps(summary, indent=2))
     return [pq, js, png]

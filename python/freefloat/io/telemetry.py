@@ -43,6 +43,9 @@ class Telemetry:
     v_labels: list = field(default_factory=list)
     momentum: np.ndarray | None = None
     wrench: np.ndarray | None = None
+    #: standard deviations (base linear, base angular, joint) of the white noise on the rates, when known (set by
+    #: `add_noise`, kept in the file's metadata): identification then removes the errors-in-variables bias
+    rate_noise: list | None = None
 
     def __post_init__(self):
         # Check shapes once here so every later step can trust them; name the offending field.
@@ -116,7 +119,10 @@ class Telemetry:
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        meta = {"freefloat": json.dumps({"model": self.model_name, "kind": "telemetry"})}
+        info = {"model": self.model_name, "kind": "telemetry"}
+        if self.rate_noise is not None:
+            info["rate_noise"] = [float(x) for x in self.rate_noise]
+        meta = {"freefloat": json.dumps(info)}
         pq.write_table(pa.table(self.columns()).replace_schema_metadata(meta), str(path))
 
     def to_csv(self, path) -> None:
@@ -124,7 +130,10 @@ class Telemetry:
         then one row per sample at full double precision (%.17g, so a round trip is exact)."""
         cols = self.columns()
         data = np.column_stack(list(cols.values()))
-        header = f"# model: {self.model_name}\n" + ",".join(cols)
+        header = f"# model: {self.model_name}\n"
+        if self.rate_noise is not None:
+            header += "# rate_noise: " + ",".join(repr(float(x)) for x in self.rate_noise) + "\n"
+        header += ",".join(cols)
         np.savetxt(str(path), data, delimiter=",", fmt="%.17g", header=header, comments="")
 
     @classmethod
@@ -138,10 +147,33 @@ class Telemetry:
         if not p.exists():
             raise FileNotFoundError(f"telemetry file not found: {p}")
         cols = _read_parquet(p) if p.suffix.lower() in (".parquet", ".pq") else _read_csv(p)
-        return _from_columns(cols, model, str(p))
+        telem = _from_columns(cols, model, str(p))
+        telem.rate_noise = _read_rate_noise(p)
+        return telem
 
 
 # -- reading and validation ------------------------------------------------------------------------------
+def _read_rate_noise(p: Path):
+    """The rate-noise levels a file declares (Parquet metadata, or a `# rate_noise: a,b,c` CSV comment), or None."""
+    try:
+        if p.suffix.lower() in (".parquet", ".pq"):
+            import pyarrow.parquet as pq
+
+            meta = pq.read_schema(str(p)).metadata or {}
+            r = json.loads(meta.get(b"freefloat", b"{}")).get("rate_noise")
+        else:
+            r = None
+            with open(p) as f:
+                for line in f:
+                    if not line.startswith("#"):
+                        break
+                    if line.startswith("# rate_noise:"):
+                        r = [float(x) for x in line.split(":", 1)[1].split(",")]
+    except (ValueError, OSError):
+        return None
+    return None if r is None else [float(x) for x in r]
+
+
 def _read_parquet(p: Path) -> dict:
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -287,7 +319,13 @@ def add_noise(
         v[:, 2] += rng.normal(0.0, sigma_ang, len(v))
     v[:, nb:] += rng.normal(0.0, sigma_joint, (len(v), model.nv - nb))
     q = integrate_poses(model, telem.t, v, telem.q[0]) if reconstruct_poses else telem.q.copy()
-    return replace(telem, q=q, v=v, momentum=None if telem.momentum is None else telem.momentum.copy())
+    return replace(
+        telem,
+        q=q,
+        v=v,
+        momentum=None if telem.momentum is None else telem.momentum.copy(),
+        rate_noise=[float(sigma_lin), float(sigma_ang), float(sigma_joint)],
+    )
 
 
 def integrate_poses(model, t, v, q0) -> np.ndarray:

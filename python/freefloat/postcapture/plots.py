@@ -13,8 +13,11 @@ from .results import SOLVER_TITLES, PostcaptureResult, _is_product
 
 
 def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
-    """Figs. 4-5 style: estimate / truth versus time, one figure per method (both solvers)."""
+    """Figs. 4-5 style: estimate / truth versus time, one figure per method (both solvers), with the scenario's
+    tolerance band (e.g. ±0.1 %, shaded) and each solver's transit time (after which it stays in the band)
+    marked by a dotted vertical line in the solver's colour."""
     plt = pyplot()
+    tol = res.scenario.tolerance
     paths = []
     for method in METHODS:
         if (method, "modified_rls") not in res.histories:
@@ -23,15 +26,23 @@ def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
         ncol = 4
         nrow = int(np.ceil(len(show) / ncol))
         fig, axes = plt.subplots(nrow, ncol, figsize=(3.2 * ncol, 2.4 * nrow), constrained_layout=True, squeeze=False)
+        transits = {s: res.transits(method, s) for s in SOLVERS}
         for ax, j in zip(axes.ravel(), show):
+            tr = res.truth[j]
+            if tr != 0:
+                ax.axhspan(1 - tol, 1 + tol, color="0.8", alpha=0.6, lw=0, label=f"±{tol * 100:g} % band")
             for solver, style in zip(SOLVERS, ("-", "--")):
                 t, h = res.histories[(method, solver)]
-                tr = res.truth[j]
                 y = h[:, j] / tr if tr != 0 else h[:, j]
-                ax.plot(t, y, style, label=SOLVER_TITLES[solver])
+                (line,) = ax.plot(t, y, style, label=SOLVER_TITLES[solver])
+                stays = transits[solver][j][1]
+                if stays is not None:
+                    ax.axvline(
+                        stays, color=line.get_color(), ls=":", lw=1.2, label=f"transit ({SOLVER_TITLES[solver]})"
+                    )
             ax.set_title(res.names[j] + (" / truth" if res.truth[j] != 0 else " (truth 0)"))
-            if res.truth[j] != 0:
-                ax.set_ylim(0.9, 1.1)
+            if res.truth[j] != 0:  # ±25 band widths: the band stays visible, the approach stays on the axes
+                ax.set_ylim(1 - 25 * tol, 1 + 25 * tol)
             ax.grid(alpha=0.3)
         for ax in axes[-1]:
             ax.set_xlabel("t [s]")

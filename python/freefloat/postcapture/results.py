@@ -93,8 +93,8 @@ class PostcaptureResult:
             if (method, "modified_rls") not in self.histories:
                 continue
             paper = self.scenario.paper.get(method, {})
-            hdr = f"{'param':>6} {'truth':>12} | {'paper ' + method:>22} | " + " | ".join(
-                f"{SOLVER_TITLES[s]:>30}" for s in SOLVERS
+            hdr = f"{'param':>6} {'truth':>12} | {'PAPER: value (transit)':>26} | " + " | ".join(
+                f"{'OURS ' + SOLVER_TITLES[s] + ': value (transit, error)':>40}" for s in SOLVERS
             )
             lines += ["", f"{method}-based", hdr, "-" * len(hdr)]
             tr = {s: self.transits(method, s) for s in SOLVERS}
@@ -104,19 +104,21 @@ class PostcaptureResult:
                     continue
                 p = paper.get(n)
                 ptxt = (
-                    ""
+                    "not in the paper"
                     if p is None or p[0] is None
-                    else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (-)"))
+                    else (f"{p[0]:.6g}" + (f" ({p[1]:g} s)" if len(p) > 1 and p[1] is not None else " (no time)"))
                 )
                 cells = []
                 for s in SOLVERS:
                     e = self.final(method, s)[j]
                     tt = tr[s][j][1]
-                    cells.append(f"{e:>13.6g} ({'-' if tt is None else f'{tt:.1f}'} s, {err[s][j]:.1e})")
-                lines.append(f"{n:>6} {self.truth[j]:>12.6g} | {ptxt:>22} | " + " | ".join(f"{c:>30}" for c in cells))
+                    cells.append(f"{e:>13.6g} ({'not converged' if tt is None else f'{tt:.1f} s'}, {err[s][j]:.1e})")
+                lines.append(f"{n:>6} {self.truth[j]:>12.6g} | {ptxt:>26} | " + " | ".join(f"{c:>40}" for c in cells))
         lines.append("")
         lines.append(
-            "(error in brackets: relative, absolute for a zero true value; '-' = not within tolerance at the end)"
+            "(PAPER: the paper's printed value and transit time; 'not in the paper': the paper prints no value, "
+            "'no time': a value without a transit time. OURS: error relative, absolute for a zero true value; "
+            f"'not converged': not within {tol * 100:g} % at the end of the run)"
         )
         return "\n".join(lines)
 

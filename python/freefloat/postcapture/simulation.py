@@ -83,10 +83,30 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         as_ = as_ + rng.normal(0.0, float(noise.get("acceleration", 0.0)), as_.shape)
     keep = slice(None)
     if mode.get("accelerations", "exact") == "central_difference":
-        # v̇ from the sampled (possibly noisy) velocities by central differences. For the base, v holds body-frame
-        # components and ddq is their time derivative, so this approximates ddq itself. The first and last
-        # samples have no central difference and are dropped (an online estimator runs one sample behind).
+        # v̇ from the sampled (possibly noisy) velocities by central differences. The base's v holds body-frame
+        # components and ddq their time derivative, but differencing rotating-frame components over a whole
+        # sample period (0.1 s of a tumbling base) drops the ω×v term the frame's rotation adds. So the base
+        # velocities are differenced in the INERTIAL frame, where the derivative is the plain acceleration,
+        # and brought back: with v_b = Aᵀ v_I,  d(v_b)/dt = Aᵀ a_I − ω_b × v_b  and  d(ω_b)/dt = Aᵀ d(ω_I)/dt.
+        # Joint rates are differenced as they are. The first and last samples have no central difference and
+        # are dropped (an online estimator runs one sample behind).
         as_ = np.gradient(vs, sc.sample_period, axis=0)
+        if not planar:
+            As = A[idx]
+            lin_i, ang_i = eq.mv(As, vs[:, 0:3]), eq.mv(As, vs[:, 3:6])
+            a_lin = np.gradient(lin_i, sc.sample_period, axis=0)
+            a_ang = np.gradient(ang_i, sc.sample_period, axis=0)
+            At = np.swapaxes(As, -1, -2)
+            as_[:, 0:3] = eq.mv(At, a_lin) - np.cross(vs[:, 3:6], vs[:, 0:3])
+            as_[:, 3:6] = eq.mv(At, a_ang)
+        else:  # planar: (vx, vy) body-frame in the plane, yaw rate r: d(v_b)/dt = R(ψ)ᵀ a_I − r × v_b
+            psi = q[idx][:, 2]
+            c, s_ = np.cos(psi), np.sin(psi)
+            vi = np.stack([c * vs[:, 0] - s_ * vs[:, 1], s_ * vs[:, 0] + c * vs[:, 1]], -1)
+            ai = np.gradient(vi, sc.sample_period, axis=0)
+            r = vs[:, 2]
+            as_[:, 0] = c * ai[:, 0] + s_ * ai[:, 1] + r * vs[:, 1]
+            as_[:, 1] = -s_ * ai[:, 0] + c * ai[:, 1] - r * vs[:, 0]
         keep = slice(1, -1)
     elif mode.get("accelerations", "exact") != "exact":
         raise InputError(

@@ -4,6 +4,8 @@
 /// Built-in robots, embedded in the engine at build time.
 pub mod builtin;
 mod joint;
+/// MJCF (MuJoCo) writer.
+pub mod mjcf;
 mod physics;
 /// URDF reader and writer.
 pub mod urdf;

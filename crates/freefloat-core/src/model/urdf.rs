@@ -4,6 +4,10 @@
 //! free, planar or fixed); joints are taken depth-first, children in document order. Massive links
 //! on fixed joints stay separate bodies (a grasped target must keep its own parameters); a massless
 //! leaf link on a fixed joint (tool points, sensor frames) becomes a `Frame`.
+//!
+//! Body tags (wheel, known, target, ...) are written as `<freefloat tags="..."/>` inside each link and read
+//! back, so a URDF written by freefloat (e.g. `identified.urdf`) feeds every command again with its known
+//! bodies; other URDF tools skip the element.
 
 use super::{BodySpec, JointLimits, JointType, Model, ModelBuilder};
 use crate::error::{FfError, Result};
@@ -14,6 +18,17 @@ use std::fmt::Write;
 struct LinkInfo<'a> {
     node: roxmltree::Node<'a, 'a>,
     inertia: Inertia,
+    tags: Vec<String>,
+}
+
+/// freefloat's body tags (wheel, known, ...) in a link: `<freefloat tags="wheel known"/>`. Other URDF readers
+/// ignore an element they do not know, so the file stays a plain URDF for them.
+fn link_tags(link: roxmltree::Node) -> Vec<String> {
+    link.children()
+        .filter(|n| n.is_element() && n.tag_name().name() == "freefloat")
+        .filter_map(|n| n.attribute("tags"))
+        .flat_map(|t| t.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+        .collect()
 }
 
 struct JointInfo<'a> {
@@ -54,7 +69,8 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonph
             "link" => {
                 let name = attr(node, "name").map_err(|m| err(node, m))?;
                 let inertia = link_inertia(node).map_err(|(n, m)| err(n, format!("link '{name}': {m}")))?;
-                if links.insert(name.to_string(), LinkInfo { node, inertia }).is_some() {
+                let tags = link_tags(node);
+                if links.insert(name.to_string(), LinkInfo { node, inertia, tags }).is_some() {
                     return Err(err(node, format!("link '{name}' is defined twice")));
                 }
                 link_order.push(name.to_string());
@@ -91,6 +107,7 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonph
     let root_info = &links[&root];
     let mut b = ModelBuilder::new(robot_name, &root, base, root_info.inertia)?;
     b.set_base_allow_nonphysical(allow_nonphysical);
+    b.set_base_tags(root_info.tags.clone());
 
     // Depth-first, children in document order.
     let mut stack: Vec<(usize, usize)> = vec![]; // (joint index, parent body index)
@@ -122,7 +139,7 @@ pub fn from_urdf_str(text: &str, source_name: &str, base: JointType, allow_nonph
             placement: j.placement,
             inertia: child.inertia,
             limits: j.limits,
-            tags: vec![],
+            tags: child.tags.clone(),
             allow_nonphysical,
         };
         let idx = b.add_body(spec).map_err(|e| err(j.node, e.to_string()))?;
@@ -266,6 +283,9 @@ pub fn to_urdf_string(m: &Model) -> Result<String> {
     for i in 0..m.nbodies() {
         let inr = &m.inertias[i];
         let _ = writeln!(s, "  <link name=\"{}\">", xml_escape(&m.body_names[i]));
+        if !m.tags[i].is_empty() {
+            let _ = writeln!(s, "    <freefloat tags=\"{}\"/>", xml_escape(&m.tags[i].join(" ")));
+        }
         if inr.mass > 0.0 {
             let ic = inr.i_com();
             let _ = writeln!(s, "    <inertial>\n      <origin xyz=\"{}\" rpy=\"0 0 0\"/>", fmt3(&inr.com()));

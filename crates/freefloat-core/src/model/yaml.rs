@@ -3,7 +3,7 @@
 
 use super::{BodySpec, JointLimits, JointType, Model, ModelBuilder};
 use crate::error::{FfError, Result};
-use crate::spatial::{rotation_about_axis, rpy_to_rot, Inertia, Se3, M3, V3};
+use crate::spatial::{rot_from_quat, rotation_about_axis, rpy_to_rot, Inertia, Se3, M3, V3};
 use serde::Deserialize;
 
 #[derive(Deserialize)]
@@ -59,6 +59,9 @@ struct LimitsYaml {
 struct OriginYaml {
     xyz: Option<[f64; 3]>,
     rpy: Option<[f64; 3]>,
+    /// Unit quaternion (x, y, z, w), an alternative to `rpy` that is exact for any rotation (the MJCF
+    /// reader writes it: no Euler-angle round trip, no gimbal-lock loss).
+    quat: Option<[f64; 4]>,
 }
 
 #[derive(Deserialize)]
@@ -199,7 +202,8 @@ impl Loader<'_> {
             })?;
             let mut placement = Se3::identity();
             if let Some(o) = &body.origin {
-                placement = origin_se3(o, &ang);
+                placement = origin_se3(o, &ang)
+                    .map_err(|m| self.err_at(&body.name, format!("body '{}': origin: {m}", body.name)))?;
             }
             let mut axis = joint.axis.map(V3::from).unwrap_or_else(V3::z);
             if let Some(dh) = &body.mdh {
@@ -274,7 +278,12 @@ impl Loader<'_> {
             let body = b
                 .body_index(&f.body)
                 .ok_or_else(|| self.err_at(&f.name, format!("frame '{}': body '{}' does not exist", f.name, f.body)))?;
-            let pl = f.origin.as_ref().map(|o| origin_se3(o, &ang)).unwrap_or_default();
+            let pl = match f.origin.as_ref() {
+                Some(o) => {
+                    origin_se3(o, &ang).map_err(|m| self.err_at(&f.name, format!("frame '{}': origin: {m}", f.name)))?
+                }
+                None => Se3::default(),
+            };
             b.add_frame(&f.name, body, pl)?;
         }
         b.build().map_err(|e| match &e {
@@ -313,7 +322,19 @@ impl Loader<'_> {
     }
 }
 
-fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> Se3 {
+fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> std::result::Result<Se3, String> {
+    let xyz = V3::from(o.xyz.unwrap_or([0.0; 3]));
+    if let Some(q) = o.quat {
+        if o.rpy.is_some() {
+            return Err("give `rpy` or `quat`, not both".into());
+        }
+        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !n.is_finite() || (n - 1.0).abs() > 1e-6 {
+            return Err(format!("`quat` [x, y, z, w] must be a unit quaternion, its norm is {n}"));
+        }
+        let u = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
+        return Ok(Se3::new(rot_from_quat(&u), xyz));
+    }
     let rpy = o.rpy.map(|r| V3::new(ang(r[0]), ang(r[1]), ang(r[2]))).unwrap_or_else(V3::zeros);
-    Se3::new(rpy_to_rot(&rpy), V3::from(o.xyz.unwrap_or([0.0; 3])))
+    Ok(Se3::new(rpy_to_rot(&rpy), xyz))
 }
