@@ -25,6 +25,14 @@ def _col(t, name, default=np.nan):
 
 def build(out: Path, page: Page) -> list[Path]:
     """Fill `page` with the campaign in `out`; returns the PNG files written."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # medians of all-missing columns (no transit) are NaN
+        return _build(out, page)
+
+
+def _build(out: Path, page: Page) -> list[Path]:
     from ..campaign import dataset
 
     res = json.loads((out / "results.json").read_text())
@@ -33,7 +41,7 @@ def build(out: Path, page: Page) -> list[Path]:
     page.subtitle = f"{res.get('kind', '?')} — {res.get('description', '')}"
     page.section("Summary")
     page.table(
-        ["runs", "total", "done", "failed", "remaining", "run by the last invocation", "where", "wall [s]"],
+        ["runs", "total", "done", "failed", "remaining", "run by the last invocation", "on", "its wall time [s]"],
         [
             [
                 "count",
@@ -145,7 +153,34 @@ def _postcapture(out, page, t, grid, paper) -> list[Path]:
         pngs.append(_png_sweep(out, t, names, combos, X, Y, xs, ys))
         _paper_sweep_table(page, t, X, Y, paper)
     else:
-        _generic(page, t, grid, prefer=[f"error.momentum.modified_rls.{n}" for n in names])
+        xname = f"param.{grid[0]}" if grid and f"param.{grid[0]}" in t.column_names else "run_index"
+        x = _col(t, xname)
+        page.section("Final relative error of every parameter over the runs")
+        page.text(
+            f"One point per run against {xname.replace('param.', '')}; each identification form and solver in "
+            "its own colour (relative error, absolute for a zero true value)."
+        )
+        fig = make_subplots(rows=2, cols=4, subplot_titles=names[:8])
+        for c, (m, s) in enumerate(combos):
+            for k, n in enumerate(names[:8]):
+                fig.add_trace(
+                    go.Box(
+                        x=x,
+                        y=np.maximum(_col(t, f"error.{m}.{s}.{n}") * 100, 1e-12),
+                        name=f"{m} / {s.replace('_', ' ')}",
+                        legendgroup=f"{m}/{s}",
+                        showlegend=k == 0,
+                        boxpoints="all",
+                        marker_color=("#1f77b4", "#aec7e8", "#d62728", "#ff9896")[c % 4],
+                    ),
+                    row=k // 4 + 1,
+                    col=k % 4 + 1,
+                )
+        fig.update_yaxes(type="log")
+        fig.update_yaxes(title_text="error [%]", col=1)
+        fig.update_xaxes(title_text=xname.replace("param.", ""), row=2)
+        fig.update_layout(boxmode="group", title="final relative error [%]")
+        page.figure(fig, height=620)
     # final estimates beside the truth, over the runs
     page.section("Final estimates over the runs (median, min, max) beside the truth")
     rows = []

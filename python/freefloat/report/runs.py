@@ -76,24 +76,27 @@ def simulation_sections(page: Page, out: Path, res: dict, title: str) -> None:
         col=2,
     )
     labels = list(traj.q_labels)
-    first_joint = 7 if len(labels) > 7 and labels[3].endswith(".qx") or len(labels) >= 7 else 0
+    name = traj.model_name or res.get("model")
+    m = None
+    if name:
+        try:
+            m = models.load(name)
+        except Exception:  # noqa: BLE001  (a model the report cannot load: no 3D view, said below)
+            m = None
+    first_joint = int(m.nqs[0]) if m is not None and m.joint_types[0] in ("free", "planar") else 0
     for j in range(first_joint, len(labels)):
         fig.add_trace(go.Scatter(x=t, y=np.asarray(traj.q)[:, j], name=labels[j], legendgroup="q"), row=1, col=3)
     fig.update_xaxes(title_text="t [s]")
     fig.update_layout(title=f"{files[0].name}: conservation and joint motion")
     page.figure(fig, height=420)
-    name = traj.model_name or res.get("model")
-    if name:
-        try:
-            m = models.load(name)
-        except Exception:  # noqa: BLE001  (a model the report cannot load: no 3D view, say so)
-            page.text(f"(no 3D view: model '{name}' cannot be loaded here)")
-            return
-        from .robot3d import figure
+    if m is None:
+        page.text(f"(no 3D view: the model '{name}' of the trajectory cannot be loaded here)")
+        return
+    from .robot3d import figure
 
-        page.section("3D view of the motion")
-        page.text("Bodies (orange), links to the parent body (grey) and body frames (x red, y green, z blue).")
-        page.figure(figure(m, t, np.asarray(traj.q)), height=640)
+    page.section("3D view of the motion")
+    page.text("Bodies (orange), links to the parent body (grey) and body frames (x red, y green, z blue).")
+    page.figure(figure(m, t, np.asarray(traj.q)), height=640)
 
 
 def identification_sections(page: Page, d: dict, title: str) -> None:
