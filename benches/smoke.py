@@ -4,7 +4,7 @@ numbers it recorded are checked. Exits non-zero if a script fails (each one abor
 its peer disagree) or a recorded number is out of bounds. Timings are not judged here (a loaded CI machine
 says nothing about speed); the full runs and their tables are in benches/results/.
 
-    python benches/smoke.py                 # all four
+    python benches/smoke.py                 # all of them
     python benches/smoke.py identify dq     # a subset, by name
 
 Pinocchio and Crocoddyl (the `[test]` extra) are needed for compare_pinocchio and excitation_bench; without them
@@ -70,12 +70,26 @@ def _check_dq(out: Path) -> list[str]:
     return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
 
 
+def _check_campaign(out: Path) -> list[str]:
+    # the script aborts when the campaign's rows and the direct runs disagree; check what it recorded
+    res = json.loads((out / "campaign_bench.json").read_text())
+    thr, bad = res["throughput_runs_per_s"], []
+    if not all(v > 0 for v in thr.values()):
+        bad.append(f"throughput not positive: {thr}")
+    if not res["agreement_max_rel"] <= 1e-12:
+        bad.append(f"agreement_max_rel = {res['agreement_max_rel']:.3g} > 1e-12")
+    if not 0 <= res["overhead"]["per_run_overhead_ms"] < 10_000:
+        bad.append(f"per-run overhead out of range: {res['overhead']}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
     "excitation": ("excitation_bench.py", [], ("pinocchio", "scipy"), _check_excitation),
     "identify": ("identify_vs_numpy.py", ["--repeats", "1"], (), _check_identify),
     "dq": ("dq_dynamics.py", [], (), _check_dq),
+    "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
 }
 
 

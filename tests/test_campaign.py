@@ -116,8 +116,10 @@ def test_builtin_specs_load_and_list():
         ({"grid": {}, "monte_carlo": None}, "no runs"),
         ({"monte_carlo": {"runs": 0}}, "positive integer"),
         ({"monte_carlo": {"runs": 2, "parameters": {"duration": {"distribution": "gauss"}}}}, "distribution"),
-        ({"monte_carlo": {"runs": 2, "parameters": {"duration": {"distribution": "uniform", "low": 2, "high": 1}}}},
-         "low must be below high"),
+        (
+            {"monte_carlo": {"runs": 2, "parameters": {"duration": {"distribution": "uniform", "low": 2, "high": 1}}}},
+            "low must be below high",
+        ),
     ],
 )
 def test_bad_spec(change, match):
@@ -306,8 +308,17 @@ def test_the_same_spec_on_a_separately_started_dask_scheduler_and_worker(tmp_pat
             assert time.monotonic() < deadline, "the dask scheduler/worker did not come up"
             time.sleep(0.5)
         r = subprocess.run(
-            [sys.executable, "-m", "freefloat", "campaign", str(spec_file), "--out", str(tmp_path / "o"),
-             "--scheduler", addr],
+            [
+                sys.executable,
+                "-m",
+                "freefloat",
+                "campaign",
+                str(spec_file),
+                "--out",
+                str(tmp_path / "o"),
+                "--scheduler",
+                addr,
+            ],
             capture_output=True,
             text=True,
             timeout=300,

@@ -7,6 +7,7 @@ Skipped with the reason when no chromium is installed locally; CI installs it, s
 
 from __future__ import annotations
 
+import html as html_lib
 import json
 import os
 import re
@@ -32,7 +33,8 @@ PROBE = """<script>
 window.__errors = [];
 window.addEventListener('error', function (e) { window.__errors.push('error: ' + e.message); });
 (function () { var ce = console.error; console.error = function () {
-  window.__errors.push('console.error: ' + Array.prototype.join.call(arguments, ' ')); ce.apply(console, arguments); }; })();
+  window.__errors.push('console.error: ' + Array.prototype.join.call(arguments, ' '));
+  ce.apply(console, arguments); }; })();
 window.addEventListener('load', function () { setTimeout(function () {
   var plots = document.querySelectorAll('.js-plotly-plot'), drawn = 0, gl = 0, marks = 0;
   plots.forEach(function (p) {
@@ -69,12 +71,10 @@ def _open(report: Path, tmp: Path, height: int = 2400) -> tuple[dict, list[str],
         "--virtual-time-budget=20000",
         f"--window-size=1280,{height}",
     ]
-    r = subprocess.run(
-        [*common, "--dump-dom", probed.as_uri()], capture_output=True, text=True, timeout=180
-    )
+    r = subprocess.run([*common, "--dump-dom", probed.as_uri()], capture_output=True, text=True, timeout=180)
     m = re.search(r'<pre id="__probe">(.*?)</pre>', r.stdout, re.S)
     assert m, f"the page did not finish loading in Chromium: {r.stderr[-2000:]}"
-    probe = json.loads(m.group(1).replace("&quot;", '"').replace("&amp;", "&").replace("&lt;", "<").replace("&gt;", ">"))
+    probe = json.loads(html_lib.unescape(m.group(1)))
     console = [
         ln
         for ln in r.stderr.splitlines()
@@ -117,8 +117,7 @@ def _check(report: Path, tmp: Path, min_figures: int, gl: int = 0):
 
 
 def _ff(*args, cwd):
-    r = subprocess.run([sys.executable, "-m", "freefloat", *args], cwd=cwd, capture_output=True, text=True,
-                       timeout=900)
+    r = subprocess.run([sys.executable, "-m", "freefloat", *args], cwd=cwd, capture_output=True, text=True, timeout=900)
     assert r.returncode == 0, r.stderr[-3000:]
     return r.stdout
 

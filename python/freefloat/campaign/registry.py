@@ -213,17 +213,22 @@ def run_minimal(scenario: dict, seed: int) -> dict:
     t0 = time.perf_counter()
     m = models.load(scenario["model"])
     dur = scenario.get("duration")
-    sim = _simulated(scenario["model"], scenario["trajectory"], float(scenario["dt"]), None if dur is None else float(dur))
+    sim = _simulated(
+        scenario["model"], scenario["trajectory"], float(scenario["dt"]), None if dur is None else float(dur)
+    )
     t_sim = time.perf_counter() - t0
     nz = scenario.get("noise") or {}
     scale = float(nz.get("scale", 1.0))
-    sig = np.array(
-        [
-            SIGMA_LIN if nz.get("velocity_linear") is None else float(nz["velocity_linear"]),
-            SIGMA_ANG if nz.get("velocity_angular") is None else float(nz["velocity_angular"]),
-            SIGMA_JOINT if nz.get("joint_rate") is None else float(nz["joint_rate"]),
-        ]
-    ) * scale
+    sig = (
+        np.array(
+            [
+                SIGMA_LIN if nz.get("velocity_linear") is None else float(nz["velocity_linear"]),
+                SIGMA_ANG if nz.get("velocity_angular") is None else float(nz["velocity_angular"]),
+                SIGMA_JOINT if nz.get("joint_rate") is None else float(nz["joint_rate"]),
+            ]
+        )
+        * scale
+    )
     if not np.all(np.isfinite(sig)) or np.any(sig < 0):
         raise InputError(f"noise: rate noise levels must be finite and non-negative, got {sig.tolist()}")
     telem = tm.from_trajectory(sim)

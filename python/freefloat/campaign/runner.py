@@ -42,6 +42,7 @@ def execute(payload: dict) -> dict:
     }
     row.update({f"param.{k}": v for k, v in payload["params"].items()})
     t0 = time.perf_counter()
+    row["started_at"] = time.time()
     caught: list = []
     try:
         with warnings.catch_warnings(record=True) as caught:
@@ -57,6 +58,7 @@ def execute(payload: dict) -> dict:
         row["error"] = str(e) or type(e).__name__
         row["traceback"] = traceback.format_exc(limit=20)
     row["run_wall_s"] = time.perf_counter() - t0
+    row["finished_at"] = time.time()
     row["warnings"] = "; ".join(dict.fromkeys(str(w.message) for w in caught or []))
     row["worker"] = f"{socket.gethostname()}:{os.getpid()}"
     return row
@@ -213,9 +215,7 @@ def run_campaign(
             "workers": state["workers"],
             "wall_s": time.perf_counter() - t_start,
             "interrupted": state["interrupted"],
-            "failures": [
-                {"run_key": k, "error": e} for k, e in list(final.failed.items())[:20] if k in keys
-            ],
+            "failures": [{"run_key": k, "error": e} for k, e in list(final.failed.items())[:20] if k in keys],
         }
         res["runs_remaining"] = res["runs_total"] - res["runs_done"] - res["runs_failed"]
         (out / "results.json").write_text(json.dumps(res, indent=1))

@@ -203,7 +203,8 @@ def parse(d: dict, source: str, base_dir: Path | None = None) -> CampaignSpec:
     if unknown:
         close = difflib.get_close_matches(str(unknown[0]), SPEC_KEYS, n=1)
         raise InputError(
-            f"{source}: unknown key '{unknown[0]}'" + (f" (did you mean '{close[0]}'?)" if close else "")
+            f"{source}: unknown key '{unknown[0]}'"
+            + (f" (did you mean '{close[0]}'?)" if close else "")
             + f"; keys of a campaign spec: {', '.join(SPEC_KEYS)}"
         )
     for k in ("name", "kind", "scenario"):

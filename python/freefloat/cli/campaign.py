@@ -12,7 +12,9 @@ import click
 @click.argument("spec", required=False)
 @click.option("--out", type=click.Path(file_okay=False), help="Folder for the dataset, campaign.json and results.json.")
 @click.option("--list", "list_", is_flag=True, help="List the built-in campaign specs and exit.")
-@click.option("--runs", type=int, help="Run only the first N runs of the spec (a quick look; the rest can follow later).")
+@click.option(
+    "--runs", type=int, help="Run only the first N runs of the spec (a quick look; the rest can follow later)."
+)
 @click.option(
     "--workers",
     type=int,

@@ -214,9 +214,7 @@ def _png_sweep(out, t, names, combos, X, Y, xs, ys) -> Path:
     from ..viz import pyplot
 
     plt = pyplot()
-    fig, axes = plt.subplots(
-        len(combos), 8, figsize=(22, 2.8 * len(combos)), constrained_layout=True, squeeze=False
-    )
+    fig, axes = plt.subplots(len(combos), 8, figsize=(22, 2.8 * len(combos)), constrained_layout=True, squeeze=False)
     for r, (m, s) in enumerate(combos):
         for k, n in enumerate(names[:8]):
             ax = axes[r, k]
@@ -257,7 +255,10 @@ def _minimal(out, page, t, grid, paper) -> list[Path]:
     fig = make_subplots(rows=1, cols=2, subplot_titles=("median relative error [%]", "max relative error [%]"))
     lab = np.array(labels, dtype=object)
     for c, stat in enumerate(("median", "max")):
-        for est, name, colour in (("ls", "least squares", "#d62728"), ("eiv", "errors-in-variables removed", "#1f77b4")):
+        for est, name, colour in (
+            ("ls", "least squares", "#d62728"),
+            ("eiv", "errors-in-variables removed", "#1f77b4"),
+        ):
             y = _col(t, f"{est}.{stat}_rel_error_pct")
             fig.add_trace(
                 go.Box(
@@ -310,8 +311,13 @@ def _minimal(out, page, t, grid, paper) -> list[Path]:
             ks = [c.split(".")[-1] for c in pcols]
             arr = np.stack([_col(t, f"{est}.rel_error_pct.{k}") for k in ks], axis=1)
             fig.add_trace(
-                go.Box(y=np.abs(arr).ravel(), x=np.repeat([[int(k) for k in ks]], len(arr), 0).ravel(), name=name,
-                       marker_color=colour, boxpoints=False)
+                go.Box(
+                    y=np.abs(arr).ravel(),
+                    x=np.repeat([[int(k) for k in ks]], len(arr), 0).ravel(),
+                    name=name,
+                    marker_color=colour,
+                    boxpoints=False,
+                )
             )
         fig.update_layout(
             boxmode="group",

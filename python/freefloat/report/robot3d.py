@@ -58,9 +58,7 @@ def figure(model, t, q, title: str = "", max_frames: int = MAX_FRAMES, axis_leng
                 ay += [p[i, 1], e[1], None]
                 az += [p[i, 2], e[2], None]
             out.append(
-                go.Scatter3d(
-                    x=ax, y=ay, z=az, mode="lines", line=dict(color=colour, width=3), name="xyz"[a] + " axes"
-                )
+                go.Scatter3d(x=ax, y=ay, z=az, mode="lines", line=dict(color=colour, width=3), name="xyz"[a] + " axes")
             )
         return out
 
