@@ -336,3 +336,30 @@ def test_the_same_spec_on_a_separately_started_dask_scheduler_and_worker(tmp_pat
                 p.wait(timeout=20)
             except subprocess.TimeoutExpired:
                 p.kill()
+
+
+@pytest.mark.slow
+def test_repair_quarantines_damaged_files_and_runs_their_runs_again(tmp_path):
+    s = _spec(grid={"initial.base_velocity.0": [1.0, 2.0]}, monte_carlo=None)
+    _fake_done_rows(s, tmp_path, 2)
+    f = dataset.files(tmp_path / "runs")[0][1]
+    f.write_bytes(f.read_bytes()[:100])  # truncated, as by a full disk
+    res = cp.run_campaign(s, tmp_path, workers=1, progress=False, repair=True, echo=lambda *_: None)
+    assert (tmp_path / "quarantine" / f"status=done-{f.name}").is_file()
+    assert res["runs_new"] == 2 and res["runs_done"] == 2
+    assert len(_rows(tmp_path)) == 2
+
+
+def test_cli_bad_input_is_one_clear_line(tmp_path):
+    from click.testing import CliRunner
+
+    from freefloat.cli import main
+
+    r = CliRunner().invoke(main, ["campaign", "zhang2020_velocity_swep", "--out", str(tmp_path / "o")])
+    assert r.exit_code == 2 and "did you mean zhang2020_velocity_sweep" in r.output
+    r = CliRunner().invoke(main, ["campaign", "zhang2020_velocity_sweep"])
+    assert r.exit_code == 2 and "--out DIR is required" in r.output
+    r = CliRunner().invoke(main, ["campaign", "zhang2020_velocity_sweep", "--out", str(tmp_path), "--runs", "0"])
+    assert r.exit_code == 2 and "--runs" in r.output
+    r = CliRunner().invoke(main, ["campaign", "--list"])
+    assert r.exit_code == 0 and "zhang2020_velocity_sweep" in r.output and "naveen_noise_monte_carlo" in r.output

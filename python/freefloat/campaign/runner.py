@@ -115,7 +115,7 @@ def _connect(scheduler: str | None, workers: int | None):
         n_workers=n,
         threads_per_worker=1,
         processes=True,
-        dashboard_address=None,
+        dashboard_address=":0",  # any free port: the scheduler's HTTP server starts anyway, never clash on 8787
         silence_logs=logging.ERROR,
     )
     return Client(cluster), cluster, f"LocalCluster({n} workers)"

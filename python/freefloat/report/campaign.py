@@ -211,27 +211,39 @@ def _paper_sweep_table(page, t, X, Y, paper):
 
 
 def _png_sweep(out, t, names, combos, X, Y, xs, ys) -> Path:
+    """The papers' format for print: rows = form/solver, columns = the eight parameters, one colour scale (log10
+    of the error in percent) shared by all panels (no constrained layout: 32 panels would make it slow)."""
     from ..viz import pyplot
 
     plt = pyplot()
-    fig, axes = plt.subplots(len(combos), 8, figsize=(22, 2.8 * len(combos)), constrained_layout=True, squeeze=False)
-    for r, (m, s) in enumerate(combos):
-        for k, n in enumerate(names[:8]):
-            ax = axes[r, k]
+    grids = {}
+    for m, s in combos:
+        for n in names[:8]:
             Z = np.full((len(ys), len(xs)), np.nan)
             for x, y, v in zip(X, Y, _col(t, f"error.{m}.{s}.{n}") * 100):
                 Z[np.searchsorted(ys, y), np.searchsorted(xs, x)] = v
-            im = ax.pcolormesh(xs, ys, np.log10(np.maximum(Z, 1e-12)), shading="nearest", cmap="viridis")
-            ax.set_title(f"{n} ({m[:3]}, {s.split('_')[0]})", fontsize=9)
+            grids[(m, s, n)] = np.log10(np.maximum(Z, 1e-12))
+    vals = np.concatenate([g[np.isfinite(g)] for g in grids.values()]) if grids else np.zeros(1)
+    lo, hi = (float(np.min(vals)), float(np.max(vals))) if vals.size else (0.0, 1.0)
+    fig, axes = plt.subplots(len(combos), 8, figsize=(20, 2.4 * len(combos) + 0.8), squeeze=False)
+    fig.subplots_adjust(left=0.05, right=0.92, bottom=0.08, top=0.9, wspace=0.3, hspace=0.45)
+    im = None
+    for r, (m, s) in enumerate(combos):
+        for k, n in enumerate(names[:8]):
+            ax = axes[r, k]
+            im = ax.pcolormesh(xs, ys, grids[(m, s, n)], shading="nearest", cmap="viridis", vmin=lo, vmax=hi)
+            ax.set_title(f"{n} ({m}, {s.split('_')[0]})", fontsize=8)
+            ax.tick_params(labelsize=7)
             if k == 0:
-                ax.set_ylabel("Vy [m/s]")
+                ax.set_ylabel("Vy [m/s]", fontsize=8)
             if r == len(combos) - 1:
-                ax.set_xlabel("Vx [m/s]")
-            fig.colorbar(im, ax=ax, label="log10 error [%]")
+                ax.set_xlabel("Vx [m/s]", fontsize=8)
+    if im is not None:
+        fig.colorbar(im, cax=fig.add_axes([0.94, 0.1, 0.012, 0.78]), label="log10 relative error [%]")
     fig.suptitle("Relative error at the end of the run vs initial base velocity (Zhang, Yue, Yuan 2020, Figs. 6-9)")
     (out / "figures").mkdir(exist_ok=True)
     p = out / "figures" / "velocity_sweep.png"
-    fig.savefig(p, dpi=100)
+    fig.savefig(p, dpi=90)
     plt.close(fig)
     return p
 
