@@ -363,3 +363,35 @@ def test_cli_bad_input_is_one_clear_line(tmp_path):
     assert r.exit_code == 2 and "--runs" in r.output
     r = CliRunner().invoke(main, ["campaign", "--list"])
     assert r.exit_code == 0 and "zhang2020_velocity_sweep" in r.output and "naveen_noise_monte_carlo" in r.output
+
+
+@pytest.mark.slow
+def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_continues(tmp_path):
+    spec_file = tmp_path / "spec.yaml"
+    spec_file.write_text(yaml.safe_dump(MEDIUM_2X8))
+    cmd = [
+        sys.executable,
+        "-m",
+        "freefloat",
+        "campaign",
+        str(spec_file),
+        "--out",
+        str(tmp_path / "o"),
+        "--workers",
+        "1",
+    ]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not dataset.files(tmp_path / "o" / "runs"):  # wait until some rows are on disk
+        assert time.monotonic() < deadline and p.poll() is None, "no rows written"
+        time.sleep(0.3)
+    p.send_signal(signal.SIGINT)
+    _, err = p.communicate(timeout=60)
+    assert p.returncode == 130 and "run the same command again to continue" in err
+    res = json.loads((tmp_path / "o" / "results.json").read_text())
+    assert res["interrupted"] is True and 1 <= res["runs_done"] < 16
+    kept = res["runs_done"]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr[-2000:]
+    res = json.loads((tmp_path / "o" / "results.json").read_text())
+    assert res["runs_done"] == 16 and res["runs_new"] == 16 - kept and len(_rows(tmp_path / "o")) == 16
