@@ -189,6 +189,33 @@ def test_damaged_dataset_is_reported_not_dropped(tmp_path):
     assert len(dataset.files(tmp_path / "runs")) == 2
 
 
+@pytest.mark.parametrize("reader", ["pyarrow", "pandas", "polars", "duckdb"])
+def test_the_dataset_is_read_by_the_usual_readers(tmp_path, reader):
+    s = _spec()
+    _fake_done_rows(s, tmp_path, 3)
+    w = dataset.Writer(tmp_path / "runs")
+    w.add(runner.execute(_spec(set={"duration": -1.0}).runs(1)[0].payload()))  # one failed run
+    w.flush()
+    root = tmp_path / "runs"
+    if reader == "pyarrow":
+        rows = pads.dataset(root, partitioning="hive").to_table().to_pylist()
+    elif reader == "pandas":
+        rows = pytest.importorskip("pandas").read_parquet(root).to_dict("records")
+    elif reader == "polars":
+        pl = pytest.importorskip("polars")
+        rows = pl.scan_parquet(f"{root}/**/*.parquet", hive_partitioning=True, missing_columns="insert").collect()
+        rows = rows.to_dicts()
+    else:
+        duckdb = pytest.importorskip("duckdb")
+        rel = duckdb.sql(
+            f"SELECT * FROM read_parquet('{root}/**/*.parquet', hive_partitioning=true, union_by_name=true)"
+        )
+        rows = [dict(zip(rel.columns, r)) for r in rel.fetchall()]
+    assert sorted(str(r["status"]) for r in rows) == ["done"] * 3 + ["failed"]
+    bad = next(r for r in rows if str(r["status"]) == "failed")
+    assert "t_final" in bad["error"]
+
+
 @pytest.mark.slow
 def test_unreachable_scheduler_is_a_clear_error_within_10_s(tmp_path):
     with socket.socket() as sk:
@@ -259,6 +286,9 @@ def test_runs_that_raise_are_recorded_and_retried_on_request(tmp_path):
     assert res["runs_done"] == 1 and res["runs_failed"] == 1 and res["runs_new"] == 2
     failed = [r for r in dataset.read(tmp_path / "runs", None).to_pylist() if r["status"] == "failed"]
     assert len(failed) == 1 and failed[0]["param.duration"] == -1.0 and "t_final" in failed[0]["error"]
+    # a reader that takes its schema from the first file (the done partition) still sees the error
+    plain = [r for r in _rows(tmp_path) if r["status"] == "failed"]
+    assert plain[0]["error"] == failed[0]["error"]
     assert res["failures"][0]["run_key"] == failed[0]["run_key"]
     # a plain re-run skips the failed run too (it would fail again); --retry-failed runs it again
     assert cp.run_campaign(s, tmp_path, workers=1, progress=False)["runs_new"] == 0

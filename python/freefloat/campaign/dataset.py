@@ -34,6 +34,9 @@ from .spec import _hash
 
 STATUSES = ("done", "failed")
 INT_COLUMNS = ("run_index", "seed", "attempts")
+#: always strings (also when empty), and present in every file of both partitions: a reader that takes the
+#: schema from the first file it finds (pyarrow.dataset's default) still sees the errors of failed runs
+STRING_COLUMNS = ("run_key", "inputs", "worker", "warnings", "error_type", "error", "traceback")
 
 
 class CorruptDataset(InputError):
@@ -43,6 +46,8 @@ class CorruptDataset(InputError):
 def _type_of(name: str, value) -> pa.DataType:
     if name in INT_COLUMNS:
         return pa.int64()
+    if name in STRING_COLUMNS:
+        return pa.string()
     if isinstance(value, bool):
         return pa.bool_()
     if isinstance(value, str):
@@ -57,6 +62,8 @@ def _cell(name: str, value):
         return json.dumps(value, sort_keys=True)
     if name in INT_COLUMNS:
         return None if value is None else int(value)
+    if name in STRING_COLUMNS:
+        return None if value is None else str(value)
     if value is None or isinstance(value, (bool, str)):
         return value
     return float(value)
@@ -91,6 +98,8 @@ class Writer:
     written: int = 0
 
     def add(self, row: dict) -> None:
+        for k in STRING_COLUMNS:
+            row.setdefault(k, None)
         self._buffer[row.pop("status")].append(row)
         pending = sum(len(b) for b in self._buffer.values())
         if pending >= self.flush_rows or time.monotonic() - self._last >= self.flush_seconds:

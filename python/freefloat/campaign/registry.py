@@ -115,8 +115,10 @@ def _pc_parameters(base: dict) -> list:
 
 def _pc_normalize(d: dict) -> dict:
     d = _json_roundtrip(d)
-    for k in ("sweep", "paper_sweep"):
-        d.pop(k, None)  # a campaign run is one run: the scenario's own sweep list is not part of it
+    # not inputs of one run: the scenario's own sweep list, the paper's printed values, the description (editing
+    # them must not make finished runs look new)
+    for k in ("sweep", "paper_sweep", "paper", "description"):
+        d.pop(k, None)
     return d
 
 
@@ -162,7 +164,7 @@ def _min_load(ref) -> dict:
         ref = {"model": ref}
     if not isinstance(ref, dict):
         raise InputError(f"scenario of kind identify_minimal: expected a robot name or a mapping, got {ref!r}")
-    unknown = [k for k in ref if k not in d and k not in ("name", "description")]
+    unknown = [k for k in ref if k not in d and k != "name"]
     if unknown:
         close = difflib.get_close_matches(unknown[0], list(d), n=1)
         raise InputError(

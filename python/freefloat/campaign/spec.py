@@ -93,9 +93,11 @@ class CampaignSpec:
     def fingerprint(self) -> str:
         """A hash of what the campaign runs (kind, base scenario, overrides, grid, draws), not its description:
         two specs with the same fingerprint produce the same runs."""
+        from . import registry
+
         what = {
             "kind": self.kind,
-            "base": self.base,
+            "base": registry.get(self.kind).normalize(copy.deepcopy(self.base)),
             "set": self.fixed,
             "grid": self.grid,
             "monte_carlo": self.monte_carlo,
