@@ -125,7 +125,7 @@ def _ff(*args, cwd):
 def test_demo_report_in_chromium(tmp_path):
     _ff("demo", "--out", "demo", "--t-final", "2", cwd=tmp_path)
     _ff("report", "demo", cwd=tmp_path)
-    _check(tmp_path / "demo" / "report.html", tmp_path, min_figures=4, gl=1)
+    _check(tmp_path / "demo" / "report.html", tmp_path, min_figures=3, gl=1)  # motion, 3D view, parameter errors
 
 
 def test_postcapture_report_in_chromium(tmp_path):
