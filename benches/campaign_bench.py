@@ -17,7 +17,7 @@ Per-run overhead: a 1-worker campaign of very short runs (0.3 s of simulated tim
 Agreement: every campaign row's final estimates equal the direct peer's for the same run (same seeds) to 1e-12
 before anything is reported.
 
-    python benches/campaign_bench.py            # 16 runs of ~1 s, 3 repeats; 200 short runs for the overhead
+    python benches/campaign_bench.py            # 16 runs of ~1 s (20 s simulated), 3 repeats; 200 short runs
     python benches/campaign_bench.py --quick    # 4 runs of ~0.3 s, 1 repeat; 40 short runs (CI smoke)
     python benches/campaign_bench.py --out DIR  # write campaign_bench.{json,md} there (default benches/results)
 """
@@ -84,11 +84,11 @@ def main(argv=None) -> int:
     ap.add_argument("--quick", action="store_true", help="small problem, one repeat (CI smoke run)")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "results"))
     ap.add_argument("--runs", type=int, help="runs per campaign (default 16; quick 4)")
-    ap.add_argument("--duration", type=float, help="simulated seconds per run (default 6 s ≈ 1 s of work)")
+    ap.add_argument("--duration", type=float, help="simulated seconds per run (default 20: ~1 s of work)")
     ap.add_argument("--repeats", type=int, help="interleaved repeats (default 3; quick 1)")
     a = ap.parse_args(argv)
     runs = a.runs or (4 if a.quick else 16)
-    duration = a.duration or (2.0 if a.quick else 6.0)
+    duration = a.duration or (2.0 if a.quick else 20.0)
     repeats = a.repeats or (1 if a.quick else 3)
     short_runs = 40 if a.quick else 200
     s = spec(runs, duration, "bench_throughput")
