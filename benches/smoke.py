@@ -88,6 +88,19 @@ def _check_derivatives(out: Path) -> list[str]:
     return bad
 
 
+def _check_campaign(out: Path) -> list[str]:
+    # the script aborts when the campaign's rows and the direct runs disagree; check what it recorded
+    res = json.loads((out / "campaign_bench.json").read_text())
+    thr, bad = res["throughput_runs_per_s"], []
+    if not all(v > 0 for v in thr.values()):
+        bad.append(f"throughput not positive: {thr}")
+    if not res["agreement_max_rel"] <= 1e-12:
+        bad.append(f"agreement_max_rel = {res['agreement_max_rel']:.3g} > 1e-12")
+    if not 0 <= res["overhead"]["per_run_overhead_ms"] < 10_000:
+        bad.append(f"per-run overhead out of range: {res['overhead']}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -96,6 +109,7 @@ BENCHES = {
     "dq": ("dq_dynamics.py", [], (), _check_dq),
     "adaptive": ("adaptive_bench.py", [], ("scipy",), _check_adaptive),
     "derivatives": ("derivatives_bench.py", [], ("pinocchio", "crocoddyl"), _check_derivatives),
+    "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
 }
 
 

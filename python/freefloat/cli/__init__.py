@@ -2,7 +2,7 @@
 
 One module per command group, each a thin layer over the library: `models`, `simulate`, `reactions`, `demo`,
 `params`, `identify` (+ `postcapture` for `identify postcapture` and `scenarios`), `excite`, `control`
-(the group; one module per controller). A new command goes
+(the group; one module per controller), `campaign` and `report`. A new command goes
 in its own module and is registered below.
 """
 
@@ -13,7 +13,7 @@ import sys
 import click
 
 from .. import _core
-from . import adaptive, control, convert, demo, excite, export, identify, models, params, postcapture, reactions, simulate
+from . import adaptive, campaign, control, convert, demo, excite, export, identify, models, params, postcapture, reactions, report, simulate
 
 
 class FriendlyGroup(click.Group):
@@ -49,5 +49,7 @@ main.add_command(control.control_group)
 control.control_group.add_command(adaptive.adaptive_cmd)
 main.add_command(export.export_cmd)
 main.add_command(convert.convert_cmd)
+main.add_command(campaign.campaign_cmd)
+main.add_command(report.report_cmd)
 
 __all__ = ["main"]

@@ -1,5 +1,5 @@
-"""Access to the files shipped inside the package (folder `freefloat/data/`): built-in post-capture scenarios and
-designed trajectories.
+"""Access to the files shipped inside the package (folder `freefloat/data/`): built-in post-capture scenarios,
+designed trajectories and campaign specs (`freefloat campaign --list`).
 
 They are found with `importlib.resources`, so they work the same from a wheel, a normal install and an editable
 install of a source checkout. Built-in robots are not here: they are embedded in the engine (`ff.models`).
@@ -22,7 +22,7 @@ from pathlib import Path
 from .._core import InputError
 
 #: kind -> file suffix of the shipped files
-KINDS = {"scenarios": ".yaml", "trajectories": ".json"}
+KINDS = {"scenarios": ".yaml", "trajectories": ".json", "campaigns": ".yaml"}
 
 #: kind -> {earlier name: current name}; earlier names still load, listings show the current ones
 ALIASES = {
