@@ -4,7 +4,7 @@ numbers it recorded are checked. Exits non-zero if a script fails (each one abor
 its peer disagree) or a recorded number is out of bounds. Timings are not judged here (a loaded CI machine
 says nothing about speed); the full runs and their tables are in benches/results/.
 
-    python benches/smoke.py                 # all four
+    python benches/smoke.py                 # all of them
     python benches/smoke.py identify dq     # a subset, by name
 
 Pinocchio and Crocoddyl (the `[test]` extra) are needed for compare_pinocchio and excitation_bench; without them
@@ -65,6 +65,16 @@ def _check_identify(out: Path) -> list[str]:
     return bad
 
 
+def _check_ddp(out: Path) -> list[str]:
+    res = json.loads((out / "ddp_vs_crocoddyl.json").read_text())
+    a, bad = res["agreement"], []
+    if not a["final_cost_rel"] <= 1e-6:
+        bad.append(f"final_cost_rel = {a['final_cost_rel']:.3g} > 1e-6")
+    if a["iterations_freefloat_le_crocoddyl"] is not True:
+        bad.append("freefloat needed more iterations than Crocoddyl")
+    return bad
+
+
 def _check_dq(out: Path) -> list[str]:
     # the script aborts when dq_dynamics and aba disagree; check that it wrote its table
     return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
@@ -76,6 +86,7 @@ BENCHES = {
     "excitation": ("excitation_bench.py", [], ("pinocchio", "scipy"), _check_excitation),
     "identify": ("identify_vs_numpy.py", ["--repeats", "1"], (), _check_identify),
     "dq": ("dq_dynamics.py", [], (), _check_dq),
+    "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
 }
 
 

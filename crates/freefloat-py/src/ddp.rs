@@ -65,7 +65,8 @@ fn cost_term(m: &Model, d: &Bound<'_, PyDict>, i: usize) -> PyResult<CostTerm> {
         }
         "frame_dq" => {
             let (body, placement) = frame(m, &need::<String>(d, &ctx, "frame")?)?;
-            let r = reference.ok_or_else(|| input_err(format!("{ctx}: missing key `reference` ((M, 8) dual quaternions)")))?;
+            let r = reference
+                .ok_or_else(|| input_err(format!("{ctx}: missing key `reference` ((M, 8) dual quaternions)")))?;
             let refs = rows(&format!("{name}.reference"), &r, 8)?
                 .iter()
                 .map(|p| [p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]])
@@ -218,7 +219,8 @@ fn info_dict<'py>(py: Python<'py>, i: &IterInfo) -> PyResult<Bound<'py, PyDict>>
 /// best_alpha, accept_ratio, reg_init, reg_min, reg_max, reg_factor, tol_expected, tol_cost.
 /// `callback(info: dict)` is called after every iteration; returning False stops (so does Ctrl-C), keeping
 /// the best iterate. Returns a dict: xs, us, gains (horizon, nu, ndx), cost, initial_cost, iterations, stop,
-/// stop_message, history (list of dicts), gap.
+/// stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
+/// and rollout blocks).
 #[pyfunction]
 #[pyo3(signature = (model, x0, dt, horizon, running, terminal, us0, keep_out = None, xs0 = None, options = None, callback = None))]
 #[allow(clippy::too_many_arguments)]
@@ -353,6 +355,15 @@ pub fn ddp_solve<'py>(
     }
     out.set_item("history", hist)?;
     out.set_item("gap", sol.gap)?;
+    let t = PyDict::new(py);
+    let tm = sol.timings;
+    t.set_item("calc_diff_s", tm.calc_diff_s)?;
+    t.set_item("calc_diff_calls", tm.calc_diff_calls)?;
+    t.set_item("backward_s", tm.backward_s)?;
+    t.set_item("backward_calls", tm.backward_calls)?;
+    t.set_item("forward_s", tm.forward_s)?;
+    t.set_item("forward_calls", tm.forward_calls)?;
+    out.set_item("timings", t)?;
     Ok(out)
 }
 
@@ -376,9 +387,7 @@ pub fn ddp_screw_reference<'py>(
     n: usize,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let s = DualQuat::from_slice(&start);
-    let r = guard(|| {
-        screw_reference(&s, &V3::from(axis), &V3::from(moment), angle, advance, t_hold, t_move, dt, n)
-    })?;
+    let r = guard(|| screw_reference(&s, &V3::from(axis), &V3::from(moment), angle, advance, t_hold, t_move, dt, n))?;
     let rows: Vec<Vec<f64>> = r.iter().map(|q| q.to_array().to_vec()).collect();
     PyArray2::from_vec2(py, &rows).map_err(|e| input_err(e.to_string()))
 }

@@ -13,7 +13,7 @@ import sys
 import click
 
 from .. import _core
-from . import control, demo, excite, identify, models, params, postcapture, reactions, simulate
+from . import control, ddp, demo, excite, identify, models, params, postcapture, reactions, simulate
 
 
 class FriendlyGroup(click.Group):
@@ -46,5 +46,6 @@ identify.identify_group.add_command(postcapture.identify_postcapture_cmd)
 main.add_command(excite.excite_cmd)
 main.add_command(postcapture.scenarios_cmd)
 main.add_command(control.control_group)
+control.control_group.add_command(ddp.ddp_cmd)
 
 __all__ = ["main"]

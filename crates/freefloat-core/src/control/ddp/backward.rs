@@ -91,14 +91,15 @@ pub fn backward_pass(
         ws.qx.gemv_tr(1.0, &d.fx, &ws.vx_plus, 1.0);
         ws.qu.copy_from(&d.lu);
         ws.qu.gemv_tr(1.0, &d.fu, &ws.vx_plus, 1.0);
-        ws.fxt_v.gemm_tr(1.0, &d.fx, vxxn, 0.0);
+        // (tr_mul_to, not gemm_tr: nalgebra's gemm_tr allocates a temporary.)
+        d.fx.tr_mul_to(vxxn, &mut ws.fxt_v);
         ws.qxx.copy_from(&d.lxx);
-        ws.qxx.gemm(1.0, &ws.fxt_v, &d.fx, 1.0);
-        ws.fut_v.gemm_tr(1.0, &d.fu, vxxn, 0.0);
+        mul_add(&mut ws.qxx, &ws.fxt_v, &d.fx);
+        d.fu.tr_mul_to(vxxn, &mut ws.fut_v);
         ws.quu.copy_from(&d.luu);
-        ws.quu.gemm(1.0, &ws.fut_v, &d.fu, 1.0);
+        mul_add(&mut ws.quu, &ws.fut_v, &d.fu);
         ws.qux.tr_copy_from(&d.lxu);
-        ws.qux.gemm(1.0, &ws.fut_v, &d.fx, 1.0);
+        mul_add(&mut ws.qux, &ws.fut_v, &d.fx);
         if full {
             // Full DDP (eqs. (8.39)–(8.41)): + Σ_j V_x'[j] ∂²F^j.
             let (xk, uk) = (ws.xs[k].as_slice(), ws.us[k].as_slice());
@@ -143,17 +144,40 @@ pub fn backward_pass(
         vx.gemv_tr(1.0, kfb, &ws.tmp_u, 1.0);
         vx.gemv_tr(1.0, &ws.qux, kff, 1.0);
         ws.tmp_ux.copy_from(&ws.qux);
-        ws.tmp_ux.gemm(1.0, &ws.quu, kfb, 1.0);
+        mul_add(&mut ws.tmp_ux, &ws.quu, kfb);
         let vxx = &mut vxx_now[k];
         vxx.copy_from(&ws.qxx);
-        vxx.gemm_tr(1.0, kfb, &ws.tmp_ux, 1.0);
-        vxx.gemm_tr(1.0, &ws.qux, kfb, 1.0);
+        kfb.tr_mul_to(&ws.tmp_ux, &mut ws.fxt_v);
+        *vxx += &ws.fxt_v;
+        ws.qux.tr_mul_to(kfb, &mut ws.fxt_v);
+        *vxx += &ws.fxt_v;
         symmetrise(vxx);
         if !vx.iter().all(|v| v.is_finite()) || !vxx.iter().all(|v| v.is_finite()) {
             return Err(FfError::Numerical(format!("the value function became non-finite at node {k}")));
         }
     }
     Ok(Backward::Done)
+}
+
+/// `out += a b` for column-major matrices, column by column (axpy form, vectorises well). Written out
+/// because nalgebra's dynamic `gemm` allocates a packing buffer on every call.
+fn mul_add(out: &mut DMatrix<f64>, a: &DMatrix<f64>, b: &DMatrix<f64>) {
+    let (m, k) = (a.nrows(), a.ncols());
+    debug_assert_eq!((out.nrows(), out.ncols(), b.nrows()), (m, b.ncols(), k));
+    let asl = a.as_slice();
+    for j in 0..b.ncols() {
+        let oc = &mut out.as_mut_slice()[j * m..(j + 1) * m];
+        for p in 0..k {
+            let bpj = b[(p, j)];
+            if bpj == 0.0 {
+                continue;
+            }
+            let ac = &asl[p * m..(p + 1) * m];
+            for i in 0..m {
+                oc[i] += ac[i] * bpj;
+            }
+        }
+    }
 }
 
 fn symmetrise(a: &mut DMatrix<f64>) {

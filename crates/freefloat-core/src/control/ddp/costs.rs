@@ -228,14 +228,11 @@ impl CostTerm {
 /// quaternion of `q` and the joint rotations, so that it is continuous in q (eq. (8.46)). The
 /// translation is taken from forward kinematics (`o_mf`, already computed).
 pub fn frame_dual_quat(m: &Model, q: &[f64], body: usize, placement: &Se3, o_mf: &Se3) -> Result<DualQuat> {
-    let mut chain = Vec::with_capacity(8);
+    // Walk from the body to the root, left-multiplying each joint's (placement ∘ joint) rotation, so the
+    // product is q_base q_1 ... q_body q_frame without a buffer.
+    let mut rot = Quat::from_rotation_matrix(&placement.rot);
     let mut j = Some(body);
     while let Some(i) = j {
-        chain.push(i);
-        j = m.parents[i];
-    }
-    let mut rot = Quat::new(1.0, 0.0, 0.0, 0.0);
-    for &i in chain.iter().rev() {
         let iq = m.idx_q[i];
         let joint = match m.joint_types[i] {
             JointType::Free => Quat::from_xyzw(&[q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6]]),
@@ -253,9 +250,9 @@ pub fn frame_dual_quat(m: &Model, q: &[f64], body: usize, placement: &Se3, o_mf:
         } else {
             Quat::new(1.0, 0.0, 0.0, 0.0)
         };
-        rot = rot.mul(&place).mul(&joint);
+        rot = place.mul(&joint).mul(&rot);
+        j = m.parents[i];
     }
-    rot = rot.mul(&Quat::from_rotation_matrix(&placement.rot));
     Ok(pose::from_rotation_translation(&rot, &o_mf.trans))
 }
 

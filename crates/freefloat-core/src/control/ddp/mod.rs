@@ -18,7 +18,7 @@ pub mod workspace;
 
 pub use problem::{ActionModel, DynamicsHessian, NodeDiff};
 pub use regularisation::{RegOptions, Regularisation};
-pub use solver::{DdpOptions, IterInfo, Solution, Solver, StopReason, Variant};
+pub use solver::{DdpOptions, IterInfo, Solution, Solver, StopReason, Timings, Variant};
 pub use workspace::Workspace;
 pub mod costs;
 pub mod fd_step;

@@ -12,6 +12,7 @@ use super::regularisation::{RegOptions, Regularisation};
 use super::workspace::Workspace;
 use crate::check::check_finite;
 use crate::error::{FfError, Result};
+use std::time::Instant;
 
 /// Which DDP.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -167,6 +168,25 @@ pub struct Solution {
     pub history: Vec<IterInfo>,
     /// Largest gap of the returned iterate.
     pub gap: f64,
+    /// Wall time spent in each block over the solve.
+    pub timings: Timings,
+}
+
+/// Wall time (s) per block of a solve and how often each ran.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Timings {
+    /// Derivatives of every node (dynamics and costs).
+    pub calc_diff_s: f64,
+    /// Derivative evaluations.
+    pub calc_diff_calls: usize,
+    /// Riccati backward passes (including the expected-change sweep).
+    pub backward_s: f64,
+    /// Backward passes.
+    pub backward_calls: usize,
+    /// Line-search rollouts (dynamics and costs along the trial).
+    pub forward_s: f64,
+    /// Rollouts.
+    pub forward_calls: usize,
 }
 
 /// A DDP solver with its preallocated workspace for one problem size.
@@ -228,10 +248,12 @@ impl Solver {
         };
         let initial_cost = cost;
         let mut reg = Regularisation::new(opts.reg);
-        let mut history = Vec::new();
+        // Reserved up front so that iterations allocate nothing.
+        let mut history = Vec::with_capacity(opts.max_iter);
         let mut need_diff = true;
         let mut stop = StopReason::MaxIterations;
         let mut iterations = 0;
+        let mut tm = Timings::default();
         for iter in 1..=opts.max_iter {
             iterations = iter;
             if iter > 1 && model.set_iteration(iter) {
@@ -247,7 +269,11 @@ impl Solver {
             }
             let feasible = !use_gaps || self.ws.is_feasible(opts.tol_gap);
             if need_diff {
-                if let Err(e) = self.calc_diff(model) {
+                let t0 = Instant::now();
+                let r = self.calc_diff(model);
+                tm.calc_diff_s += t0.elapsed().as_secs_f64();
+                tm.calc_diff_calls += 1;
+                if let Err(e) = r {
                     stop = StopReason::Failed(e.to_string());
                     break;
                 }
@@ -255,8 +281,10 @@ impl Solver {
             // Backward pass, raising λ until Q_uu + λI is positive definite at every node.
             let mut passes = 0;
             let lambda_used;
+            let t0 = Instant::now();
             loop {
                 passes += 1;
+                tm.backward_calls += 1;
                 match backward_pass(model, &mut self.ws, reg.lambda, opts.second_order, use_gaps && !feasible) {
                     Ok(Backward::Done) => {
                         lambda_used = reg.lambda;
@@ -283,6 +311,7 @@ impl Solver {
                 break;
             }
             let (d1, d2) = expected_change(&mut self.ws, use_gaps && !feasible);
+            tm.backward_s += t0.elapsed().as_secs_f64();
             let expected_full = -(d1 + 0.5 * d2);
             if feasible && expected_full.abs() < opts.tol_expected {
                 let info = IterInfo {
@@ -307,7 +336,11 @@ impl Solver {
             let mut rollouts = 0;
             for &alpha in &opts.alphas {
                 rollouts += 1;
-                let Ok(c) = rollout_trial(model, &mut self.ws, alpha, use_gaps && !feasible) else {
+                let t0 = Instant::now();
+                let trial = rollout_trial(model, &mut self.ws, alpha, use_gaps && !feasible);
+                tm.forward_s += t0.elapsed().as_secs_f64();
+                tm.forward_calls += 1;
+                let Ok(c) = trial else {
                     continue; // diverged: a rejected trial
                 };
                 let expected = -(alpha * d1 + 0.5 * alpha * alpha * d2);
@@ -406,6 +439,7 @@ impl Solver {
             stop,
             history,
             gap: ws.gap_norm(),
+            timings: tm,
         })
     }
 
