@@ -27,8 +27,6 @@ from pathlib import Path
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-
 from freefloat.control import ddp  # noqa: E402
 from freefloat.control import ddp_crocoddyl as dc  # noqa: E402
 
@@ -58,7 +56,11 @@ def truncate(p: ddp.Problem, n: int) -> ddp.Problem:
         return out
 
     return replace(
-        p, horizon=n, running=cut(p.running), terminal=cut(p.terminal), us0=p.us0[:n],
+        p,
+        horizon=n,
+        running=cut(p.running),
+        terminal=cut(p.terminal),
+        us0=p.us0[:n],
         reference_dq=p.reference_dq[: n + 1],
     )
 
@@ -87,8 +89,9 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=None)
     a = ap.parse_args(argv)
     reps = a.repeats or (1 if a.quick else 3)
-    prob = ddp.load_scenario("valverde_ch8_tracking", cost="log", schedule=False, keep_out=False,
-                             initial_controls="zero")
+    prob = ddp.load_scenario(
+        "valverde_ch8_tracking", cost="log", schedule=False, keep_out=False, initial_controls="zero"
+    )
     prob = truncate(prob, 80 if a.quick else prob.horizon)
     n = prob.horizon
     ff_t, cr_t, ff_it, cr_it, ff_cost, cr_cost, ff_blocks = [], [], [], [], [], [], []
@@ -99,19 +102,24 @@ def main(argv=None) -> int:
         ff_it.append(sol["iterations"])
         ff_cost.append(sol["cost"])
         tm = sol["timings"]
-        ff_blocks.append({
-            "calc_diff": 1e6 * tm["calc_diff_s"] / max(tm["calc_diff_calls"], 1) / n,
-            "backward": 1e6 * tm["backward_s"] / max(tm["backward_calls"], 1) / n,
-            "forward": 1e6 * tm["forward_s"] / max(tm["forward_calls"], 1) / n,
-        })
+        ff_blocks.append(
+            {
+                "calc_diff": 1e6 * tm["calc_diff_s"] / max(tm["calc_diff_calls"], 1) / n,
+                "backward": 1e6 * tm["backward_s"] / max(tm["backward_calls"], 1) / n,
+                "forward": 1e6 * tm["forward_s"] / max(tm["forward_calls"], 1) / n,
+            }
+        )
         shooting = dc.build_crocoddyl_problem(prob)
         t0 = time.perf_counter()
         cr_solver, it, c = dc.solve_crocoddyl(shooting, prob.us0, OPTIONS["max_iter"])
         cr_t.append(time.perf_counter() - t0)
         cr_it.append(it)
         cr_cost.append(c)
-        print(f"repeat {r + 1}/{reps}: freefloat {ff_t[-1]:.2f} s ({ff_it[-1]} it, cost {ff_cost[-1]:.10g}); "
-              f"crocoddyl {cr_t[-1]:.2f} s ({cr_it[-1]} it, cost {cr_cost[-1]:.10g})", flush=True)
+        print(
+            f"repeat {r + 1}/{reps}: freefloat {ff_t[-1]:.2f} s ({ff_it[-1]} it, cost {ff_cost[-1]:.10g}); "
+            f"crocoddyl {cr_t[-1]:.2f} s ({cr_it[-1]} it, cost {cr_cost[-1]:.10g})",
+            flush=True,
+        )
     cb = crocoddyl_blocks(cr_solver, n)
     med = statistics.median
 
@@ -121,14 +129,31 @@ def main(argv=None) -> int:
     rel = abs(ff_cost[-1] - cr_cost[-1]) / abs(cr_cost[-1])
     ffb = {k: med([b[k] for b in ff_blocks]) for k in ff_blocks[0]}
     res = {
-        "problem": {"scenario": "valverde_ch8_tracking", "horizon": n, "dt": prob.dt, "pose_cost": "log",
-                    "weights": "Table 8.2 End (constant)", "start": "zero controls", "repeats": reps},
-        "freefloat": {"iterations": ff_it[-1], "final_cost": ff_cost[-1], "solve_s_median": med(ff_t),
-                      "solve_s_spread": spread(ff_t), "per_iteration_ms_median": 1e3 * med(ff_t) / ff_it[-1],
-                      "blocks_us_per_node": ffb},
-        "crocoddyl": {"iterations": cr_it[-1], "final_cost": cr_cost[-1], "solve_s_median": med(cr_t),
-                      "solve_s_spread": spread(cr_t), "per_iteration_ms_median": 1e3 * med(cr_t) / cr_it[-1],
-                      "blocks_us_per_node": cb},
+        "problem": {
+            "scenario": "valverde_ch8_tracking",
+            "horizon": n,
+            "dt": prob.dt,
+            "pose_cost": "log",
+            "weights": "Table 8.2 End (constant)",
+            "start": "zero controls",
+            "repeats": reps,
+        },
+        "freefloat": {
+            "iterations": ff_it[-1],
+            "final_cost": ff_cost[-1],
+            "solve_s_median": med(ff_t),
+            "solve_s_spread": spread(ff_t),
+            "per_iteration_ms_median": 1e3 * med(ff_t) / ff_it[-1],
+            "blocks_us_per_node": ffb,
+        },
+        "crocoddyl": {
+            "iterations": cr_it[-1],
+            "final_cost": cr_cost[-1],
+            "solve_s_median": med(cr_t),
+            "solve_s_spread": spread(cr_t),
+            "per_iteration_ms_median": 1e3 * med(cr_t) / cr_it[-1],
+            "blocks_us_per_node": cb,
+        },
         "agreement": {"final_cost_rel": rel, "iterations_freefloat_le_crocoddyl": ff_it[-1] <= cr_it[-1]},
         "ratios_freefloat_over_crocoddyl": {
             "total": med(ff_t) / med(cr_t),
@@ -145,18 +170,24 @@ def main(argv=None) -> int:
         "",
         f"N = {n}, dt = {prob.dt} s, {reps} interleaved repeats, single thread; times: median (min-max).",
         "",
-        "| solver | iterations | final cost | solve [s] | per iteration [ms] | calcDiff / backward / forward [µs per node] |",
+        "| solver | iterations | final cost | solve [s] | per iteration [ms] "
+        "| calcDiff / backward / forward [µs per node] |",
         "|---|---|---|---|---|---|",
     ]
     for name, key in (("freefloat (FD step Jacobians)", "freefloat"), ("Crocoddyl FDDP", "crocoddyl")):
         s = res[key]
         b = s["blocks_us_per_node"]
-        md.append(f"| {name} | {s['iterations']} | {s['final_cost']:.10g} | {s['solve_s_median']:.3f} "
-                  f"({s['solve_s_spread'][0]:.3f}-{s['solve_s_spread'][1]:.3f}) | {s['per_iteration_ms_median']:.1f} | "
-                  f"{b['calc_diff']:.1f} / {b['backward']:.1f} / {b['forward']:.1f} |")
-    md += ["", f"Final-cost agreement {rel:.2e} relative. Ratios freefloat/Crocoddyl: total {ra['total']:.2f}, per "
-           f"iteration {ra['per_iteration']:.2f}, calcDiff {ra['block_calc_diff']:.2f}, backward "
-           f"{ra['block_backward']:.2f}, forward {ra['block_forward']:.2f}."]
+        md.append(
+            f"| {name} | {s['iterations']} | {s['final_cost']:.10g} | {s['solve_s_median']:.3f} "
+            f"({s['solve_s_spread'][0]:.3f}-{s['solve_s_spread'][1]:.3f}) | {s['per_iteration_ms_median']:.1f} | "
+            f"{b['calc_diff']:.1f} / {b['backward']:.1f} / {b['forward']:.1f} |"
+        )
+    md += [
+        "",
+        f"Final-cost agreement {rel:.2e} relative. Ratios freefloat/Crocoddyl: total {ra['total']:.2f}, per "
+        f"iteration {ra['per_iteration']:.2f}, calcDiff {ra['block_calc_diff']:.2f}, backward "
+        f"{ra['block_backward']:.2f}, forward {ra['block_forward']:.2f}.",
+    ]
     (out / "ddp_vs_crocoddyl.md").write_text("\n".join(md) + "\n")
     print("\n".join(md))
     if not rel <= 1e-6 or ff_it[-1] > cr_it[-1]:

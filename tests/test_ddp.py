@@ -27,8 +27,14 @@ def short(prob: ddp.Problem, n: int) -> ddp.Problem:
             out.append(t)
         return out
 
-    return replace(prob, horizon=n, running=cut(prob.running), terminal=cut(prob.terminal), us0=prob.us0[:n],
-                   reference_dq=prob.reference_dq[: n + 1])
+    return replace(
+        prob,
+        horizon=n,
+        running=cut(prob.running),
+        terminal=cut(prob.terminal),
+        us0=prob.us0[:n],
+        reference_dq=prob.reference_dq[: n + 1],
+    )
 
 
 def test_scenarios_load_with_the_thesis_sizes():
@@ -52,8 +58,16 @@ def test_short_solve_reduces_the_cost_and_reports_results():
     assert sol["cost"] < sol["initial_cost"]
     assert all(h["reduction"] > 0 for h in sol["history"] if h["accepted"])
     res = ddp.results(prob, sol)
-    for k in ("iterations", "final_cost", "solve_time_s", "time_per_iteration_s", "ee_position_error_final_hold_max_m",
-              "ee_angle_error_final_hold_max_deg", "base_force_peak_N", "base_torque_peak_Nm"):
+    for k in (
+        "iterations",
+        "final_cost",
+        "solve_time_s",
+        "time_per_iteration_s",
+        "ee_position_error_final_hold_max_m",
+        "ee_angle_error_final_hold_max_deg",
+        "base_force_peak_N",
+        "base_torque_peak_Nm",
+    ):
         assert math.isfinite(res[k]), k
     # A callback returning False stops after the first iteration, keeping the iterate.
     sol = ddp.solve(prob, progress=lambda i: False, max_iter=5)
@@ -93,8 +107,9 @@ def test_cli_help_and_bad_scenario():
 
 @pytest.mark.slow
 def test_cli_writes_results_and_figures(tmp_path):
-    r = CliRunner().invoke(main, ["control", "ddp", "valverde_ch8_tracking", "--cost", "log", "--max-iter", "2",
-                                  "--out", str(tmp_path)])
+    r = CliRunner().invoke(
+        main, ["control", "ddp", "valverde_ch8_tracking", "--cost", "log", "--max-iter", "2", "--out", str(tmp_path)]
+    )
     assert r.exit_code == 0, r.output
     res = json.loads((tmp_path / "results.json").read_text())
     assert res["iterations"] == 2 and res["final_cost"] < res["initial_cost"]
@@ -106,10 +121,18 @@ def test_tracking_reaches_crocoddyls_cost_in_no_more_iterations():
     pytest.importorskip("crocoddyl")
     from freefloat.control import ddp_crocoddyl as dc
 
-    prob = ddp.load_scenario("valverde_ch8_tracking", cost="log", schedule=False, keep_out=False,
-                             initial_controls="zero")
-    opts = dict(variant="fddp", alphas=[0.5**k for k in range(10)], accept_ratio=0.1, reg_init=1e-9, reg_min=1e-9,
-                tol_expected=1e-9, max_iter=150)
+    prob = ddp.load_scenario(
+        "valverde_ch8_tracking", cost="log", schedule=False, keep_out=False, initial_controls="zero"
+    )
+    opts = dict(
+        variant="fddp",
+        alphas=[0.5**k for k in range(10)],
+        accept_ratio=0.1,
+        reg_init=1e-9,
+        reg_min=1e-9,
+        tol_expected=1e-9,
+        max_iter=150,
+    )
     sol = ddp.solve(prob, **opts)
     _, croc_iters, croc_cost = dc.solve_crocoddyl(dc.build_crocoddyl_problem(prob), prob.us0, 150)
     assert sol["stop"] == "converged"

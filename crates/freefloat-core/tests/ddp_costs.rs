@@ -24,6 +24,11 @@ fn x0(m: &freefloat_core::Model) -> Vec<f64> {
 fn keep_out_reproduces_the_table_and_its_derivatives_match_differences() {
     let l = std::f64::consts::PI / 180.0;
     // (|θ − θ̄| in degrees, c, |c'|, c'') from the §6.3 table (K = 0.1, ℓ = 1°).
+    // Far from the band (e^{2s} would overflow) everything is finite and tiny.
+    for deg in [15.0, 19.0, 25.0, 40.0, 1e3] {
+        let (v, d1, d2) = keep_out(deg * l, 0.0, l, 0.1);
+        assert!(v.is_finite() && d1.is_finite() && d2.is_finite() && v.abs() < 1e-30, "{deg}°: {v} {d1} {d2}");
+    }
     for (deg, c, c1, c2) in [
         (0.0, 0.05, 0.0, -164.14),
         (0.5, 0.043782, 1.4102, -151.55),

@@ -112,8 +112,15 @@ def control_cost(name: str, model: Model, weights, reference=None) -> dict:
 def screw_reference(start_dq, axis, moment, angle, advance, t_hold, t_move, dt, n) -> np.ndarray:
     """Hold / screw / hold reference of §8.7 as dual quaternions (n + 1, 8) (engine: `ddp_screw_reference`)."""
     return _core.ddp_screw_reference(
-        [float(x) for x in start_dq], list(map(float, axis)), list(map(float, moment)), angle, advance, t_hold,
-        t_move, dt, n,
+        [float(x) for x in start_dq],
+        list(map(float, axis)),
+        list(map(float, moment)),
+        angle,
+        advance,
+        t_hold,
+        t_move,
+        dt,
+        n,
     )
 
 
@@ -257,9 +264,15 @@ def load_scenario(
         axis = np.array(_num_list(ref, "axis", rsrc, 3))
         point = np.array(_num_list(ref, "axis_point", rsrc, 3))
         ref_dq = screw_reference(
-            start, axis, np.cross(point, axis), math.radians(float(_key(ref, "angle_deg", rsrc, (int, float)))),
-            float(_key(ref, "advance", rsrc, (int, float))), float(_key(ref, "t_hold", rsrc, (int, float))),
-            float(_key(ref, "t_move", rsrc, (int, float))), dt, n,
+            start,
+            axis,
+            np.cross(point, axis),
+            math.radians(float(_key(ref, "angle_deg", rsrc, (int, float)))),
+            float(_key(ref, "advance", rsrc, (int, float))),
+            float(_key(ref, "t_hold", rsrc, (int, float))),
+            float(_key(ref, "t_move", rsrc, (int, float))),
+            dt,
+            n,
         )
     else:
         raise InputError(f"{rsrc}: key 'type': expected 'fixed' or 'screw', got {rtype!r}")
@@ -284,7 +297,11 @@ def load_scenario(
         if cost == "dq":
             return _concat([_expand(real, 4), _expand(dual, 4)])
         # log6 = [translation; rotation]: ‖δq‖² ≈ ¼‖(δp, δθ)‖² for small errors, so W/4 on each block.
-        quarter = lambda b: {k: ([x / 4 for x in v] if k != "breakpoints" else v) for k, v in b.items()} if isinstance(b, dict) else [x / 4 for x in b]  # noqa: E731
+        quarter = lambda b: (
+            {k: ([x / 4 for x in v] if k != "breakpoints" else v) for k, v in b.items()}
+            if isinstance(b, dict)
+            else [x / 4 for x in b]
+        )  # noqa: E731
         return _concat([_expand(quarter(dual), 3), _expand(quarter(real), 3)])
 
     pose_ref = ref_dq if cost == "dq" else dq_to_pose(ref_dq)
@@ -296,13 +313,22 @@ def load_scenario(
         frame_cost("pose", frame, pose_ref, pose_weights(sched("pose_running_real"), sched("pose_running_dual")), cost),
         state_cost("base_velocity", model, _concat([zeros(nv), _expand(vel_run, nb), zeros(nv - nb)])),
         control_cost(
-            "control", model,
-            _concat([_expand(sched("control_force"), 3), _expand(sched("control_torque"), 3),
-                     _expand(sched("control_joints"), 3), _expand(sched("control_wrist"), nv - 9)]),
+            "control",
+            model,
+            _concat(
+                [
+                    _expand(sched("control_force"), 3),
+                    _expand(sched("control_torque"), 3),
+                    _expand(sched("control_joints"), 3),
+                    _expand(sched("control_wrist"), nv - 9),
+                ]
+            ),
         ),
     ]
     terminal = [
-        frame_cost("pose", frame, pose_ref, pose_weights(sched("pose_terminal_real"), sched("pose_terminal_dual")), cost),
+        frame_cost(
+            "pose", frame, pose_ref, pose_weights(sched("pose_terminal_real"), sched("pose_terminal_dual")), cost
+        ),
         state_cost("base_velocity", model, _concat([zeros(nv), _expand(vel_fin, nb), zeros(nv - nb)])),
     ]
     # Keep-out.
@@ -311,11 +337,14 @@ def load_scenario(
     if ko is not None and keep_out is not False:
         ksrc = f"{source}: keep_out"
         for j in _key(ko, "joints", ksrc, list):
-            kos.append({
-                "joint": str(j), "center": math.radians(float(_key(ko, "center_deg", ksrc, (int, float)))),
-                "width": math.radians(float(_key(ko, "width_deg", ksrc, (int, float)))),
-                "height": float(_key(ko, "height", ksrc, (int, float))),
-            })
+            kos.append(
+                {
+                    "joint": str(j),
+                    "center": math.radians(float(_key(ko, "center_deg", ksrc, (int, float)))),
+                    "width": math.radians(float(_key(ko, "width_deg", ksrc, (int, float)))),
+                    "height": float(_key(ko, "height", ksrc, (int, float))),
+                }
+            )
     # Initial controls.
     ic = initial_controls or _key(d, "initial_controls", source, str, "zero")
     if ic == "zero":
@@ -334,8 +363,19 @@ def load_scenario(
     if s.get("alphas") == "backtracking":
         s["alphas"] = [0.5**k for k in range(10)]
     return Problem(
-        model=model, x0=x0, dt=dt, horizon=n, running=running, terminal=terminal, us0=us0, keep_out=kos,
-        options=s, frame=frame, reference_dq=ref_dq, name=Path(str(spec)).stem, cost_kind=cost,
+        model=model,
+        x0=x0,
+        dt=dt,
+        horizon=n,
+        running=running,
+        terminal=terminal,
+        us0=us0,
+        keep_out=kos,
+        options=s,
+        frame=frame,
+        reference_dq=ref_dq,
+        name=Path(str(spec)).stem,
+        cost_kind=cost,
     )
 
 
@@ -348,9 +388,17 @@ def solve(problem: Problem, progress=None, **options) -> dict:
     opts = {**problem.options, **options}
     t0 = time.perf_counter()
     sol = _core.ddp_solve(
-        problem.model._core, list(map(float, problem.x0)), problem.dt, problem.horizon, problem.running,
-        problem.terminal, np.ascontiguousarray(problem.us0, dtype=float), keep_out=problem.keep_out,
-        xs0=problem.xs0, options=opts, callback=progress,
+        problem.model._core,
+        list(map(float, problem.x0)),
+        problem.dt,
+        problem.horizon,
+        problem.running,
+        problem.terminal,
+        np.ascontiguousarray(problem.us0, dtype=float),
+        keep_out=problem.keep_out,
+        xs0=problem.xs0,
+        options=opts,
+        callback=progress,
     )
     sol["solve_time_s"] = time.perf_counter() - t0
     return sol

@@ -57,7 +57,8 @@ pub(crate) fn cholesky_solve_in_place(l: &DMatrix<f64>, b: &mut [f64]) {
 pub enum Backward {
     /// Gains computed at every node.
     Done,
-    /// Q_uu + λI was not positive definite at this node: raise λ and try again.
+    /// Q_uu + λI was not positive definite at this node (or the value function overflowed there): raise λ
+    /// and try again.
     NotPositiveDefinite(usize),
 }
 
@@ -153,7 +154,9 @@ pub fn backward_pass(
         *vxx += &ws.fxt_v;
         symmetrise(vxx);
         if !vx.iter().all(|v| v.is_finite()) || !vxx.iter().all(|v| v.is_finite()) {
-            return Err(FfError::Numerical(format!("the value function became non-finite at node {k}")));
+            // Gains too aggressive for the local model (tiny λ on an ill-conditioned Q_uu): treat it like a
+            // failed factorisation so that the caller raises λ instead of stopping.
+            return Ok(Backward::NotPositiveDefinite(k));
         }
     }
     Ok(Backward::Done)

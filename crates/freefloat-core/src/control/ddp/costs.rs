@@ -102,11 +102,11 @@ pub fn keep_out(theta: f64, center: f64, width: f64, height: f64) -> (f64, f64, 
     if s > 700.0 {
         return (0.0, 0.0, 0.0);
     }
-    let es = s.exp();
-    let den = es + 1.0;
-    let sig = 1.0 / den;
-    let dsig = -es / (den * den);
-    let d2sig = -es / (den * den) + 2.0 * es * es / (den * den * den);
+    // σ' = −σ(1 − σ), σ'' = σ(1 − σ)(1 − 2σ): the same as the e^s forms, without overflowing e^{2s}.
+    let sig = 1.0 / (s.exp() + 1.0);
+    let one_minus = 1.0 / (1.0 + (-s).exp());
+    let dsig = -sig * one_minus;
+    let d2sig = sig * one_minus * (1.0 - 2.0 * sig);
     let ds = 2.0 * e / (width * width);
     (height * sig, height * dsig * ds, height * (d2sig * ds * ds + dsig * 2.0 / (width * width)))
 }
