@@ -3,6 +3,9 @@
 //! on the floating-robot model with every cost kind, and the backward pass, the line-search rollout and the
 //! node derivatives allocate nothing after a warm-up.
 
+// Table values are printed numbers (not approximations of constants); loops index several arrays.
+#![allow(clippy::approx_constant, clippy::needless_range_loop)]
+
 use freefloat_core::control::ddp::backward::backward_pass;
 use freefloat_core::control::ddp::costs::{CostTerm, KeepOut, Residual, Weights};
 use freefloat_core::control::ddp::forward::rollout_trial;

@@ -2,6 +2,9 @@
 //! (§6.3), weight schedule (§6.2), the helical reference (§7.2), the initial end-effector pose of
 //! `valverde_ch8_arm`, and every analytic cost gradient against central differences in the tangent.
 
+// Table values are printed numbers (not approximations of constants); loops index several arrays.
+#![allow(clippy::approx_constant, clippy::needless_range_loop)]
+
 use freefloat_core::control::ddp::costs::{keep_out, schedule_blend, CostTerm, KeepOut, Residual, Weights};
 use freefloat_core::control::ddp::reference::screw_reference;
 use freefloat_core::control::ddp::{ActionModel, FloatingRobot, NodeDiff};

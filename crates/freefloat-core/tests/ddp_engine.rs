@@ -2,6 +2,9 @@
 //! least-squares solution, backward-pass equivalence with eqs. (8.32)–(8.33), full DDP vs iLQG on
 //! quadratic dynamics, regularisation and line-search behaviour, the feasibility-driven variant, bad input.
 
+// Table values are printed numbers (not approximations of constants); loops index several arrays.
+#![allow(clippy::approx_constant, clippy::needless_range_loop)]
+
 use freefloat_core::control::ddp::backward::{backward_pass, Backward};
 use freefloat_core::control::ddp::{
     ActionModel, DdpOptions, DynamicsHessian, NodeDiff, RegOptions, Solver, StopReason, Variant, Workspace,
@@ -296,7 +299,7 @@ fn non_positive_definite_quu_raises_lambda_on_the_1_6_schedule() {
     m.rl.fill(0.0);
     let opts = DdpOptions { max_iter: 3, reg: RegOptions { init: 1.0, ..Default::default() }, ..Default::default() };
     let mut solver = Solver::new(&m, opts).unwrap();
-    let sol = solver.solve(&mut m, &[0.1, 0.2, 0.3], &vec![0.0; 20], None, &mut |_| true).unwrap();
+    let sol = solver.solve(&mut m, &[0.1, 0.2, 0.3], &[0.0; 20], None, &mut |_| true).unwrap();
     let h = &sol.history[0];
     assert!(h.backward_passes > 1, "λ was never raised");
     // λ after p failed passes from λ = 1, dλ = 1: λ = Π 1.6^j (dλ = 1.6, 2.56, ...).
@@ -320,7 +323,7 @@ fn line_search_accepts_only_descent_and_fixed_alpha_applies_exactly_a_tenth() {
     let mut solver = Solver::new(&m, opts).unwrap();
     let mut seen = Vec::new();
     let sol = solver
-        .solve(&mut m, &x0, &vec![0.0; 24], None, &mut |i| {
+        .solve(&mut m, &x0, &[0.0; 24], None, &mut |i| {
             seen.push(i.clone());
             true
         })
@@ -342,7 +345,7 @@ fn line_search_accepts_only_descent_and_fixed_alpha_applies_exactly_a_tenth() {
         ..Default::default()
     };
     let mut solver = Solver::new(&m, opts).unwrap();
-    let sol = solver.solve(&mut m, &x0, &vec![0.0; 24], None, &mut |_| true).unwrap();
+    let sol = solver.solve(&mut m, &x0, &[0.0; 24], None, &mut |_| true).unwrap();
     assert!(sol.history[0].accepted, "{:?}", sol.history);
     for i in 0..2 {
         assert_eq!(sol.us[0][i], 0.1 * solver.ws.kff[0][i]);
