@@ -119,7 +119,13 @@ def test_cli_writes_results_and_figures(tmp_path):
 @pytest.mark.slow
 def test_tracking_reaches_crocoddyls_cost_in_no_more_iterations():
     pytest.importorskip("crocoddyl")
-    from freefloat.control import ddp_crocoddyl as dc
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benches" / "ddp_vs_crocoddyl.py"
+    spec = importlib.util.spec_from_file_location("ddp_vs_crocoddyl", path)
+    dc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dc)
 
     prob = ddp.load_scenario(
         "valverde_ch8_tracking", cost="log", schedule=False, keep_out=False, initial_controls="zero"
