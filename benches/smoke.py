@@ -65,6 +65,16 @@ def _check_identify(out: Path) -> list[str]:
     return bad
 
 
+def _check_ddp(out: Path) -> list[str]:
+    res = json.loads((out / "ddp_vs_crocoddyl.json").read_text())
+    a, bad = res["agreement"], []
+    if not a["final_cost_rel"] <= 1e-6:
+        bad.append(f"final_cost_rel = {a['final_cost_rel']:.3g} > 1e-6")
+    if a["iterations_freefloat_le_crocoddyl"] is not True:
+        bad.append("freefloat needed more iterations than Crocoddyl")
+    return bad
+
+
 def _check_dq(out: Path) -> list[str]:
     # the script aborts when dq_dynamics and aba disagree; check that it wrote its table
     return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
@@ -110,6 +120,7 @@ BENCHES = {
     "adaptive": ("adaptive_bench.py", [], ("scipy",), _check_adaptive),
     "derivatives": ("derivatives_bench.py", [], ("pinocchio", "crocoddyl"), _check_derivatives),
     "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
+    "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
 }
 
 

@@ -274,6 +274,37 @@ def centroidal_momentum_matrix(model: Model, q: ArrayLike) -> np.ndarray:
 def crba(model: Model, q: ArrayLike) -> np.ndarray:
     """Joint-space inertia matrix (nv, nv), full symmetric."""
 
+def ddp_frame_dual_quats(model: Model, qs: ArrayLike, frame_name: ArrayLike) -> Any:
+    """The frame's pose as a dual quaternion (thesis layout), composed along the chain so that it is continuous
+along a trajectory (never properised), for each row of `qs` (M, nq). Returns (M, 8).
+    """
+
+def ddp_screw_reference(start: ArrayLike, axis: ArrayLike, moment: ArrayLike, angle: ArrayLike, advance: ArrayLike, t_hold: ArrayLike, t_move: ArrayLike, dt: float, n: ArrayLike) -> Any:
+    """Three-phase screw reference (Valverde 2018, §8.7): hold `start` (8, thesis layout [real w x y z, dual
+w x y z]) for `t_hold`, then `start · exp(½ θ̂ ŝ)` with `ŝ = axis + ε moment` (start-frame coordinates),
+`θ = angle·τ/t_move`, `d = advance·τ/t_move` for `t_move` seconds, then hold; sampled at k·dt,
+k = 0..=n. Returns (n + 1, 8); never properised.
+    """
+
+def ddp_solve(model: Model, x0: ArrayLike, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, us0: ArrayLike, keep_out: ArrayLike | None = None, xs0: ArrayLike | None = None, options: ArrayLike | None = None, callback: ArrayLike | None = None) -> Any:
+    """Solve a floating-robot optimal-control problem by DDP (Valverde 2018, ch. 8).
+
+State `x = [q; v]` (nq + nv), control `u = τ` (nv: base force and torque in the base frame, then joint
+torques), semi-implicit Euler steps of `dt` over `horizon` nodes. `running` / `terminal`: lists of cost
+dicts with keys `name`, `kind` ('frame_placement' with `frame` and `reference` (M, 7) [p, quat xyzw];
+'frame_dq' with `frame` and `reference` (M, 8) thesis-layout dual quaternions; 'state' with optional
+`reference` (M, nx); 'control' with optional `reference` (M, nu)), and `weights` (one per residual
+entry) or `weights_start`/`weights_medium`/`weights_end` + `breakpoints` [i1, i2, i3, i4] (Table 8.2
+schedule). M is 1 or one per node. Cost = Σ w r² (no ½, no Δt). `keep_out`: dicts with `joint`,
+`center`, `width`, `height` (rad). `us0`: (horizon, nu); `xs0`: optional (horizon + 1, nx) initial
+states (feasibility-driven variant). `options`: variant ('ddp'/'fddp'), second_order, max_iter, alphas,
+best_alpha, accept_ratio, reg_init, reg_min, reg_max, reg_factor, tol_expected, tol_cost.
+`callback(info: dict)` is called after every iteration; returning False stops (so does Ctrl-C), keeping
+the best iterate. Returns a dict: xs, us, gains (horizon, nu, ndx), cost, initial_cost, iterations, stop,
+stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
+and rollout blocks).
+    """
+
 def dq_approach_slope(q_ga: ArrayLike, z_a: ArrayLike, half_angle: float) -> Any:
     ...
 

@@ -6,6 +6,7 @@ mod algorithms;
 mod batch;
 mod cpu;
 mod derivatives;
+mod ddp;
 mod dq;
 mod dqdynamics;
 mod errors;
@@ -71,6 +72,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<postcapture::PyRls>()?;
     m.add_class::<postcapture::PyModifiedRls>()?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_dynamics, m)?)?;
+    m.add_function(wrap_pyfunction!(ddp::ddp_solve, m)?)?;
+    m.add_function(wrap_pyfunction!(ddp::ddp_screw_reference, m)?)?;
+    m.add_function(wrap_pyfunction!(ddp::ddp_frame_dual_quats, m)?)?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
     m.add_class::<dq::PyDualQuaternion>()?;
     m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;

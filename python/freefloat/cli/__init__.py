@@ -13,7 +13,7 @@ import sys
 import click
 
 from .. import _core
-from . import adaptive, campaign, control, convert, demo, excite, export, identify, models, params, postcapture, reactions, report, simulate
+from . import adaptive, campaign, control, convert, ddp, demo, excite, export, identify, models, params, postcapture, reactions, report, simulate
 
 
 class FriendlyGroup(click.Group):
@@ -51,5 +51,6 @@ main.add_command(export.export_cmd)
 main.add_command(convert.convert_cmd)
 main.add_command(campaign.campaign_cmd)
 main.add_command(report.report_cmd)
+control.control_group.add_command(ddp.ddp_cmd)
 
 __all__ = ["main"]

@@ -4,3 +4,6 @@
 //! dual-inertia regressor) are in `dualquat`.
 
 pub mod adaptive;
+/// Differential dynamic programming (Valverde 2018, ch. 8): Riccati backward pass, regularisation, line
+/// search, the feasibility-driven variant, costs and the floating-base robot action model.
+pub mod ddp;

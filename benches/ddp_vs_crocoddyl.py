@@ -1,0 +1,318 @@
+#!/usr/bin/env python3
+"""freefloat's DDP against Crocoddyl 3.2.1 on the identical chapter 8 tracking problem (Valverde 2018, §8.7):
+valverde_ch8_arm, log-SE(3) pose cost, constant Table 8.2 End weights, semi-implicit Euler, zero-control start,
+backtracking line search. Both solvers run interleaved (repeats), single thread; reported: iterations, final cost
+(agreement), total solve and per-iteration time (median, min-max), and the per-node cost of each block
+(derivatives, backward pass, forward rollout). Aborts (exit 1) if the final costs differ by more than 1e-6
+relative or freefloat needs more iterations.
+
+    python benches/ddp_vs_crocoddyl.py --out benches/results          # full problem (N = 640), 3 repeats
+    python benches/ddp_vs_crocoddyl.py --quick --out /tmp/x          # N = 80, 1 repeat (CI smoke)
+
+freefloat's step Jacobians are still central finite differences (temporary, until the analytic ABA derivatives
+land), so its derivative block is expected to be far slower than Crocoddyl's analytic one; the backward and forward
+blocks are the solver's own.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+from dataclasses import replace
+from pathlib import Path
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
+
+from freefloat.control import ddp  # noqa: E402
+
+# -- the identical problem in Pinocchio + Crocoddyl (independent oracle; also used by tests/test_ddp.py) --
+# The robot is built here by hand from its description (not from freefloat's model file); Crocoddyl's cost is
+# dt·Σ½ w r² (running) + ½ w r² (terminal), so weights are scaled by 2/dt and 2 to equal freefloat's Σ w r².
+
+
+def build_pinocchio_model():
+    """valverde_ch8_arm in Pinocchio: free-flyer base 50 kg / 10 I, RRR arm (waist z, shoulder and elbow about the
+    local z of frames rotated +90° about x), 5 kg / I links, a Z-Y-X wrist of 0.1 kg / 0.01 I bodies, frame `ee`."""
+    import pinocchio as pin
+
+    m = pin.Model()
+    m.gravity = pin.Motion.Zero()
+    eye = np.eye(3)
+
+    def body(jid, mass, com, inertia):
+        m.appendBodyToJoint(jid, pin.Inertia(mass, np.asarray(com, float), inertia * eye), pin.SE3.Identity())
+
+    rx90 = pin.utils.rotate("x", np.pi / 2)
+    base = m.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root_joint")
+    body(base, 50.0, [0, 0, 0], 10.0)
+    waist = m.addJoint(base, pin.JointModelRZ(), pin.SE3(eye, np.array([0.0, 0, 1])), "waist")
+    body(waist, 5.0, [0, 0, 1], 1.0)
+    shoulder = m.addJoint(waist, pin.JointModelRZ(), pin.SE3(rx90, np.array([0.75, 0, 4])), "shoulder")
+    body(shoulder, 5.0, [1.5, 0, 0], 1.0)
+    elbow = m.addJoint(shoulder, pin.JointModelRZ(), pin.SE3(eye, np.array([3.0, 0, 0])), "elbow")
+    body(elbow, 5.0, [1.5, 0, 0], 1.0)
+    wz = m.addJoint(elbow, pin.JointModelRZ(), pin.SE3(eye, np.array([3.0, 0, 0])), "wrist_z")
+    body(wz, 0.1, [0, 0, 0], 0.01)
+    wy = m.addJoint(wz, pin.JointModelRY(), pin.SE3.Identity(), "wrist_y")
+    body(wy, 0.1, [0, 0, 0], 0.01)
+    wx = m.addJoint(wy, pin.JointModelRX(), pin.SE3.Identity(), "wrist_x")
+    body(wx, 0.1, [0, 0, 0], 0.01)
+    m.addFrame(pin.Frame("ee", wx, pin.SE3.Identity(), pin.FrameType.OP_FRAME))
+    return m
+
+
+def _se3(pose7):
+    import pinocchio as pin
+
+    p = np.asarray(pose7, float)
+    quat = pin.Quaternion(p[6], p[3], p[4], p[5])  # (w, x, y, z)
+    quat.normalize()
+    return pin.SE3(quat.matrix(), p[:3].copy())
+
+
+def build_crocoddyl_problem(problem):
+    """Crocoddyl's ShootingProblem for a freefloat `Problem` whose costs are frame_placement (log), state and
+    control terms with constant weights (e.g. `load_scenario(..., cost="log", schedule=False, keep_out=False)`)."""
+    import crocoddyl
+
+    if problem.keep_out:
+        raise ValueError("Crocoddyl has no keep-out activation: build the problem with keep_out=False")
+    model = build_pinocchio_model()
+    state = crocoddyl.StateMultibody(model)
+    act = crocoddyl.ActuationModelFull(state)
+    nu = act.nu
+    fid = model.getFrameId(problem.frame)
+    dt, n = problem.dt, problem.horizon
+
+    def costs_for(terms, k, scale):
+        cs = crocoddyl.CostModelSum(state, nu)
+        for t in terms:
+            if "weights" not in t:
+                raise ValueError(f"cost {t['name']!r}: scheduled weights cannot be mirrored in Crocoddyl")
+            w = np.asarray(t["weights"], float) * scale
+            act_w = crocoddyl.ActivationModelWeightedQuad(w)
+            ref = t.get("reference")
+            if t["kind"] == "frame_placement":
+                r = ref[min(k, len(ref) - 1)]
+                res = crocoddyl.ResidualModelFramePlacement(state, fid, _se3(r), nu)
+            elif t["kind"] == "state":
+                xr = state.zero() if ref is None else np.asarray(ref[min(k, len(ref) - 1)], float)
+                res = crocoddyl.ResidualModelState(state, xr, nu)
+            elif t["kind"] == "control":
+                res = crocoddyl.ResidualModelControl(state, nu)
+            else:
+                raise ValueError(f"cost kind {t['kind']!r} has no Crocoddyl counterpart here")
+            cs.addCost(t["name"], crocoddyl.CostModelResidual(state, act_w, res), 1.0)
+        return cs
+
+    running = []
+    for k in range(n):
+        dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, act, costs_for(problem.running, k, 2.0 / dt))
+        running.append(crocoddyl.IntegratedActionModelEuler(dam, dt))
+    dam = crocoddyl.DifferentialActionModelFreeFwdDynamics(state, act, costs_for(problem.terminal, n, 2.0))
+    terminal = crocoddyl.IntegratedActionModelEuler(dam, 0.0)
+    x0 = np.asarray(problem.x0, float)
+    shooting = crocoddyl.ShootingProblem(x0, running, terminal)
+    try:
+        shooting.nthreads = 1
+    except AttributeError:
+        pass
+    return shooting
+
+
+def solve_crocoddyl(shooting, us0, max_iter: int = 150, solver: str = "fddp"):
+    """Solve with Crocoddyl's FDDP (or DDP) from the rollout of `us0`. Returns (solver, iterations, cost), with
+    iterations counted as derivative evaluations (callbacks), as freefloat counts them."""
+    import crocoddyl
+
+    s = crocoddyl.SolverFDDP(shooting) if solver == "fddp" else crocoddyl.SolverDDP(shooting)
+    count = []
+
+    class _Count(crocoddyl.CallbackAbstract):
+        def __init__(self):
+            crocoddyl.CallbackAbstract.__init__(self)
+
+        def __call__(self, solver):
+            count.append(solver.cost)
+
+    s.setCallbacks([_Count()])
+    us = [np.asarray(u, float) for u in us0]
+    xs = shooting.rollout(us)
+    s.solve(xs, us, max_iter, True)
+    return s, len(count), float(s.cost)
+
+
+OPTIONS = dict(
+    variant="fddp",
+    alphas=[0.5**k for k in range(10)],  # Crocoddyl's line search: 1, 1/2, ..., 1/512
+    accept_ratio=0.1,  # Crocoddyl's th_acceptStep
+    reg_init=1e-9,
+    reg_min=1e-9,
+    tol_expected=1e-9,  # Crocoddyl's th_stop on the expected improvement
+    max_iter=150,
+)
+
+
+def truncate(p: ddp.Problem, n: int) -> ddp.Problem:
+    """The first n steps of a problem (references cut to n + 1 nodes)."""
+    if n >= p.horizon:
+        return p
+
+    def cut(terms):
+        out = []
+        for t in terms:
+            t = dict(t)
+            if "reference" in t and len(t["reference"]) > 1:
+                t["reference"] = t["reference"][: n + 1]
+            out.append(t)
+        return out
+
+    return replace(
+        p,
+        horizon=n,
+        running=cut(p.running),
+        terminal=cut(p.terminal),
+        us0=p.us0[:n],
+        reference_dq=p.reference_dq[: n + 1],
+    )
+
+
+def crocoddyl_blocks(solver, n: int, reps: int = 10) -> dict:
+    """Per-node µs of Crocoddyl's calcDiff, backwardPass and forwardPass(1) at its solution (median of reps)."""
+    out = {}
+    for name, f in (
+        ("calc_diff", lambda: solver.calcDiff()),
+        ("backward", lambda: solver.backwardPass()),
+        ("forward", lambda: solver.forwardPass(1.0)),
+    ):
+        ts = []
+        for _ in range(reps):
+            t0 = time.perf_counter()
+            f()
+            ts.append(time.perf_counter() - t0)
+        out[name] = 1e6 * statistics.median(ts) / n
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", required=True, help="Directory for ddp_vs_crocoddyl.json and .md")
+    ap.add_argument("--quick", action="store_true", help="N = 80 and 1 repeat (smoke run)")
+    ap.add_argument("--repeats", type=int, default=None)
+    a = ap.parse_args(argv)
+    reps = a.repeats or (1 if a.quick else 3)
+    prob = ddp.load_scenario(
+        "valverde_ch8_tracking", cost="log", schedule=False, keep_out=False, initial_controls="zero"
+    )
+    prob = truncate(prob, 80 if a.quick else prob.horizon)
+    n = prob.horizon
+    ff_t, cr_t, ff_it, cr_it, ff_cost, cr_cost, ff_blocks = [], [], [], [], [], [], []
+    cr_solver = None
+    for r in range(reps):
+        sol = ddp.solve(prob, **OPTIONS)
+        ff_t.append(sol["solve_time_s"])
+        ff_it.append(sol["iterations"])
+        ff_cost.append(sol["cost"])
+        tm = sol["timings"]
+        ff_blocks.append(
+            {
+                "calc_diff": 1e6 * tm["calc_diff_s"] / max(tm["calc_diff_calls"], 1) / n,
+                "backward": 1e6 * tm["backward_s"] / max(tm["backward_calls"], 1) / n,
+                "forward": 1e6 * tm["forward_s"] / max(tm["forward_calls"], 1) / n,
+            }
+        )
+        shooting = build_crocoddyl_problem(prob)
+        t0 = time.perf_counter()
+        cr_solver, it, c = solve_crocoddyl(shooting, prob.us0, OPTIONS["max_iter"])
+        cr_t.append(time.perf_counter() - t0)
+        cr_it.append(it)
+        cr_cost.append(c)
+        print(
+            f"repeat {r + 1}/{reps}: freefloat {ff_t[-1]:.2f} s ({ff_it[-1]} it, cost {ff_cost[-1]:.10g}); "
+            f"crocoddyl {cr_t[-1]:.2f} s ({cr_it[-1]} it, cost {cr_cost[-1]:.10g})",
+            flush=True,
+        )
+    cb = crocoddyl_blocks(cr_solver, n)
+    med = statistics.median
+
+    def spread(x):
+        return [min(x), max(x)]
+
+    rel = abs(ff_cost[-1] - cr_cost[-1]) / abs(cr_cost[-1])
+    ffb = {k: med([b[k] for b in ff_blocks]) for k in ff_blocks[0]}
+    res = {
+        "problem": {
+            "scenario": "valverde_ch8_tracking",
+            "horizon": n,
+            "dt": prob.dt,
+            "pose_cost": "log",
+            "weights": "Table 8.2 End (constant)",
+            "start": "zero controls",
+            "repeats": reps,
+        },
+        "freefloat": {
+            "iterations": ff_it[-1],
+            "final_cost": ff_cost[-1],
+            "solve_s_median": med(ff_t),
+            "solve_s_spread": spread(ff_t),
+            "per_iteration_ms_median": 1e3 * med(ff_t) / ff_it[-1],
+            "blocks_us_per_node": ffb,
+        },
+        "crocoddyl": {
+            "iterations": cr_it[-1],
+            "final_cost": cr_cost[-1],
+            "solve_s_median": med(cr_t),
+            "solve_s_spread": spread(cr_t),
+            "per_iteration_ms_median": 1e3 * med(cr_t) / cr_it[-1],
+            "blocks_us_per_node": cb,
+        },
+        "agreement": {"final_cost_rel": rel, "iterations_freefloat_le_crocoddyl": ff_it[-1] <= cr_it[-1]},
+        "ratios_freefloat_over_crocoddyl": {
+            "total": med(ff_t) / med(cr_t),
+            "per_iteration": (med(ff_t) / ff_it[-1]) / (med(cr_t) / cr_it[-1]),
+            **{f"block_{k}": ffb[k] / cb[k] for k in cb},
+        },
+    }
+    out = Path(a.out)
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "ddp_vs_crocoddyl.json").write_text(json.dumps(res, indent=2))
+    ra = res["ratios_freefloat_over_crocoddyl"]
+    md = [
+        "# freefloat DDP vs Crocoddyl 3.2.1 (ch. 8 tracking, log-SE(3) cost, End weights, zero start)",
+        "",
+        f"N = {n}, dt = {prob.dt} s, {reps} interleaved repeats, single thread; times: median (min-max).",
+        "",
+        "| solver | iterations | final cost | solve [s] | per iteration [ms] "
+        "| calcDiff / backward / forward [µs per node] |",
+        "|---|---|---|---|---|---|",
+    ]
+    for name, key in (("freefloat (FD step Jacobians)", "freefloat"), ("Crocoddyl FDDP", "crocoddyl")):
+        s = res[key]
+        b = s["blocks_us_per_node"]
+        md.append(
+            f"| {name} | {s['iterations']} | {s['final_cost']:.10g} | {s['solve_s_median']:.3f} "
+            f"({s['solve_s_spread'][0]:.3f}-{s['solve_s_spread'][1]:.3f}) | {s['per_iteration_ms_median']:.1f} | "
+            f"{b['calc_diff']:.1f} / {b['backward']:.1f} / {b['forward']:.1f} |"
+        )
+    md += [
+        "",
+        f"Final-cost agreement {rel:.2e} relative. Ratios freefloat/Crocoddyl: total {ra['total']:.2f}, per "
+        f"iteration {ra['per_iteration']:.2f}, calcDiff {ra['block_calc_diff']:.2f}, backward "
+        f"{ra['block_backward']:.2f}, forward {ra['block_forward']:.2f}.",
+    ]
+    (out / "ddp_vs_crocoddyl.md").write_text("\n".join(md) + "\n")
+    print("\n".join(md))
+    if not rel <= 1e-6 or ff_it[-1] > cr_it[-1]:
+        print(f"DISAGREEMENT: cost rel {rel:.3g}, iterations {ff_it[-1]} vs {cr_it[-1]}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

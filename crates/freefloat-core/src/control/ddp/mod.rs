@@ -1,0 +1,28 @@
+//! Differential dynamic programming for end-effector control of a free-floating robot (Valverde 2018,
+//! ch. 8): the Riccati backward pass of iLQG and of full DDP, the 1.6-factor regularisation schedule, a
+//! backtracking line search with the expected-improvement test and the thesis' fixed-α mode, and a
+//! feasibility-driven variant for infeasible initial guesses. The solver linearises in the minimal
+//! tangent error state of the state manifold (`ActionModel::difference`), so a floating base's pose is
+//! integrated on the group in the rollout and never linearised in its redundant coordinates.
+//!
+//! Files by job: `problem` (the action-model trait), `workspace` (per-node buffers), `backward`,
+//! `forward` (rollouts), `regularisation`, `solver` (driver), `costs`, `lie` (SE(3) exp/log),
+//! `robot` (the floating-base robot action model), `fd_step` (temporary step Jacobians).
+
+pub mod backward;
+pub mod forward;
+pub mod problem;
+pub mod regularisation;
+pub mod solver;
+pub mod workspace;
+
+pub use problem::{ActionModel, DynamicsHessian, NodeDiff};
+pub use regularisation::{RegOptions, Regularisation};
+pub use solver::{DdpOptions, IterInfo, Solution, Solver, StopReason, Timings, Variant};
+pub use workspace::Workspace;
+pub mod costs;
+pub mod fd_step;
+pub mod lie;
+pub mod robot;
+pub use robot::FloatingRobot;
+pub mod reference;

@@ -1,0 +1,150 @@
+"""DDP end-effector control (Valverde 2018, ch. 8): scenario files, bad input, a short solve, the CLI, and (slow)
+the identical tracking problem in Crocoddyl 3.2.1 as an oracle for the final cost and the iteration count."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from freefloat._core import InputError
+from freefloat.cli import main
+from freefloat.control import ddp
+
+
+def short(prob: ddp.Problem, n: int) -> ddp.Problem:
+    from dataclasses import replace
+
+    def cut(terms):
+        out = []
+        for t in terms:
+            t = dict(t)
+            if "reference" in t and len(t["reference"]) > 1:
+                t["reference"] = t["reference"][: n + 1]
+            out.append(t)
+        return out
+
+    return replace(
+        prob,
+        horizon=n,
+        running=cut(prob.running),
+        terminal=cut(prob.terminal),
+        us0=prob.us0[:n],
+        reference_dq=prob.reference_dq[: n + 1],
+    )
+
+
+def test_scenarios_load_with_the_thesis_sizes():
+    t = ddp.load_scenario("valverde_ch8_tracking")
+    assert (t.horizon, t.dt, t.model.nv) == (640, 0.05, 12)
+    assert t.reference_dq.shape == (641, 8)
+    # §7.2 table, t = 12 s: q_r = (0, 1, 0, 0), q_d = (-3.15, 0, 2.675, 0) (interpretation A).
+    np.testing.assert_allclose(t.reference_dq[240], [0, 1, 0, 0, -3.15, 0, 2.675, 0], atol=1e-9)
+    assert len(t.keep_out) == 2 and t.options["alphas"] == [0.1]
+    s = ddp.load_scenario("valverde_ch8_stabilisation")
+    assert (s.horizon, s.dt) == (1000, 0.015)
+    # eq. (8.53): (0.5, [0.5, -0.5, -0.5]) + eps (0.25, [2.25, 0.25, 2.25]).
+    np.testing.assert_allclose(s.reference_dq[0], [0.5, 0.5, -0.5, -0.5, 0.25, 2.25, 0.25, 2.25], atol=1e-12)
+
+
+def test_short_solve_reduces_the_cost_and_reports_results():
+    prob = short(ddp.load_scenario("valverde_ch8_tracking", cost="dq", keep_out=True), 30)
+    seen = []
+    sol = ddp.solve(prob, progress=lambda i: seen.append(i) or True, max_iter=4, alphas=[1.0, 0.5, 0.25])
+    assert len(seen) == len(sol["history"]) >= 1
+    assert sol["cost"] < sol["initial_cost"]
+    assert all(h["reduction"] > 0 for h in sol["history"] if h["accepted"])
+    res = ddp.results(prob, sol)
+    for k in (
+        "iterations",
+        "final_cost",
+        "solve_time_s",
+        "time_per_iteration_s",
+        "ee_position_error_final_hold_max_m",
+        "ee_angle_error_final_hold_max_deg",
+        "base_force_peak_N",
+        "base_torque_peak_Nm",
+    ):
+        assert math.isfinite(res[k]), k
+    # A callback returning False stops after the first iteration, keeping the iterate.
+    sol = ddp.solve(prob, progress=lambda i: False, max_iter=5)
+    assert sol["stop"] == "stopped_by_callback" and sol["iterations"] == 1
+
+
+def test_bad_input_names_the_argument():
+    prob = short(ddp.load_scenario("valverde_ch8_tracking", cost="log"), 10)
+    x0 = prob.x0.copy()
+    x0[8] = np.nan
+    with pytest.raises(InputError, match="x0"):
+        ddp.solve(ddp.Problem(**{**prob.__dict__, "x0": x0}))
+    with pytest.raises(InputError, match="us0"):
+        ddp.solve(ddp.Problem(**{**prob.__dict__, "us0": np.zeros((9, 12))}))
+    bad = [dict(prob.running[0], reference=prob.running[0]["reference"][:5])] + prob.running[1:]
+    with pytest.raises(InputError, match="pose.reference"):
+        ddp.solve(ddp.Problem(**{**prob.__dict__, "running": bad}))
+    with pytest.raises(InputError, match="horizon"):
+        ddp.solve(ddp.Problem(**{**prob.__dict__, "horizon": 0, "us0": np.zeros((0, 12))}))
+    with pytest.raises(InputError, match="weights"):
+        ddp.control_cost("u", prob.model, [1.0] * 11)
+    neg = [prob.running[0], prob.running[1], dict(prob.running[2], weights=[-1.0] * 12)]
+    with pytest.raises(InputError, match="weights"):
+        ddp.solve(ddp.Problem(**{**prob.__dict__, "running": neg}))
+    with pytest.raises(InputError, match="alphas"):
+        ddp.solve(prob, alphas=[])
+    with pytest.raises(InputError, match="unknown key"):
+        ddp.solve(prob, alpha=0.1)
+
+
+def test_cli_help_and_bad_scenario():
+    r = CliRunner().invoke(main, ["control", "ddp", "--help"])
+    assert r.exit_code == 0 and "Valverde 2018" in r.output and "--cost" in r.output
+    r = CliRunner().invoke(main, ["control", "ddp", "no_such_scenario"])
+    assert r.exit_code != 0 and "not found" in r.output
+
+
+@pytest.mark.slow
+def test_cli_writes_results_and_figures(tmp_path):
+    r = CliRunner().invoke(
+        main, ["control", "ddp", "valverde_ch8_tracking", "--cost", "log", "--max-iter", "2", "--out", str(tmp_path)]
+    )
+    assert r.exit_code == 0, r.output
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["iterations"] == 2 and res["final_cost"] < res["initial_cost"]
+    assert len(list(tmp_path.glob("*.png"))) >= 6
+
+
+@pytest.mark.slow
+def test_tracking_reaches_crocoddyls_cost_in_no_more_iterations():
+    pytest.importorskip("crocoddyl")
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benches" / "ddp_vs_crocoddyl.py"
+    spec = importlib.util.spec_from_file_location("ddp_vs_crocoddyl", path)
+    dc = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(dc)
+
+    prob = ddp.load_scenario(
+        "valverde_ch8_tracking", cost="log", schedule=False, keep_out=False, initial_controls="zero"
+    )
+    opts = dict(
+        variant="fddp",
+        alphas=[0.5**k for k in range(10)],
+        accept_ratio=0.1,
+        reg_init=1e-9,
+        reg_min=1e-9,
+        tol_expected=1e-9,
+        max_iter=150,
+    )
+    sol = ddp.solve(prob, **opts)
+    _, croc_iters, croc_cost = dc.solve_crocoddyl(dc.build_crocoddyl_problem(prob), prob.us0, 150)
+    assert sol["stop"] == "converged"
+    assert abs(sol["cost"] - croc_cost) <= 1e-6 * abs(croc_cost), (sol["cost"], croc_cost)
+    assert sol["iterations"] <= croc_iters, (sol["iterations"], croc_iters)
+    # The baseline digest's number for the same problem.
+    assert abs(croc_cost - 204.19) < 0.01
+    res = ddp.results(prob, sol)
+    assert res["ee_position_error_final_m"] < 0.01
