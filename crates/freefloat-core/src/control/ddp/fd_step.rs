@@ -1,6 +1,5 @@
-//! TEMPORARY — to be replaced by the analytic derivatives of the floating-base ABA and of the
-//! semi-implicit Euler step (`dynamics::derivatives`) when they land. Central finite differences of the
-//! robot's step in the tangent error state, used only to get the DDP pipeline running and tested:
+//! The test oracle of `step_jacobians` (the solver uses the analytic ones): central finite differences of
+//! the robot's step in the tangent error state,
 //! `Fx e_i ≈ [(F(x ⊕ h eᵢ, u) ⊖ F(x, u)) − (F(x ⊕ −h eᵢ, u) ⊖ F(x, u))] / 2h`, same for u.
 //! Cost: 2 (ndx + nu) steps per node, which is why the robot's iterations are slow.
 
@@ -12,7 +11,7 @@ use nalgebra::DMatrix;
 const H: f64 = 1e-6;
 
 impl FloatingRobot {
-    /// `fx` (ndx × ndx) and `fu` (ndx × nu) of the step at (x, u) by central differences (TEMPORARY).
+    /// `fx` (ndx × ndx) and `fu` (ndx × nu) of the step at (x, u) by central differences (the oracle of `step_jacobians`).
     pub fn fd_step_jacobians(
         &mut self,
         x: &[f64],

@@ -7,7 +7,8 @@
 //!
 //! Files by job: `problem` (the action-model trait), `workspace` (per-node buffers), `backward`,
 //! `forward` (rollouts), `regularisation`, `solver` (driver), `costs`, `lie` (SE(3) exp/log),
-//! `robot` (the floating-base robot action model), `fd_step` (temporary step Jacobians).
+//! `robot` (the floating-base robot action model), `step_jacobians` (analytic step Jacobians), `fd_step` (their
+//! central-difference oracle for the tests).
 
 pub mod backward;
 pub mod forward;
@@ -24,5 +25,6 @@ pub mod costs;
 pub mod fd_step;
 pub mod lie;
 pub mod robot;
+pub mod step_jacobians;
 pub use robot::FloatingRobot;
 pub mod reference;

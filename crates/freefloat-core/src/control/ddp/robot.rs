@@ -4,14 +4,15 @@
 //! actuation, as a spacecraft with thrusters and reaction wheels allows), zero gravity or not as the model
 //! says. The step is semi-implicit Euler on the group, `v⁺ = v + Δt·ABA(q, v, u)`, `q⁺ = q ⊕ Δt v⁺`.
 //!
-//! Step Jacobians come from `fd_step` (central differences) until the analytic derivatives of the
-//! floating-base ABA replace them; cost derivatives are analytic (`costs`).
+//! Step Jacobians are analytic (`step_jacobians`, from the engine's forward-dynamics derivatives), as are
+//! the cost derivatives (`costs`); `fd_step` keeps the central-difference Jacobians as the test oracle.
 
 use super::costs::{dual_quat_jacobian, frame_dual_quat, keep_out, placement_residual, CostTerm, KeepOut, Residual};
 use super::lie::{ff_difference, ff_integrate, se3_right_jacobian_inv};
 use super::problem::{ActionModel, NodeDiff};
 use crate::data::Data;
 use crate::dynamics::aba;
+use crate::dynamics::derivatives::Derivatives;
 use crate::error::{FfError, Result};
 use crate::kinematics::{frame_jacobian, Reference};
 use crate::model::{JointType, Model};
@@ -43,6 +44,8 @@ pub struct FloatingRobot {
     pub(crate) dxbuf: Vec<f64>,
     pub(crate) dxbuf2: Vec<f64>,
     pub(crate) tbuf: Vec<f64>,
+    /// Forward-dynamics derivatives workspace (analytic step Jacobians).
+    pub(crate) deriv: Derivatives,
 }
 
 impl FloatingRobot {
@@ -95,6 +98,7 @@ impl FloatingRobot {
         let data = Data::new(&model);
         Ok(FloatingRobot {
             data,
+            deriv: Derivatives::new(&model),
             dt,
             n,
             running,
@@ -369,7 +373,7 @@ impl ActionModel for FloatingRobot {
     }
     fn calc_diff(&mut self, k: usize, x: &[f64], u: &[f64], d: &mut NodeDiff) -> Result<()> {
         d.clear();
-        self.fd_step_jacobians(x, u, &mut d.fx, &mut d.fu)?;
+        self.step_jacobians(x, u, &mut d.fx, &mut d.fu)?;
         self.cost_diff(k, x, Some(u), d)
     }
     fn calc_diff_terminal(&mut self, x: &[f64], d: &mut NodeDiff) -> Result<()> {
