@@ -3,6 +3,7 @@
 
 mod algorithms;
 mod batch;
+mod concurrent;
 mod cpu;
 mod dq;
 mod dqdynamics;
@@ -60,6 +61,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<postcapture::PyModifiedRls>()?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_dynamics, m)?)?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
+    m.add_function(wrap_pyfunction!(concurrent::cl_run, m)?)?;
+    m.add_function(wrap_pyfunction!(concurrent::cl_sample, m)?)?;
+    m.add_class::<concurrent::PyConcurrentEstimator>()?;
     m.add_class::<dq::PyDualQuaternion>()?;
     m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_exp, m)?)?;
