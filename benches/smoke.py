@@ -4,7 +4,7 @@ numbers it recorded are checked. Exits non-zero if a script fails (each one abor
 its peer disagree) or a recorded number is out of bounds. Timings are not judged here (a loaded CI machine
 says nothing about speed); the full runs and their tables are in benches/results/.
 
-    python benches/smoke.py                 # all four
+    python benches/smoke.py                 # all of them
     python benches/smoke.py identify dq     # a subset, by name
 
 Pinocchio and Crocoddyl (the `[test]` extra) are needed for compare_pinocchio and excitation_bench; without them
@@ -70,12 +70,24 @@ def _check_dq(out: Path) -> list[str]:
     return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
 
 
+def _check_cl(out: Path) -> list[str]:
+    res = json.loads((out / "cl_vs_numpy.json").read_text())
+    bad = []
+    for ns, a in res["agreement"].items():
+        if not (a["freefloat_max_rel_error"] < 0.01 and a["numpy_max_rel_error"] < 0.01):
+            bad.append(f"N_s = {ns}: an estimator missed 1 % ({a})")
+        if not a["engine_estimator_vs_run_max_rel_diff"] < 1e-6:
+            bad.append(f"N_s = {ns}: engine estimator and whole run disagree ({a})")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
     "excitation": ("excitation_bench.py", [], ("pinocchio", "scipy"), _check_excitation),
     "identify": ("identify_vs_numpy.py", ["--repeats", "1"], (), _check_identify),
     "dq": ("dq_dynamics.py", [], (), _check_dq),
+    "cl": ("cl_vs_numpy.py", [], (), _check_cl),
 }
 
 

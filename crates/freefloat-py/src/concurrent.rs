@@ -6,7 +6,7 @@ use crate::batch::model_arg;
 use crate::errors::{guard, input_err};
 use freefloat_core::dqdynamics::dq_dynamics;
 use freefloat_core::estimation::concurrent::{
-    run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer, SampleBuilder, SplitMix, M87, NP, V8,
+    estimate_recorded, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer, SampleBuilder, SplitMix, M87, NP, V8,
 };
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyKeyboardInterrupt;
@@ -137,6 +137,48 @@ pub fn cl_run<'py>(
     d.set_item("stack_trials", res.stack_trials)?;
     d.set_item("interrupted", res.interrupted)?;
     Ok(d)
+}
+
+/// The ch. 9 estimator alone over recorded data points: R (n, B, 8, 7), F (n, B, 8) taken every `dt` from
+/// t = 0; the same sequence as `cl_run` (offer, record, step) without the robot. Returns the estimates (n, 7B).
+#[pyfunction]
+#[pyo3(signature = (r, f, dt, m0, *, ns = 10, sigma_th = 0.001, t_th = 5.0, aggressive = true, t_th2 = 4.9,
+    sigma_th2 = 0.5, sigma_new = 100.0, seed = 1))]
+#[allow(clippy::too_many_arguments)]
+pub fn cl_estimate<'py>(
+    py: Python<'py>,
+    r: PyReadonlyArrayDyn<'py, f64>,
+    f: PyReadonlyArrayDyn<'py, f64>,
+    dt: f64,
+    m0: PyReadonlyArray1<'py, f64>,
+    ns: usize,
+    sigma_th: f64,
+    t_th: f64,
+    aggressive: bool,
+    t_th2: f64,
+    sigma_th2: f64,
+    sigma_new: f64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyAny>> {
+    let sh = r.shape().to_vec();
+    if sh.len() != 4 || sh[2] != 8 || sh[3] != NP {
+        return Err(input_err(format!("argument `R`: expected shape (n, B, 8, 7), got {sh:?}")));
+    }
+    let (n, nb) = (sh[0], sh[1]);
+    if f.shape() != [n, nb, 8] {
+        return Err(input_err(format!("argument `F`: expected shape ({n}, {nb}, 8), got {:?}", f.shape())));
+    }
+    let (Ok(rs), Ok(fs)) = (r.as_slice(), f.as_slice()) else {
+        return Err(input_err("arguments `R`, `F`: must be C-contiguous float64 arrays (numpy.ascontiguousarray)"));
+    };
+    // row-major (…, 8, 7) blocks into nalgebra's column-major 8×7
+    let rb: Vec<M87> = rs.chunks_exact(56).map(|c| M87::from_row_slice(c)).collect();
+    let fb: Vec<V8> = fs.chunks_exact(8).map(V8::from_column_slice).collect();
+    let p = params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, seed);
+    let m0 = m0.as_array().to_vec();
+    let mut out = vec![0.0; n * NP * nb];
+    py.detach(|| guard(|| estimate_recorded(nb, p, &m0, dt, &rb, &fb, &mut out)))?;
+    Ok(PyArray1::from_vec(py, out).reshape([n, NP * nb])?.into_any())
 }
 
 /// One data point of ch. 9 from a multibody state: the dual-quaternion dynamics at (q, v, tau) give every

@@ -63,6 +63,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
     m.add_function(wrap_pyfunction!(concurrent::cl_run, m)?)?;
     m.add_function(wrap_pyfunction!(concurrent::cl_sample, m)?)?;
+    m.add_function(wrap_pyfunction!(concurrent::cl_estimate, m)?)?;
     m.add_class::<concurrent::PyConcurrentEstimator>()?;
     m.add_class::<dq::PyDualQuaternion>()?;
     m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;

@@ -283,3 +283,33 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
     out.stack_trials = tr;
     Ok(out)
 }
+
+/// The estimator alone over recorded data points: `r` holds n samples × B blocks (sample-major), `f` the matching
+/// wrenches, taken at t_k = k·dt; `out` receives the estimate at every t_k (n × 7B, before the step from t_k).
+/// The same per-step sequence as `run_cl` (offer, record, step), without the robot.
+pub fn estimate_recorded(
+    nbodies: usize,
+    params: ClParams,
+    m0: &[f64],
+    dt: f64,
+    r: &[super::M87],
+    f: &[super::V8],
+    out: &mut [f64],
+) -> Result<()> {
+    let mut est = ConcurrentEstimator::new(nbodies, params, m0)?;
+    if r.len() != f.len() || r.len() % nbodies != 0 || r.is_empty() {
+        return Err(FfError::arg("R/F", format!("need n samples × {nbodies} blocks each, got {} and {}", r.len(), f.len())));
+    }
+    let n = r.len() / nbodies;
+    crate::check::check_len("out", out.len(), n * NP * nbodies)?;
+    let np = NP * nbodies;
+    for k in 0..n {
+        est.set_time(k as f64 * dt);
+        est.add_sample(&r[k * nbodies..(k + 1) * nbodies], &f[k * nbodies..(k + 1) * nbodies])?;
+        est.estimate_into(&mut out[k * np..(k + 1) * np]);
+        if k + 1 < n {
+            est.step(dt)?;
+        }
+    }
+    Ok(())
+}

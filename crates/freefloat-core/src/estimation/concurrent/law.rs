@@ -40,14 +40,44 @@ pub fn svd_gain(t: &M7, sigma_th2: f64, sigma_new: f64, s_ref: f64) -> M7 {
     k
 }
 
-/// `−K Tᵀ(T m − g)` (= −K(RR m − Rf)) for one block; K = None is the identity, (9.15).
+/// `−K Tᵀ(T m − g)` (= −K(RR m − Rf)) for one block; K = None is the identity, (9.15). T is upper triangular
+/// (the R of a QR); the products are written out (the generic small-matrix path is several times slower).
 #[inline]
 pub fn block_rate(t: &M7, g: &V7, k: Option<&M7>, m: &V7) -> V7 {
-    let e = t.tr_mul(&(t * m - g));
-    match k {
-        Some(k) => -(k * e),
-        None => -e,
+    let mut e = [0.0; NP];
+    for i in 0..NP {
+        let mut s = -g[i];
+        for j in i..NP {
+            s += t[(i, j)] * m[j];
+        }
+        e[i] = s;
     }
+    let mut y = [0.0; NP];
+    for j in 0..NP {
+        let mut s = 0.0;
+        for i in 0..=j {
+            s += t[(i, j)] * e[i];
+        }
+        y[j] = s;
+    }
+    let mut out = V7::zeros();
+    match k {
+        Some(k) => {
+            for i in 0..NP {
+                let mut s = 0.0;
+                for j in 0..NP {
+                    s += k[(i, j)] * y[j];
+                }
+                out[i] = -s;
+            }
+        }
+        None => {
+            for i in 0..NP {
+                out[i] = -y[i];
+            }
+        }
+    }
+    out
 }
 
 /// One classical RK4 step of (9.15)/(9.23) for every block over `dt`, RR, Rf and K held constant over the

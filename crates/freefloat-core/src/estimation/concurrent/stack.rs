@@ -25,6 +25,32 @@ fn merge(a: &M8, b: &M8) -> M8 {
     x.qr().r()
 }
 
+/// `R̂ᵀR̂` and `R̂ᵀF` of one block, written out (the generic small-matrix product is several times slower here,
+/// and this runs for every candidate).
+#[inline]
+fn gram(r: &M87, f: &V8) -> (M7, V7) {
+    let mut g = M7::zeros();
+    let mut gf = V7::zeros();
+    for j in 0..NP {
+        let cj = r.column(j);
+        for k in j..NP {
+            let ck = r.column(k);
+            let mut s = 0.0;
+            for i in 0..8 {
+                s += cj[i] * ck[i];
+            }
+            g[(j, k)] = s;
+            g[(k, j)] = s;
+        }
+        let mut s = 0.0;
+        for i in 0..8 {
+            s += cj[i] * f[i];
+        }
+        gf[j] = s;
+    }
+    (g, gf)
+}
+
 /// A small deterministic generator (SplitMix64) for the random visiting order π of Algorithm 3 and for
 /// the measurement noise of the studies: reproducible from a seed, no dependency.
 #[derive(Clone, Debug)]
@@ -234,8 +260,7 @@ impl DataStack {
             return Err(FfError::arg("candidate", "regressor or wrench has a non-finite entry"));
         }
         for i in 0..nb {
-            self.cand_g[i] = x[i].transpose() * x[i];
-            self.cand_gf[i] = x[i].transpose() * fw[i];
+            (self.cand_g[i], self.cand_gf[i]) = gram(&x[i], &fw[i]);
         }
         if self.nc < self.ns {
             // filling phase: accept unconditionally
@@ -266,9 +291,10 @@ impl DataStack {
                 continue;
             }
             if cand_trace == 0.0 && p_trace == 0.0 {
-                // both carry no information (e.g. a robot at rest): the replacement passes the test and
-                // changes no sum; store the point without recomputing what cannot change
-                self.store(p, x, fw);
+                // both carry no information (e.g. a robot at rest: R̂ = 0 exactly): the replacement passes the
+                // test and changes neither RR nor T; store the point without recomputing what cannot change
+                // (with R̂ = 0 on both sides Rf and g are unchanged too: the F column only enters ρ)
+                self.store_raw(p, x, fw);
                 return Ok(Offer::Replaced(p));
             }
             self.trials += 1;
@@ -285,6 +311,17 @@ impl DataStack {
             }
         }
         Ok(Offer::Rejected)
+    }
+
+    fn store_raw(&mut self, s: usize, x: &[M87], fw: &[V8]) {
+        let nb = self.nb;
+        for i in 0..nb {
+            self.r[s * nb + i] = x[i];
+            self.f[s * nb + i] = fw[i];
+            self.g[s * nb + i] = self.cand_g[i];
+            self.gf[s * nb + i] = self.cand_gf[i];
+        }
+        self.changes += 1;
     }
 
     fn store(&mut self, s: usize, x: &[M87], fw: &[V8]) {
