@@ -122,7 +122,9 @@ def numpy_peer(t, R, F, m0, ns, sigma_th=1e-3, t_th=5.0, t_th2=4.9, sigma_th2=0.
                         Rs[p], Fs[p], G[p] = Rc, Fc, Gc
                     else:
                         trial = RR[None] - G[cand] + Gc[None]  # (n, nb, 7, 7)
-                        tv = np.sort(np.clip(np.linalg.eigvalsh(trial), 0, None).reshape(len(cand), -1), axis=1)[:, ::-1]
+                        tv = np.sort(np.clip(np.linalg.eigvalsh(trial), 0, None).reshape(len(cand), -1), axis=1)[
+                            :, ::-1
+                        ]
                         ok = np.all(tv >= sv_test[None] - tol, axis=1)
                         if ok.any():
                             p = cand[np.argmax(ok)]
@@ -141,7 +143,7 @@ def numpy_peer(t, R, F, m0, ns, sigma_th=1e-3, t_th=5.0, t_th2=4.9, sigma_th2=0.
             K = np.einsum("bji,bj,bjk->bik", vt, sbar, vt)
             changed = False
 
-        def rate(x):
+        def rate(x, K=K, on=on):
             e = np.einsum("bji,bj->bi", T, np.einsum("bij,bj->bi", T, x) - g)
             return -np.einsum("bij,bj->bi", K, e) if on else -e
 
@@ -172,9 +174,16 @@ def block_saving(repeats=200):
 
     t_full = med(lambda: np.linalg.eigvalsh(full))
     t_block = med(lambda: np.linalg.eigvalsh(blocks))
-    same = np.allclose(np.sort(np.linalg.eigvalsh(full)), np.sort(np.linalg.eigvalsh(blocks).ravel()), rtol=1e-10, atol=1e-10)
-    return {"full_77x77_us": t_full * 1e6, "blocks_11x7x7_us": t_block * 1e6, "ratio": t_full / t_block, "same": bool(same),
-            "flops_ratio_estimate": 77**3 / (11 * 7**3)}
+    same = np.allclose(
+        np.sort(np.linalg.eigvalsh(full)), np.sort(np.linalg.eigvalsh(blocks).ravel()), rtol=1e-10, atol=1e-10
+    )
+    return {
+        "full_77x77_us": t_full * 1e6,
+        "blocks_11x7x7_us": t_block * 1e6,
+        "ratio": t_full / t_block,
+        "same": bool(same),
+        "flops_ratio_estimate": 77**3 / (11 * 7**3),
+    }
 
 
 def main():
@@ -197,14 +206,19 @@ def main():
         peer = numpy_peer(t, R, F, sc.m0, ns)
         e_ff = float(np.max(np.abs(ref.final_estimate - truth) / scale))
         e_np = float(np.max(np.abs(peer[-1] - truth) / scale))
-        agreement[ns] = {"freefloat_max_rel_error": e_ff, "numpy_max_rel_error": e_np,
-                         "final_estimate_max_rel_diff": float(np.max(np.abs(ref.final_estimate - peer[-1]) / scale))}
+        agreement[ns] = {
+            "freefloat_max_rel_error": e_ff,
+            "numpy_max_rel_error": e_np,
+            "final_estimate_max_rel_diff": float(np.max(np.abs(ref.final_estimate - peer[-1]) / scale)),
+        }
         if not (e_ff < 0.01 and e_np < 0.01):
             raise SystemExit(f"N_s = {ns}: an estimator missed 1 % (freefloat {e_ff:.3g}, numpy {e_np:.3g})")
         if ns == 10 and agreement[ns]["final_estimate_max_rel_diff"] > 1e-6:
             raise SystemExit(f"N_s = 10: freefloat and numpy disagree ({agreement[ns]})")
         est_ff = ff._core.cl_estimate(R, F, sc.dt, sc.m0, ns=ns)
-        agreement[ns]["engine_estimator_vs_run_max_rel_diff"] = float(np.max(np.abs(est_ff[-1] - ref.final_estimate) / scale))
+        agreement[ns]["engine_estimator_vs_run_max_rel_diff"] = float(
+            np.max(np.abs(est_ff[-1] - ref.final_estimate) / scale)
+        )
         tw, te, tn = [], [], []
         for _ in range(repeats):
             t0 = time.perf_counter()
@@ -217,35 +231,67 @@ def main():
             numpy_peer(t, R, F, sc.m0, ns)
             tn.append(time.perf_counter() - t0)
         med = statistics.median
-        rows.append({"ns": ns, "whole_run_s": med(tw), "whole_run_min": min(tw), "whole_run_max": max(tw),
-                     "estimator_s": med(te), "estimator_min": min(te), "estimator_max": max(te),
-                     "numpy_s": med(tn), "numpy_min": min(tn), "numpy_max": max(tn),
-                     "ratio_estimator": med(tn) / med(te), "ratio_whole_run": med(tn) / med(tw)})
+        rows.append(
+            {
+                "ns": ns,
+                "whole_run_s": med(tw),
+                "whole_run_min": min(tw),
+                "whole_run_max": max(tw),
+                "estimator_s": med(te),
+                "estimator_min": min(te),
+                "estimator_max": max(te),
+                "numpy_s": med(tn),
+                "numpy_min": min(tn),
+                "numpy_max": max(tn),
+                "ratio_estimator": med(tn) / med(te),
+                "ratio_whole_run": med(tn) / med(tw),
+            }
+        )
         r_ = rows[-1]
-        print(f"N_s {ns:4d}: whole run {r_['whole_run_s']:.3f} s, engine estimator {r_['estimator_s']:.4f} s, "
-              f"numpy estimator {r_['numpy_s']:.3f} s: {r_['ratio_estimator']:.1f}x (whole run vs numpy estimator "
-              f"{r_['ratio_whole_run']:.1f}x)")
+        print(
+            f"N_s {ns:4d}: whole run {r_['whole_run_s']:.3f} s, engine estimator {r_['estimator_s']:.4f} s, "
+            f"numpy estimator {r_['numpy_s']:.3f} s: {r_['ratio_estimator']:.1f}x (whole run vs numpy estimator "
+            f"{r_['ratio_whole_run']:.1f}x)"
+        )
     bs = block_saving(50 if a.quick else 300)
-    print(f"block-diagonal saving: 77x77 eigh {bs['full_77x77_us']:.1f} us vs 11 x 7x7 {bs['blocks_11x7x7_us']:.1f} us "
-          f"({bs['ratio']:.1f}x)")
-    res = {"scenario": SCENARIO, "repeats": repeats, "rows": rows, "agreement": {str(k): v for k, v in agreement.items()},
-           "block_saving": bs, "machine": platform.platform(), "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-           "targets": {"ns10_under_s": 0.2, "ns300_under_s": 2.0, "ratio_at_least": 10}}
+    print(
+        f"block-diagonal saving: 77x77 eigh {bs['full_77x77_us']:.1f} us vs 11 x 7x7 {bs['blocks_11x7x7_us']:.1f} us "
+        f"({bs['ratio']:.1f}x)"
+    )
+    res = {
+        "scenario": SCENARIO,
+        "repeats": repeats,
+        "rows": rows,
+        "agreement": {str(k): v for k, v in agreement.items()},
+        "block_saving": bs,
+        "machine": platform.platform(),
+        "when": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+        "targets": {"ns10_under_s": 0.2, "ns300_under_s": 2.0, "ratio_at_least": 10},
+    }
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cl_vs_numpy.json").write_text(json.dumps(res, indent=2))
-    md = [f"# freefloat vs numpy: Valverde 2018 ch. 9 concurrent learning ({res['when']})", "",
-          "Median of %d interleaved repeats [min-max]. Estimator: the stack update and law on the same recorded "
-          "data (engine vs numpy). Whole run: the engine's 10 s run including the robot simulation." % repeats, "",
-          "| N_s | whole run [s] | engine estimator [s] | numpy estimator [s] | estimator ratio | whole run vs numpy |",
-          "|---:|---:|---:|---:|---:|---:|"]
+    md = [
+        f"# freefloat vs numpy: Valverde 2018 ch. 9 concurrent learning ({res['when']})",
+        "",
+        f"Median of {repeats} interleaved repeats [min-max]. Estimator: the stack update and law on the same "
+        "recorded data (engine vs numpy). Whole run: the engine's 10 s run including the robot simulation.",
+        "",
+        "| N_s | whole run [s] | engine estimator [s] | numpy estimator [s] | estimator ratio | whole run vs numpy |",
+        "|---:|---:|---:|---:|---:|---:|",
+    ]
     for r in rows:
-        md.append(f"| {r['ns']} | {r['whole_run_s']:.3f} [{r['whole_run_min']:.3f}-{r['whole_run_max']:.3f}] | "
-                  f"{r['estimator_s']:.4f} [{r['estimator_min']:.4f}-{r['estimator_max']:.4f}] | "
-                  f"{r['numpy_s']:.3f} [{r['numpy_min']:.3f}-{r['numpy_max']:.3f}] | {r['ratio_estimator']:.1f} | "
-                  f"{r['ratio_whole_run']:.1f} |")
-    md += ["", f"Block-diagonal structure (numpy eigh): one 77x77 {bs['full_77x77_us']:.1f} us, eleven 7x7 batched "
-           f"{bs['blocks_11x7x7_us']:.1f} us ({bs['ratio']:.1f}x; flop estimate {bs['flops_ratio_estimate']:.0f}x)."]
+        md.append(
+            f"| {r['ns']} | {r['whole_run_s']:.3f} [{r['whole_run_min']:.3f}-{r['whole_run_max']:.3f}] | "
+            f"{r['estimator_s']:.4f} [{r['estimator_min']:.4f}-{r['estimator_max']:.4f}] | "
+            f"{r['numpy_s']:.3f} [{r['numpy_min']:.3f}-{r['numpy_max']:.3f}] | {r['ratio_estimator']:.1f} | "
+            f"{r['ratio_whole_run']:.1f} |"
+        )
+    md += [
+        "",
+        f"Block-diagonal structure (numpy eigh): one 77x77 {bs['full_77x77_us']:.1f} us, eleven 7x7 batched "
+        f"{bs['blocks_11x7x7_us']:.1f} us ({bs['ratio']:.1f}x; flop estimate {bs['flops_ratio_estimate']:.0f}x).",
+    ]
     (out / "cl_vs_numpy.md").write_text("\n".join(md) + "\n")
 
 

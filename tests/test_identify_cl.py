@@ -119,7 +119,7 @@ def test_D2_block_svd_equals_full_svd(model):
     rng = np.random.default_rng(3)
     est = cl.ConcurrentLearningEstimator(11, np.zeros(77), ns=12)
     Rs = []
-    for k in range(12):
+    for _ in range(12):
         q = model.random_configuration(rng)
         v = rng.normal(size=model.nv) * 0.3
         R, F, _, _ = cl.sample(model, q, v, rng.normal(size=model.nv))
@@ -139,7 +139,9 @@ def test_D2_block_svd_equals_full_svd(model):
     assert np.all(off == 0)
     full_sv = np.sort(np.linalg.svd(stacked, compute_uv=False) ** 2)[::-1]
     np.testing.assert_allclose(est.singular_values, full_sv, rtol=1e-9, atol=1e-12 * full_sv[0])
-    np.testing.assert_allclose(np.sort(est.block_singular_values.ravel())[::-1], full_sv, rtol=1e-9, atol=1e-12 * full_sv[0])
+    np.testing.assert_allclose(
+        np.sort(est.block_singular_values.ravel())[::-1], full_sv, rtol=1e-9, atol=1e-12 * full_sv[0]
+    )
     # the same through the (8B, 7B) block-diagonal form of add_sample
     est2 = cl.ConcurrentLearningEstimator(11, np.zeros(77), ns=12)
     for full in Rs:
@@ -149,7 +151,9 @@ def test_D2_block_svd_equals_full_svd(model):
 
 
 def test_D3_at_rest_without_excitation_nothing_moves(scenario):
-    sc = cl.ClScenario(**{**scenario.__dict__, "excitation": {**scenario.excitation, "amplitude": 0.0}, "duration": 1.0})
+    sc = cl.ClScenario(
+        **{**scenario.__dict__, "excitation": {**scenario.excitation, "amplitude": 0.0}, "duration": 1.0}
+    )
     r = cl.run(sc)
     assert np.all(r.singular_values == 0)
     np.testing.assert_array_equal(r.estimates, np.tile(sc.m0, (len(r.t), 1)))
@@ -226,7 +230,9 @@ def test_algorithm3_invariants(model):
     # a good-enough stack (σ_min ≥ σ_th) is never changed
     est = cl.ConcurrentLearningEstimator(11, np.zeros(77), ns=5, sigma_th=0.0)
     for k in range(8):
-        R, F, _, _ = cl.sample(model, model.random_configuration(rng), rng.normal(size=model.nv), rng.normal(size=model.nv))
+        R, F, _, _ = cl.sample(
+            model, model.random_configuration(rng), rng.normal(size=model.nv), rng.normal(size=model.nv)
+        )
         what = est.add_sample(R, F)
         assert what == ("appended" if k < 5 else "full")
     # after t_th the stack is frozen

@@ -300,7 +300,9 @@ def load_scenario(spec) -> ClScenario:
             raise _err(source, "estimator.initial_estimate", f"no value for body '{b}' and no 'default'")
     for b in ie:
         if b != "default" and b not in model.body_names:
-            raise _err(source, f"estimator.initial_estimate.{b}", f"no such body (bodies: {', '.join(model.body_names)})")
+            raise _err(
+                source, f"estimator.initial_estimate.{b}", f"no such body (bodies: {', '.join(model.body_names)})"
+            )
     st = d.get("studies", {}) or {}
     if not isinstance(st, dict):
         raise _err(source, "studies", "expected a mapping")
@@ -458,10 +460,11 @@ class ClResult:
                 e = abs(fe[i, j] - tr[i, j]) / sc[i, j]
                 lines.append(f"{b:8s} {p:5s} {tr[i, j]:10.4g} {fe[i, j]:14.8g} {e:10.2e}")
         w = self.time_within_1pct_s
+        worst = self.to_dict()["max_final_relative_error"]
         lines.append(
             f"rank {self.rank}/{len(self.truth)}; singular values constant after "
             f"{self.last_stack_change_s} s; every estimate within 1 % from "
-            f"{'never' if w is None else f'{w:.2f} s'}; max final rel. error {self.to_dict()['max_final_relative_error']:.2e}; "
+            f"{'never' if w is None else f'{w:.2f} s'}; max final rel. error {worst:.2e}; "
             f"max |R M - F| {self.max_residual:.2e}; run time {self.wall_time_s:.3f} s"
         )
         bad = [names[i] for i, ok in enumerate(self.realisable) if not ok]

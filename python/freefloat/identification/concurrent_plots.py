@@ -135,7 +135,10 @@ def comparison_figure(comp: dict, out: Path) -> Path:
     """cl_vs_ls.png: relative errors of the identifiable combinations, CL (mapped) and momentum least squares."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 4))
-    for label, key, style in (("concurrent learning (mapped)", "cl_rel_errors", "o"), ("momentum LS", "ls_rel_errors", "x")):
+    for label, key, style in (
+        ("concurrent learning (mapped)", "cl_rel_errors", "o"),
+        ("momentum LS", "ls_rel_errors", "x"),
+    ):
         for lvl in comp["levels"]:
             e = np.maximum(np.abs(lvl[key]), 1e-17)
             ax.semilogy(np.arange(len(e)), e, style, ms=4, label=f"{label}, rate σ = {lvl['rate_noise']:g}")

@@ -122,7 +122,14 @@ def compare_ls(scenario, rate_levels=(0.0,), seed: int = 7, known=("base",)) -> 
     for lvl in rate_levels:
         telem = tm.from_trajectory(traj)
         if lvl > 0:
-            telem = tm.add_noise(telem, m, np.random.default_rng(seed), sigma_lin=lvl, sigma_ang=lvl, sigma_joint=lvl, reconstruct_poses=False
+            telem = tm.add_noise(
+                telem,
+                m,
+                np.random.default_rng(seed),
+                sigma_lin=lvl,
+                sigma_ang=lvl,
+                sigma_joint=lvl,
+                reconstruct_poses=False,
             )
         ls = identify_minimal(m, telem, known=list(known), method="numeric")
         truth_min = ls.truth_values(m)
@@ -133,7 +140,9 @@ def compare_ls(scenario, rate_levels=(0.0,), seed: int = 7, known=("base",)) -> 
         inertia = np.array([[[a[0], a[1], a[2]], [a[1], a[3], a[4]], [a[2], a[4], a[5]]] for a in v])
         p_cl = inertia_standard_form(np.ascontiguousarray(v[:, 6]), np.ascontiguousarray(coms), inertia)
         cl_min = ls.mp.from_standard(p_cl)
-        scale = np.where(np.abs(truth_min) > 1e-9 * np.max(np.abs(truth_min)), np.abs(truth_min), np.max(np.abs(truth_min)))
+        scale = np.where(
+            np.abs(truth_min) > 1e-9 * np.max(np.abs(truth_min)), np.abs(truth_min), np.max(np.abs(truth_min))
+        )
         levels.append(
             {
                 "rate_noise": lvl,
@@ -151,8 +160,8 @@ def compare_ls(scenario, rate_levels=(0.0,), seed: int = 7, known=("base",)) -> 
         "ls_combination_names": list(ls.names),
         "cl_parameters": int(7 * m.nbodies),
         "needs": {
-            "concurrent_learning": "every body's twist and twist rate (accelerations), every joint's 6-axis force/torque "
-            "(reaction + actuation), the CoM locations; identifies all 7 mass properties of every body",
+            "concurrent_learning": "every body's twist and twist rate (accelerations), every joint's 6-axis "
+            "force/torque (reaction + actuation), the CoM locations; identifies all 7 mass properties of every body",
             "momentum_least_squares": "joint rates and base twist only (no accelerations, no force sensors), one known "
             "body or a known external impulse for the scale; identifies the identifiable combinations of the "
             "standard parameters (mass, first moments, inertias about the joints)",
