@@ -6,7 +6,8 @@ use crate::batch::model_arg;
 use crate::errors::{guard, input_err};
 use freefloat_core::dqdynamics::dq_dynamics;
 use freefloat_core::estimation::concurrent::{
-    estimate_recorded, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer, SampleBuilder, SplitMix, M87, NP, V8,
+    estimate_recorded, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer, SampleBuilder,
+    SplitMix, M87, NP, V8,
 };
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyKeyboardInterrupt;
@@ -124,10 +125,7 @@ pub fn cl_run<'py>(
     d.set_item("t", PyArray1::from_slice(py, &res.times))?;
     d.set_item("estimates", PyArray1::from_slice(py, &res.estimates).reshape([n, np])?)?;
     d.set_item("singular_values", PyArray1::from_slice(py, &res.singular_values).reshape([n, np])?)?;
-    d.set_item(
-        "block_singular_values",
-        PyArray1::from_slice(py, &res.block_singular_values).reshape([n, nb, NP])?,
-    )?;
+    d.set_item("block_singular_values", PyArray1::from_slice(py, &res.block_singular_values).reshape([n, nb, NP])?)?;
     d.set_item("offers", PyArray1::from_slice(py, &res.offers))?;
     d.set_item("truth", PyArray1::from_slice(py, &res.truth))?;
     d.set_item("final_estimate", PyArray1::from_slice(py, &res.final_estimate))?;
@@ -299,7 +297,11 @@ impl PyConcurrentEstimator {
         }
         let fa = f.as_array();
         if f.len() != 8 * nb || !(f.shape() == [nb, 8] || f.shape() == [8 * nb]) {
-            return Err(input_err(format!("argument `F`: expected shape ({nb}, 8) or ({},), got {:?}", 8 * nb, f.shape())));
+            return Err(input_err(format!(
+                "argument `F`: expected shape ({nb}, 8) or ({},), got {:?}",
+                8 * nb,
+                f.shape()
+            )));
         }
         for (k, x) in fa.iter().enumerate() {
             self.f[k / 8][k % 8] = *x;
@@ -330,9 +332,7 @@ impl PyConcurrentEstimator {
     /// Per body, its block's 7 singular values (descending), shape (B, 7).
     #[getter]
     fn block_singular_values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        Ok(PyArray1::from_slice(py, self.inner.stack().block_singular_values())
-            .reshape([self.r.len(), NP])?
-            .into_any())
+        Ok(PyArray1::from_slice(py, self.inner.stack().block_singular_values()).reshape([self.r.len(), NP])?.into_any())
     }
 
     /// RR = Σ𝐑_kᵀ𝐑_k as its diagonal blocks, shape (B, 7, 7).

@@ -298,7 +298,10 @@ pub fn estimate_recorded(
 ) -> Result<()> {
     let mut est = ConcurrentEstimator::new(nbodies, params, m0)?;
     if r.len() != f.len() || r.len() % nbodies != 0 || r.is_empty() {
-        return Err(FfError::arg("R/F", format!("need n samples × {nbodies} blocks each, got {} and {}", r.len(), f.len())));
+        return Err(FfError::arg(
+            "R/F",
+            format!("need n samples × {nbodies} blocks each, got {} and {}", r.len(), f.len()),
+        ));
     }
     let n = r.len() / nbodies;
     crate::check::check_len("out", out.len(), n * NP * nbodies)?;

@@ -255,8 +255,7 @@ impl DataStack {
         if x.len() != nb || fw.len() != nb {
             return Err(FfError::arg("candidate", format!("needs one 8×7 regressor and one wrench per body ({nb})")));
         }
-        if x.iter().any(|r| r.iter().any(|v| !v.is_finite())) || fw.iter().any(|f| f.iter().any(|v| !v.is_finite()))
-        {
+        if x.iter().any(|r| r.iter().any(|v| !v.is_finite())) || fw.iter().any(|f| f.iter().any(|v| !v.is_finite())) {
             return Err(FfError::arg("candidate", "regressor or wrench has a non-finite entry"));
         }
         for i in 0..nb {

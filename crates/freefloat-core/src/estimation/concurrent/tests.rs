@@ -31,7 +31,9 @@ fn explore() {
         sc.params.t_th = x.parse().unwrap();
     }
     let wb: f64 = std::env::var("CL_WB").map(|x| x.parse().unwrap()).unwrap_or(0.0);
-    sc.v0[3] = wb; sc.v0[4] = -0.7 * wb; sc.v0[5] = 0.4 * wb;
+    sc.v0[3] = wb;
+    sc.v0[4] = -0.7 * wb;
+    sc.v0[5] = 0.4 * wb;
     let t0 = std::time::Instant::now();
     let r = run_cl(&m, &sc, None).unwrap();
     println!("run {:?}", t0.elapsed());
@@ -44,7 +46,10 @@ fn explore() {
     let last_change = r.offers.iter().rposition(|&o| o == 1 || o == 2).unwrap();
     println!("last stack change at t={}", last_change as f64 * 0.01);
     let err: f64 = r.final_estimate.iter().zip(&r.truth).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
-    println!("max final err {err:.3e} residual {:.3e} changes {} trials {}", r.max_residual, r.stack_changes, r.stack_trials);
+    println!(
+        "max final err {err:.3e} residual {:.3e} changes {} trials {}",
+        r.max_residual, r.stack_changes, r.stack_trials
+    );
     for i in 0..m.nbodies() {
         let k = 1000;
         let b = &r.block_singular_values[k * np + 7 * i..k * np + 7 * i + 7];
@@ -142,7 +147,13 @@ fn thesis_run_on_the_builtin_robot() {
     let smax = sv[0].sqrt();
     assert!(sv.iter().all(|s| s.sqrt() > ZERO_RTOL * smax), "rank < 77");
     for (j, (e, t)) in r.final_estimate.iter().zip(&r.truth).enumerate() {
-        let scale = if *t != 0.0 { t.abs() } else if j / 7 == 0 { 10.0 } else { 1.0 };
+        let scale = if *t != 0.0 {
+            t.abs()
+        } else if j / 7 == 0 {
+            10.0
+        } else {
+            1.0
+        };
         assert!((e - t).abs() < 0.01 * scale, "parameter {j}: {e} vs {t}");
     }
     assert!(r.max_residual < 1e-12);
