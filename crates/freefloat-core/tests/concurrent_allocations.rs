@@ -41,6 +41,17 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
+fn allocations() -> usize {
+    COUNT.with(|c| c.get())
+}
+
+/// Allocations made by `f` on this thread.
+fn count(f: impl FnOnce()) -> usize {
+    let before = allocations();
+    f();
+    allocations() - before
+}
+
 fn scenario(m: &freefloat_core::Model, t_final: f64, noise: Noise) -> ClScenario {
     ClScenario {
         q0: m.neutral(),
