@@ -297,7 +297,7 @@ pub fn estimate_recorded(
     out: &mut [f64],
 ) -> Result<()> {
     let mut est = ConcurrentEstimator::new(nbodies, params, m0)?;
-    if r.len() != f.len() || r.len() % nbodies != 0 || r.is_empty() {
+    if r.len() != f.len() || !r.len().is_multiple_of(nbodies) || r.is_empty() {
         return Err(FfError::arg(
             "R/F",
             format!("need n samples × {nbodies} blocks each, got {} and {}", r.len(), f.len()),
