@@ -170,7 +170,7 @@ pub fn cl_estimate<'py>(
         return Err(input_err("arguments `R`, `F`: must be C-contiguous float64 arrays (numpy.ascontiguousarray)"));
     };
     // row-major (…, 8, 7) blocks into nalgebra's column-major 8×7
-    let rb: Vec<M87> = rs.chunks_exact(56).map(|c| M87::from_row_slice(c)).collect();
+    let rb: Vec<M87> = rs.chunks_exact(56).map(M87::from_row_slice).collect();
     let fb: Vec<V8> = fs.chunks_exact(8).map(V8::from_column_slice).collect();
     let p = params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, seed);
     let m0 = m0.as_array().to_vec();
@@ -186,7 +186,7 @@ pub fn cl_estimate<'py>(
 /// `wrench_noise`, `rate_noise` as in `cl_run`, drawn with `noise_seed`.
 #[pyfunction]
 #[pyo3(signature = (model, q, v, tau, wrench_noise = 0.0, rate_noise = 0.0, noise_seed = 7))]
-#[allow(clippy::type_complexity)]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn cl_sample<'py>(
     py: Python<'py>,
     model: &Bound<'py, PyAny>,
@@ -200,7 +200,8 @@ pub fn cl_sample<'py>(
     let mb = model_arg(model)?;
     let model = mb.get();
     let m = model.inner.clone();
-    if !(wrench_noise >= 0.0) || !(rate_noise >= 0.0) || !wrench_noise.is_finite() || !rate_noise.is_finite() {
+    let ok = |x: f64| x.is_finite() && x >= 0.0;
+    if !ok(wrench_noise) || !ok(rate_noise) {
         return Err(input_err("arguments `wrench_noise`, `rate_noise`: must be finite and ≥ 0"));
     }
     let (q, v, tau) = (q.as_array().to_vec(), v.as_array().to_vec(), tau.as_array().to_vec());
