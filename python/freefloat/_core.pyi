@@ -307,6 +307,9 @@ def dq_body_poses(model: Model, q: ArrayLike, method: str = 'chain') -> Any:
 (3.43)) or "poe" (product of exponentials (3.19)).
     """
 
+def dq_body_regressor(twist: ArrayLike, twist_dot: ArrayLike) -> Any:
+    """`R̂(ω̇, ω)` (8×7), eq. (9.7)."""
+
 def dq_condition_number(model: Model, q: ArrayLike) -> Any:
     """2-norm condition number of Valverde 2018's system matrix S (6.17) at each configuration (one q or (T, nq))."""
 
@@ -334,8 +337,20 @@ def dq_from_pose(quat_xyzw: ArrayLike, t: ArrayLike) -> Any:
 rejected otherwise, as everywhere in freefloat) and translation `t`.
     """
 
+def dq_h_vector(a: ArrayLike, b: ArrayLike) -> Any:
+    """`h(a, b)` (7,), §4.2: `a ∘ (M ⋆ b) = h(a, b) @ v(M)`."""
+
+def dq_inertia_params(mass: ArrayLike, inertia: ArrayLike) -> Any:
+    """`v(M) = [I11, I12, I13, I22, I23, I33, m]` of a rigid body (mass, 3×3 inertia about the CoM)."""
+
 def dq_line_of_sight(q_ga: ArrayLike, y_g: ArrayLike, half_angle: float) -> Any:
     """Constraint `(value, gradient)`; `value ≤ 0` is feasible. See `freefloat.dq.line_of_sight`."""
+
+def dq_r_matrix(b: ArrayLike) -> Any:
+    """`r(b)` (8×7), eq. (4.2): `r(b) @ v(M) = M ⋆ b` for a vector dual quaternion `b`."""
+
+def dq_relative_regressor(w_bd_dot: ArrayLike, w_bd: ArrayLike, w_di_dot: ArrayLike, w_di: ArrayLike, q_bd: ArrayLike) -> Any:
+    """`R(ω̇_B/D, ω_B/D, ω̇_D/I, ω_D/I, q_B/D)` (8×7), eq. (4.3)."""
 
 def dq_screw(theta: float, d: float, l: ArrayLike, m: ArrayLike) -> Any:
     """Screw exponential (3.10) `exp(½(θ + εd)(ℓ + εm))`."""

@@ -6,8 +6,12 @@ use crate::errors::{guard, input_err};
 use freefloat_core::dualquat::constraints::{self, ConstraintValue};
 use freefloat_core::dualquat::kinematics::{dh, dh_chain};
 use freefloat_core::dualquat::pose::checked_pose;
-use freefloat_core::dualquat::{exp, log, screw_exp, screw_log, DualQuat, M8};
-use freefloat_core::spatial::V3;
+use freefloat_core::dualquat::regressor::params;
+use freefloat_core::dualquat::{
+    body_regressor, exp, h_vector, log, r_matrix, relative_regressor, screw_exp, screw_log, DualInertia, DualQuat, M8,
+    M87,
+};
+use freefloat_core::spatial::{M3, V3};
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyTuple;
@@ -388,4 +392,90 @@ pub fn dq_body_poses<'py>(
     })?;
     let n = poses.len();
     arr2(py, poses.iter().flat_map(|p| p.to_array()).collect(), n, 8)
+}
+
+// ---- the dual-inertia regressor (Valverde 2018, §4.1 and §9.1) ----
+
+/// A vector dual quaternion argument (twist, wrench or their rates): 8 coefficients with zero scalar parts.
+fn vector_arg(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<DualQuat> {
+    let q = operand(obj, name)?;
+    if !q.is_vector(1e-12 * q.norm().max(1.0)) {
+        return Err(input_err(format!(
+            "argument `{name}`: must be a vector dual quaternion (scalar parts zero: [0, x, y, z, 0, x, y, z]), got \
+             scalar parts {} and {}",
+            q.r.w, q.d.w
+        )));
+    }
+    Ok(q)
+}
+
+fn m87<'py>(py: Python<'py>, m: &M87) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    arr2(py, (0..8).flat_map(|i| (0..7).map(move |j| m[(i, j)])).collect(), 8, 7)
+}
+
+/// `r(b)` (8×7), eq. (4.2): `r(b) @ v(M) = M ⋆ b` for a vector dual quaternion `b`.
+#[pyfunction]
+pub fn dq_r_matrix<'py>(py: Python<'py>, b: &Bound<'_, PyAny>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    m87(py, &r_matrix(&vector_arg(b, "b")?))
+}
+
+/// `h(a, b)` (7,), §4.2: `a ∘ (M ⋆ b) = h(a, b) @ v(M)`.
+#[pyfunction]
+pub fn dq_h_vector<'py>(
+    py: Python<'py>,
+    a: &Bound<'_, PyAny>,
+    b: &Bound<'_, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let h = h_vector(&vector_arg(a, "a")?, &vector_arg(b, "b")?);
+    Ok(arr1(py, h.iter().copied().collect()))
+}
+
+/// `R̂(ω̇, ω)` (8×7), eq. (9.7).
+#[pyfunction]
+pub fn dq_body_regressor<'py>(
+    py: Python<'py>,
+    twist: &Bound<'_, PyAny>,
+    twist_dot: &Bound<'_, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    m87(py, &body_regressor(&vector_arg(twist, "twist")?, &vector_arg(twist_dot, "twist_dot")?))
+}
+
+/// `R(ω̇_B/D, ω_B/D, ω̇_D/I, ω_D/I, q_B/D)` (8×7), eq. (4.3).
+#[pyfunction]
+pub fn dq_relative_regressor<'py>(
+    py: Python<'py>,
+    w_bd_dot: &Bound<'_, PyAny>,
+    w_bd: &Bound<'_, PyAny>,
+    w_di_dot: &Bound<'_, PyAny>,
+    w_di: &Bound<'_, PyAny>,
+    q_bd: &Bound<'_, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let r = relative_regressor(
+        &vector_arg(w_bd_dot, "w_bd_dot")?,
+        &vector_arg(w_bd, "w_bd")?,
+        &vector_arg(w_di_dot, "w_di_dot")?,
+        &vector_arg(w_di, "w_di")?,
+        &pose_arg(q_bd, "q_bd")?,
+    );
+    m87(py, &r)
+}
+
+/// `v(M) = [I11, I12, I13, I22, I23, I33, m]` of a rigid body (mass, 3×3 inertia about the CoM).
+#[pyfunction]
+pub fn dq_inertia_params<'py>(
+    py: Python<'py>,
+    mass: f64,
+    inertia: &Bound<'_, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let np = inertia.py().import("numpy")?;
+    let arr = np
+        .call_method1("asarray", (inertia, "float64"))
+        .map_err(|_| input_err("argument `inertia`: cannot be read as numbers"))?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    if shape != [3, 3] {
+        return Err(input_err(format!("argument `inertia`: expected a 3×3 matrix, got shape {shape:?}")));
+    }
+    let i = floats(&arr.call_method0("flatten")?, "inertia", 9)?;
+    let m = guard(|| DualInertia::new(mass, M3::from_row_slice(&i)))?;
+    Ok(arr1(py, params(&m).iter().copied().collect()))
 }

@@ -76,5 +76,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dq::dq_approach_slope, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_attitude, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_distance_bound, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_r_matrix, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_h_vector, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_body_regressor, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_relative_regressor, m)?)?;
+    m.add_function(wrap_pyfunction!(dq::dq_inertia_params, m)?)?;
     Ok(())
 }

@@ -69,7 +69,11 @@ def read(spec: str | Path, kind: str) -> tuple[dict, str]:
     if not p.suffix and data.exists("scenarios", str(spec)):
         text, source = data.read_text("scenarios", str(spec)), f"built-in scenario '{spec}'"
     elif p.suffix and p.is_file():
-        text, source = p.read_text(encoding="utf-8"), str(p)
+        source = str(p)
+        try:
+            text = p.read_text(encoding="utf-8")
+        except UnicodeDecodeError as e:
+            raise InputError(f"{source}: not UTF-8 text (byte {e.start}: {e.reason}); save the file as UTF-8") from None
     else:
         own = ", ".join(s.name for s in listing() if s.kind == kind) or "none"
         raise InputError(f"scenario '{spec}' not found (built-in {kind} scenarios: {own}; or give a .yaml file path)")

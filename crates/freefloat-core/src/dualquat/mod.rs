@@ -14,9 +14,11 @@ pub mod kinematics;
 pub mod orbital;
 pub mod pose;
 mod quaternion;
+pub mod regressor;
 pub mod screw;
 
 pub use dual_quaternion::{swap_matrix, DualQuat, M8, UNIT_TOL, V8};
 pub use inertia::DualInertia;
 pub use quaternion::{Quat, M4, V4};
+pub use regressor::{apply_params, body_regressor, h_vector, params, r_matrix, relative_regressor, M87, V7};
 pub use screw::{exp, log, screw_exp, screw_log, Screw};
