@@ -111,6 +111,17 @@ def _check_campaign(out: Path) -> list[str]:
     return bad
 
 
+def _check_cl(out: Path) -> list[str]:
+    res = json.loads((out / "cl_vs_numpy.json").read_text())
+    bad = []
+    for ns, a in res["agreement"].items():
+        if not (a["freefloat_max_rel_error"] < 0.01 and a["numpy_max_rel_error"] < 0.01):
+            bad.append(f"N_s = {ns}: an estimator missed 1 % ({a})")
+        if not a["engine_estimator_vs_run_max_rel_diff"] < 1e-6:
+            bad.append(f"N_s = {ns}: engine estimator and whole run disagree ({a})")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -121,6 +132,7 @@ BENCHES = {
     "derivatives": ("derivatives_bench.py", [], ("pinocchio", "crocoddyl"), _check_derivatives),
     "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
+    "cl": ("cl_vs_numpy.py", [], (), _check_cl),
 }
 
 

@@ -42,6 +42,51 @@ advance the estimate by dt (forward Euler). Returns the new estimate (7,).
 
 COMPILED_CPU_FEATURES: list
 
+class ConcurrentEstimator:
+    """The concurrent-learning estimator of Valverde 2018 ch. 9 for `nbodies` bodies, driven from the caller's own
+loop: `add_sample(R, F)` offers a data point (Algorithm 3 while the time is below t_th), `step(dt)` advances
+the estimate by one RK4 step of (9.15), or of (9.23) with the SVD gain once the time reaches t_th2.
+`m0` is the initial estimate (7 per body: [I11, I12, I13, I22, I23, I33, m]).
+    """
+    def __init__(self, nbodies: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1) -> None: ...
+    def add_sample(self, r: ArrayLike, f: ArrayLike) -> Any:
+        """Offer the data point (R, F): R as (B, 8, 7) per-body blocks or the (8B, 7B) block-diagonal matrix 𝐑 of
+(9.9), F as (B, 8) or (8B,). Returns what Algorithm 3 did: "appended", "replaced", "rejected", "full"
+(the stack is good enough: σ_min ≥ σ_th), or "ignored" (time ≥ t_th).
+        """
+    @property
+    def block_singular_values(self) -> Any:
+        """Per body, its block's 7 singular values (descending), shape (B, 7)."""
+    @property
+    def estimate(self) -> Any:
+        """The current estimate, 7 per body."""
+    @property
+    def gain(self) -> Any:
+        """The gain K per body, shape (B, 7, 7) (identity until t_th2)."""
+    @property
+    def gain_active(self) -> Any:
+        """Whether the SVD gain K is in use (time ≥ t_th2 at the last step, aggressive mode)."""
+    @property
+    def nbodies(self) -> int:
+        """Number of bodies."""
+    @property
+    def rf(self) -> Any:
+        """Rf = Σ𝐑_kᵀ𝐅_k per body, shape (B, 7)."""
+    @property
+    def rr(self) -> Any:
+        """RR = Σ𝐑_kᵀ𝐑_k as its diagonal blocks, shape (B, 7, 7)."""
+    @property
+    def singular_values(self) -> Any:
+        """The 7B singular values of ΣRᵀR, descending (the union of the per-body blocks' ones)."""
+    @property
+    def stack_size(self) -> Any:
+        """Number of stored data points N_c."""
+    def step(self, dt: float) -> Any:
+        """Advance by one RK4 step of length dt (RR, Rf and the gain held over the step)."""
+    @property
+    def time(self) -> Any:
+        """Current time (advanced by `step`; settable)."""
+
 class DualQuaternion:
     """A dual quaternion `r + ε d`; poses are unit (`q q* = 1`), twists `ω + εv`, wrenches `f + ετ`."""
     def __init__(self, coeffs: ArrayLike) -> None: ...
@@ -270,6 +315,31 @@ def center_of_mass(model: Model, q: ArrayLike) -> np.ndarray:
 
 def centroidal_momentum_matrix(model: Model, q: ArrayLike) -> np.ndarray:
     """Centroidal momentum matrix about the inertial origin (6, nv): momentum == A @ v."""
+
+def cl_estimate(r: ArrayLike, f: ArrayLike, dt: float, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1) -> Any:
+    """The ch. 9 estimator alone over recorded data points: R (n, B, 8, 7), F (n, B, 8) taken every `dt` from
+t = 0; the same sequence as `cl_run` (offer, record, step) without the robot. Returns the estimates (n, 7B).
+    """
+
+def cl_run(model: Model, q0: ArrayLike, v0: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1, dt: float = 0.01, t_final: float = 10.0, amplitude: ArrayLike = 0.5, frequency: ArrayLike = 1.0, phase: ArrayLike = 0.0, t_start: ArrayLike = 2.0, t_end: ArrayLike = 3.0, wrench_noise: ArrayLike = 0.0, rate_noise: ArrayLike = 0.0, noise_seed: ArrayLike = 7, progress: Callable[[float], Any] | None = None) -> Any:
+    """Run Valverde 2018 ch. 9 on `model` (free base, no gravity) from (q0, v0): the robot under the joint
+actuation `amplitude·sin(frequency·t + phase)` on every joint DOF for t_start ≤ t ≤ t_end, integrated with
+RK4 at `dt` to `t_final`, and the concurrent-learning estimator (Algorithms 3-4, law (9.15), SVD gain
+(9.22-9.27)) fed one data point per step. `m0`: initial estimate, 7 per body ([I11, I12, I13, I22, I23, I33,
+m], model order). `wrench_noise`, `rate_noise`: standard deviations of the joint force/torque sensors and of
+the measured body twists and twist rates. `progress(t)` is called with the simulated time; returning False
+(or Ctrl-C) stops the run, which then returns what it has with `interrupted = True`. Returns a dict of numpy
+arrays: t, estimates (n, 7B), singular_values (n, 7B, descending), block_singular_values (n, B, 7), offers
+(n,), truth, final_estimate, realisable (B,), max_residual, stack_changes, stack_trials, interrupted.
+    """
+
+def cl_sample(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, wrench_noise: ArrayLike = 0.0, rate_noise: ArrayLike = 0.0, noise_seed: ArrayLike = 7) -> Any:
+    """One data point of ch. 9 from a multibody state: the dual-quaternion dynamics at (q, v, tau) give every
+body's CoM twist and twist rate and every joint's transmitted wrench; returns (R, F, twists, rates) with
+R (B, 8, 7) the per-body regressors R̂ (9.7), F (B, 8) the wrenches on the bodies about their CoMs (from the
+joint wrenches, not from the mass properties), twists and rates (B, 8) as dual quaternions (ω + ε v).
+`wrench_noise`, `rate_noise` as in `cl_run`, drawn with `noise_seed`.
+    """
 
 def crba(model: Model, q: ArrayLike) -> np.ndarray:
     """Joint-space inertia matrix (nv, nv), full symmetric."""

@@ -4,6 +4,7 @@
 mod adaptive;
 mod algorithms;
 mod batch;
+mod concurrent;
 mod cpu;
 mod ddp;
 mod derivatives;
@@ -76,6 +77,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ddp::ddp_screw_reference, m)?)?;
     m.add_function(wrap_pyfunction!(ddp::ddp_frame_dual_quats, m)?)?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
+    m.add_function(wrap_pyfunction!(concurrent::cl_run, m)?)?;
+    m.add_function(wrap_pyfunction!(concurrent::cl_sample, m)?)?;
+    m.add_function(wrap_pyfunction!(concurrent::cl_estimate, m)?)?;
+    m.add_class::<concurrent::PyConcurrentEstimator>()?;
     m.add_class::<dq::PyDualQuaternion>()?;
     m.add_function(wrap_pyfunction!(dq::dq_from_pose, m)?)?;
     m.add_function(wrap_pyfunction!(dq::dq_exp, m)?)?;

@@ -13,7 +13,7 @@ import sys
 import click
 
 from .. import _core
-from . import adaptive, campaign, control, convert, ddp, demo, excite, export, identify, models, params, postcapture, reactions, report, simulate
+from . import adaptive, campaign, concurrent, control, convert, ddp, demo, excite, export, identify, models, params, postcapture, reactions, report, simulate
 
 
 class FriendlyGroup(click.Group):
@@ -43,6 +43,7 @@ main.add_command(demo.demo_cmd)
 main.add_command(params.params_group)
 main.add_command(identify.identify_group)
 identify.identify_group.add_command(postcapture.identify_postcapture_cmd)
+identify.identify_group.add_command(concurrent.identify_cl_cmd)
 main.add_command(excite.excite_cmd)
 main.add_command(postcapture.scenarios_cmd)
 main.add_command(control.control_group)

@@ -8,6 +8,8 @@ tree-type free-floating robot), in pipeline order:
 - `identify`: `identify_minimal` from telemetry (weighted, errors-in-variables bias compensation);
 - `consistent`: physically consistent standard parameters reproducing the minimal ones (a convex program);
 - `validation`: prediction of base twist and joint torques by true and identified robots (Table 6);
+- `concurrent` (+ `concurrent_plots`, `concurrent_studies`): concurrent-learning estimation of every body's mass
+  properties from the Newton–Euler equations with measured joint wrenches (Valverde 2018, ch. 9);
 - `online`: recursive estimators (RLS with forgetting, the modified RLS of Zhang, Yue, Yuan 2020).
 
 A new estimator goes here: a function that takes a model and a `Telemetry` (or regressor rows) and returns a result
@@ -16,6 +18,7 @@ object with `to_dict()` / `save(out)`, its arithmetic in the engine (`crates/fre
 
 from . import (
     comparison,
+    concurrent,
     consistent,
     estimation,
     excitation,
@@ -26,13 +29,16 @@ from . import (
     pruning,
     validation,
 )
+from .concurrent import ConcurrentLearningEstimator
 from .identify import IdentificationResult, identify_minimal
 from .minimal import MinimalParameters, minimal_parameters
 
 __all__ = [
+    "ConcurrentLearningEstimator",
     "IdentificationResult",
     "MinimalParameters",
     "comparison",
+    "concurrent",
     "consistent",
     "estimation",
     "excitation",

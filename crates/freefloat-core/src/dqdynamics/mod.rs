@@ -2,6 +2,7 @@
 //! from one linear system solved through the Schur complement of the body block. Cross-checked against the
 //! engine's ABA (accelerations) and RNEA (transmitted wrenches) in tests/dqdynamics.rs.
 
+mod body_samples;
 mod condition;
 pub mod decoupled;
 pub mod joints;
@@ -10,6 +11,7 @@ mod system;
 mod tree_solve;
 mod workspace;
 
+pub use body_samples::{com_motion, com_wrenches};
 pub use condition::condition_number;
 pub use sixvec::{ad_in, ad_out, reduce};
 pub(crate) use system::solve_system_unchecked;

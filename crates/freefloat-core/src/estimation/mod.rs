@@ -20,6 +20,8 @@
 //! column-equilibrated `R`, so that parameter units do not decide what counts as excited).
 
 mod analysis;
+/// Concurrent-learning estimation of every body's mass properties (Valverde 2018, ch. 9).
+pub mod concurrent;
 mod gram;
 mod modified_rls;
 mod momentum;

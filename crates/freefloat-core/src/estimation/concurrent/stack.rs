@@ -1,0 +1,377 @@
+//! The concurrent-learning data stack 𝒳, ℱ of Valverde 2018 §9.3: Algorithm 3 (populate it: fill, then
+//! replace a stored point only while the smallest singular value is below σ_th and only if no sorted singular
+//! value decreases) and Algorithm 4's accumulation `RR = Σ 𝐑_kᵀ𝐑_k`, `Rf = Σ 𝐑_kᵀ𝐅_k` (with the reset to zero
+//! that the printed algorithm omits).
+//!
+//! Block-diagonal structure: 𝐑 = blkdiag(R̂_1, …, R̂_B) (9.9), so ΣRᵀR is block diagonal with B blocks of 7×7
+//! and its 7B singular values are the union of the blocks' ones. Every singular-value test below works on the
+//! B small symmetric blocks (their eigenvalues: they are Gram matrices), never on the 7B×7B matrix. Each stored
+//! point keeps its per-block Gram `R̂ᵀR̂` and `R̂ᵀF`, so a trial replacement costs B rank-updates and B 7×7
+//! eigen-decompositions. Nothing here allocates after `DataStack::new`.
+
+use super::{M7, M87, NP, V7, V8};
+use crate::error::{FfError, Result};
+use nalgebra::{SMatrix, SVD};
+
+type M8 = SMatrix<f64, 8, 8>;
+type M16x8 = SMatrix<f64, 16, 8>;
+
+/// The triangular factor of `[a; b]` (two 8×8 blocks stacked): a Householder QR of the 16×8 matrix, whose R
+/// has `RᵀR = aᵀa + bᵀb`.
+fn merge(a: &M8, b: &M8) -> M8 {
+    let mut x = M16x8::zeros();
+    x.fixed_view_mut::<8, 8>(0, 0).copy_from(a);
+    x.fixed_view_mut::<8, 8>(8, 0).copy_from(b);
+    x.qr().r()
+}
+
+/// `R̂ᵀR̂` and `R̂ᵀF` of one block, written out (the generic small-matrix product is several times slower here,
+/// and this runs for every candidate).
+#[inline]
+fn gram(r: &M87, f: &V8) -> (M7, V7) {
+    let mut g = M7::zeros();
+    let mut gf = V7::zeros();
+    for j in 0..NP {
+        let cj = r.column(j);
+        for k in j..NP {
+            let ck = r.column(k);
+            let mut s = 0.0;
+            for i in 0..8 {
+                s += cj[i] * ck[i];
+            }
+            g[(j, k)] = s;
+            g[(k, j)] = s;
+        }
+        let mut s = 0.0;
+        for i in 0..8 {
+            s += cj[i] * f[i];
+        }
+        gf[j] = s;
+    }
+    (g, gf)
+}
+
+/// A small deterministic generator (SplitMix64) for the random visiting order π of Algorithm 3 and for
+/// the measurement noise of the studies: reproducible from a seed, no dependency.
+#[derive(Clone, Debug)]
+pub struct SplitMix(u64);
+
+impl SplitMix {
+    /// Generator from a seed.
+    pub fn new(seed: u64) -> Self {
+        SplitMix(seed)
+    }
+    /// Next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn uniform(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+    /// Uniform integer in 0..n (n > 0).
+    pub fn below(&mut self, n: usize) -> usize {
+        ((self.uniform() * n as f64) as usize).min(n - 1)
+    }
+    /// Standard normal (Box–Muller).
+    pub fn normal(&mut self) -> f64 {
+        let u1 = 1.0 - self.uniform(); // (0, 1]
+        let u2 = self.uniform();
+        (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+    }
+}
+
+/// Singular values of a symmetric positive semi-definite 7×7 block, in descending order (its eigenvalues,
+/// clamped at zero against round-off).
+pub fn block_singular_values(a: &M7, out: &mut [f64]) {
+    // eigenvalues only (no eigenvectors): about half the work of a full decomposition
+    let e = a.symmetric_eigenvalues();
+    for (o, x) in out.iter_mut().zip(e.iter()) {
+        *o = x.max(0.0);
+    }
+    out[..NP].sort_unstable_by(|a, b| b.total_cmp(a));
+}
+
+/// What Algorithm 3 did with a candidate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Offer {
+    /// Stored in an empty slot (filling phase, N_c < N_s).
+    Appended,
+    /// Replaced the stored point with this index (element-wise singular-value test passed).
+    Replaced(usize),
+    /// The stack was poor (σ_min < σ_th) but no replacement passed the test.
+    Rejected,
+    /// The stack was good enough (σ_min ≥ σ_th); the candidate was not tried.
+    Full,
+}
+
+/// The data stack 𝒳, ℱ with its cached sums and singular values.
+#[derive(Clone, Debug)]
+pub struct DataStack {
+    nb: usize,
+    ns: usize,
+    sigma_th: f64,
+    nc: usize,
+    /// stored 𝐑_k, 𝐅_k (slot-major: slot s, body i at s·nb + i)
+    r: Vec<M87>,
+    f: Vec<V8>,
+    g: Vec<M7>,
+    gf: Vec<V7>,
+    /// RR, Rf per body (Algorithm 4)
+    rr: Vec<M7>,
+    rf: Vec<V7>,
+    /// per body: the triangular factor T (TᵀT = RR) and g (Tᵀg = Rf) of the stacked data
+    /// `[R̂_1|F_1; …; R̂_N|F_N]`, kept in a binary tree of 8×8 QR factors over the slots (leaf = a point's
+    /// `[R̂|F]`, node = the factor of its two children stacked, root = the stack's factor): replacing a point
+    /// re-factors log₂(N_s) nodes, with no downdating (which would lose the weak modes this form keeps)
+    tri: Vec<M7>,
+    leaves: usize,
+    qtree: Vec<M8>,
+    gvec: Vec<V7>,
+    /// sorted (descending) union of the blocks' singular values of RR, from T (σ = s(T)², accurate down to
+    /// ε·σ_max instead of the Gram eigenvalues' √ε·… floor)
+    sv: Vec<f64>,
+    /// the same from the Gram blocks' eigenvalues: what Algorithm 3's element-wise test compares, for the
+    /// stack and for a trial alike
+    sv_test: Vec<f64>,
+    trial_sv: Vec<f64>,
+    /// per-block singular values of RR (body-major, each descending)
+    block_sv: Vec<f64>,
+    cand_g: Vec<M7>,
+    cand_gf: Vec<V7>,
+    perm: Vec<usize>,
+    rng: SplitMix,
+    /// number of changes of the stored set, trial decompositions done (cost counters)
+    changes: u64,
+    trials: u64,
+}
+
+impl DataStack {
+    /// An empty stack for `nb` bodies holding up to `ns` points; σ_th is Algorithm 3's threshold and
+    /// `seed` fixes the random visiting order π.
+    pub fn new(nb: usize, ns: usize, sigma_th: f64, seed: u64) -> Result<Self> {
+        if nb == 0 {
+            return Err(FfError::arg("nbodies", "the estimator needs at least one body"));
+        }
+        if ns < 2 {
+            return Err(FfError::arg(
+                "ns",
+                format!("the stack must hold at least 2 points (one sample has rank ≤ 6 of 7), got {ns}"),
+            ));
+        }
+        if !(sigma_th >= 0.0) || !sigma_th.is_finite() {
+            return Err(FfError::arg("sigma_th", format!("must be finite and ≥ 0, got {sigma_th}")));
+        }
+        let z7 = M7::zeros();
+        Ok(DataStack {
+            nb,
+            ns,
+            sigma_th,
+            nc: 0,
+            r: vec![M87::zeros(); ns * nb],
+            f: vec![V8::zeros(); ns * nb],
+            g: vec![z7; ns * nb],
+            gf: vec![V7::zeros(); ns * nb],
+            rr: vec![z7; nb],
+            rf: vec![V7::zeros(); nb],
+            tri: vec![z7; nb],
+            leaves: ns.next_power_of_two(),
+            qtree: vec![M8::zeros(); 2 * ns.next_power_of_two() * nb],
+            gvec: vec![V7::zeros(); nb],
+            sv: vec![0.0; NP * nb],
+            sv_test: vec![0.0; NP * nb],
+            trial_sv: vec![0.0; NP * nb],
+            block_sv: vec![0.0; NP * nb],
+            cand_g: vec![z7; nb],
+            cand_gf: vec![V7::zeros(); nb],
+            perm: (0..ns).collect(),
+            rng: SplitMix::new(seed),
+            changes: 0,
+            trials: 0,
+        })
+    }
+
+    /// Number of stored points N_c.
+    pub fn len(&self) -> usize {
+        self.nc
+    }
+    /// True when nothing is stored.
+    pub fn is_empty(&self) -> bool {
+        self.nc == 0
+    }
+    /// Capacity N_s.
+    pub fn capacity(&self) -> usize {
+        self.ns
+    }
+    /// Number of bodies B.
+    pub fn nbodies(&self) -> usize {
+        self.nb
+    }
+    /// RR's 7×7 blocks (one per body).
+    pub fn rr(&self) -> &[M7] {
+        &self.rr
+    }
+    /// Rf's 7-vectors (one per body).
+    pub fn rf(&self) -> &[V7] {
+        &self.rf
+    }
+    /// The triangular factors T of the stacked data (TᵀT = RR), one per body.
+    pub fn tri(&self) -> &[M7] {
+        &self.tri
+    }
+    /// The vectors g with Tᵀg = Rf, one per body.
+    pub fn g(&self) -> &[V7] {
+        &self.gvec
+    }
+    /// The 7B singular values of RR, descending (the union of the blocks' ones).
+    pub fn singular_values(&self) -> &[f64] {
+        &self.sv
+    }
+    /// The singular values of each body's block (body-major, each block descending).
+    pub fn block_singular_values(&self) -> &[f64] {
+        &self.block_sv
+    }
+    /// The smallest singular value of RR (0 while empty).
+    pub fn sigma_min(&self) -> f64 {
+        self.sv.last().copied().unwrap_or(0.0)
+    }
+    /// How often the stored set changed, and how many trial decompositions Algorithm 3 made.
+    pub fn counters(&self) -> (u64, u64) {
+        (self.changes, self.trials)
+    }
+    /// The stored point `k` (< N_c): its per-body regressors and wrenches.
+    pub fn point(&self, k: usize) -> Option<(&[M87], &[V8])> {
+        (k < self.nc).then(|| (&self.r[k * self.nb..(k + 1) * self.nb], &self.f[k * self.nb..(k + 1) * self.nb]))
+    }
+
+    /// Algorithm 3 for the candidate (X, F) = (per-body R̂_i, F_i). Returns what was done; when the stored
+    /// set changed, RR, Rf and the singular values are recomputed from the stored points (Algorithm 4 with
+    /// its missing reset).
+    pub fn offer(&mut self, x: &[M87], fw: &[V8]) -> Result<Offer> {
+        let nb = self.nb;
+        if x.len() != nb || fw.len() != nb {
+            return Err(FfError::arg("candidate", format!("needs one 8×7 regressor and one wrench per body ({nb})")));
+        }
+        if x.iter().any(|r| r.iter().any(|v| !v.is_finite())) || fw.iter().any(|f| f.iter().any(|v| !v.is_finite())) {
+            return Err(FfError::arg("candidate", "regressor or wrench has a non-finite entry"));
+        }
+        for i in 0..nb {
+            (self.cand_g[i], self.cand_gf[i]) = gram(&x[i], &fw[i]);
+        }
+        if self.nc < self.ns {
+            // filling phase: accept unconditionally
+            let s = self.nc;
+            self.store(s, x, fw);
+            self.nc += 1;
+            self.rebuild();
+            return Ok(Offer::Appended);
+        }
+        if !(self.sigma_min() < self.sigma_th) {
+            return Ok(Offer::Full);
+        }
+        // random order π (Fisher–Yates)
+        for k in (1..self.ns).rev() {
+            let j = self.rng.below(k + 1);
+            self.perm.swap(k, j);
+        }
+        // a singular value of the current stack counts as "not decreased" within round-off of the largest
+        let tol = 64.0 * f64::EPSILON * self.sv_test.first().copied().unwrap_or(0.0).max(1e-300);
+        // Element-wise ≥ of the sorted values implies ≥ of their sums, i.e. trace(G_cand) ≥ trace(G_p): a
+        // free necessary condition that skips most trials' decompositions without changing the outcome.
+        let cand_trace: f64 = self.cand_g.iter().map(|g| g.trace()).sum();
+        let all_tol = tol * (NP * nb) as f64;
+        for pi in 0..self.ns {
+            let p = self.perm[pi];
+            let p_trace: f64 = (0..nb).map(|i| self.g[p * nb + i].trace()).sum();
+            if cand_trace < p_trace - all_tol {
+                continue;
+            }
+            if cand_trace == 0.0 && p_trace == 0.0 {
+                // both carry no information (e.g. a robot at rest: R̂ = 0 exactly): the replacement passes the
+                // test and changes neither RR nor T; store the point without recomputing what cannot change
+                // (with R̂ = 0 on both sides Rf and g are unchanged too: the F column only enters ρ)
+                self.store_raw(p, x, fw);
+                return Ok(Offer::Replaced(p));
+            }
+            self.trials += 1;
+            for i in 0..nb {
+                let a = self.rr[i] - self.g[p * nb + i] + self.cand_g[i];
+                block_singular_values(&a, &mut self.trial_sv[NP * i..NP * (i + 1)]);
+            }
+            self.trial_sv.sort_unstable_by(|a, b| b.total_cmp(a));
+            // Remark 17: element-wise over the sorted singular values, every one must hold
+            if self.trial_sv.iter().zip(&self.sv_test).all(|(new, old)| *new >= *old - tol) {
+                self.store(p, x, fw);
+                self.rebuild();
+                return Ok(Offer::Replaced(p));
+            }
+        }
+        Ok(Offer::Rejected)
+    }
+
+    fn store_raw(&mut self, s: usize, x: &[M87], fw: &[V8]) {
+        let nb = self.nb;
+        for i in 0..nb {
+            self.r[s * nb + i] = x[i];
+            self.f[s * nb + i] = fw[i];
+            self.g[s * nb + i] = self.cand_g[i];
+            self.gf[s * nb + i] = self.cand_gf[i];
+        }
+        self.changes += 1;
+    }
+
+    fn store(&mut self, s: usize, x: &[M87], fw: &[V8]) {
+        let nb = self.nb;
+        let p2 = self.leaves;
+        for i in 0..nb {
+            self.r[s * nb + i] = x[i];
+            self.f[s * nb + i] = fw[i];
+            self.g[s * nb + i] = self.cand_g[i];
+            self.gf[s * nb + i] = self.cand_gf[i];
+            // the slot's leaf, then every node above it
+            let base = i * 2 * p2;
+            let mut k = p2 + s;
+            let leaf = &mut self.qtree[base + k];
+            leaf.fixed_view_mut::<8, 7>(0, 0).copy_from(&x[i]);
+            leaf.fixed_view_mut::<8, 1>(0, 7).copy_from(&fw[i]);
+            while k > 1 {
+                k /= 2;
+                self.qtree[base + k] = merge(&self.qtree[base + 2 * k], &self.qtree[base + 2 * k + 1]);
+            }
+        }
+        self.changes += 1;
+    }
+
+    /// Algorithm 4's sums, reset first (the printed algorithm accumulates onto the previous call's RR, Rf),
+    /// the triangular factors, and the singular values, block by block.
+    fn rebuild(&mut self) {
+        let nb = self.nb;
+        for i in 0..nb {
+            let (mut a, mut b) = (M7::zeros(), V7::zeros());
+            for s in 0..self.nc {
+                a += self.g[s * nb + i];
+                b += self.gf[s * nb + i];
+            }
+            let tri = &self.qtree[i * 2 * self.leaves + 1];
+            self.rr[i] = a;
+            self.rf[i] = b;
+            self.tri[i] = tri.fixed_view::<7, 7>(0, 0).into_owned();
+            self.gvec[i] = tri.fixed_view::<7, 1>(0, 7).into_owned();
+            block_singular_values(&a, &mut self.trial_sv[NP * i..NP * (i + 1)]);
+            let sv = SVD::new(self.tri[i], false, false).singular_values;
+            let out = &mut self.block_sv[NP * i..NP * (i + 1)];
+            for (o, x) in out.iter_mut().zip(sv.iter()) {
+                *o = x * x;
+            }
+            out.sort_unstable_by(|a, b| b.total_cmp(a));
+        }
+        self.sv_test.copy_from_slice(&self.trial_sv);
+        self.sv_test.sort_unstable_by(|a, b| b.total_cmp(a));
+        self.sv.copy_from_slice(&self.block_sv);
+        self.sv.sort_unstable_by(|a, b| b.total_cmp(a));
+    }
+}

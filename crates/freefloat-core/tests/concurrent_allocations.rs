@@ -1,0 +1,82 @@
+//! The chapter-9 concurrent-learning run allocates nothing per step (Valverde 2018 §9.5): a counting global
+//! allocator counts the allocations of whole runs of different lengths; everything is sized up front, so a
+//! 9 s run (filling, replacements, the SVD gain at 4.9 s, the frozen stack after 5 s) must make exactly as many
+//! allocations as a 1 s run.
+
+use freefloat_core::estimation::concurrent::{run_cl, ClParams, ClScenario, Excitation, Noise};
+use freefloat_core::model::builtin;
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+struct Counting;
+
+thread_local! {
+    // const-initialised: reading it never allocates (no lazy registration)
+    static COUNT: Cell<usize> = const { Cell::new(0) };
+}
+
+fn bump() {
+    let _ = COUNT.try_with(|c| c.set(c.get() + 1));
+}
+
+// SAFETY: every call is forwarded to the system allocator unchanged; only a thread-local counter is added.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        bump();
+        System.alloc(l)
+    }
+    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
+        bump();
+        System.alloc_zeroed(l)
+    }
+    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
+        bump();
+        System.realloc(p, l, n)
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        System.dealloc(p, l)
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+fn allocations() -> usize {
+    COUNT.with(|c| c.get())
+}
+
+/// Allocations made by `f` on this thread.
+fn count(f: impl FnOnce()) -> usize {
+    let before = allocations();
+    f();
+    allocations() - before
+}
+
+fn scenario(m: &freefloat_core::Model, t_final: f64, noise: Noise) -> ClScenario {
+    ClScenario {
+        q0: m.neutral(),
+        v0: vec![0.0; m.nv],
+        excitation: Excitation::default(),
+        params: ClParams { ns: 10, ..ClParams::default() },
+        m0: vec![0.1; 7 * m.nbodies()],
+        dt: 0.01,
+        t_final,
+        noise,
+        noise_seed: 3,
+    }
+}
+
+#[test]
+fn a_cl_run_allocates_nothing_per_step() {
+    let m = builtin::load("valverde_ch9_two_arm").expect("built-in");
+    for noise in [Noise::default(), Noise { wrench: 1e-3, rate: 1e-5 }] {
+        let _ = run_cl(&m, &scenario(&m, 1.0, noise), None).expect("runs");
+        let short = count(|| {
+            run_cl(&m, &scenario(&m, 1.0, noise), None).expect("runs");
+        });
+        let long = count(|| {
+            run_cl(&m, &scenario(&m, 9.0, noise), None).expect("runs");
+        });
+        assert_eq!(short, long, "a 9 s run allocates {long} times, a 1 s run {short} (noise {noise:?})");
+    }
+}
