@@ -224,7 +224,8 @@ def test_noise_degrades_gracefully():
 def test_cli_identify_postcapture(tmp_path):
     r = CliRunner().invoke(main, ["identify", "postcapture", "zhang2020_2d_small", "--out", str(tmp_path)])
     assert r.exit_code == 0, r.output
-    assert "momentum-based" in r.output and "paper force" in r.output
+    # both forms, with the paper's columns and ours labelled apart (PAPER / OURS)
+    assert "momentum-based" in r.output and "force-based" in r.output and "PAPER:" in r.output and "OURS" in r.output
     data = json.loads((tmp_path / "results.json").read_text())
     entry = data["methods"]["momentum"]["modified_rls"]["In"]
     assert entry["truth"] == pytest.approx(5.2)

@@ -286,6 +286,13 @@ class RecursiveLS:
 def aba(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
     """Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`."""
 
+def aba_derivatives(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> Any:
+    """Derivatives of forward dynamics a = FD(q, v, tau, fext): (da_dq, da_dv, da_dtau), each (nv, nv).
+Derivatives with respect to q are taken along the local tangent of q (nv columns): for a free base,
+a base-frame displacement and a base-frame rotation vector, the axes of the base twist in v
+(Pinocchio's convention, so they compare with pin.computeABADerivatives). da_dtau = M⁻¹.
+    """
+
 def adaptive_simulate(truth: ArrayLike, q0: ArrayLike, w0: ArrayLike, estimate0: ArrayLike, k_r: ArrayLike, k_q: ArrayLike, k_v: ArrayLike, k_w: ArrayLike, k_i: ArrayLike, alpha: float, t_final: float, learning: ArrayLike = 'continuous', n_s: ArrayLike = 50, sigma_stop: ArrayLike = Ellipsis, selection: ArrayLike = 'elementwise', seed: ArrayLike = 0, law_form: ArrayLike = 'corrected', reference_angular: ArrayLike | None = None, reference_linear: ArrayLike | None = None, reference_times: ArrayLike | None = None, reference_twists: ArrayLike | None = None, method: str = 'dopri5', dt: float = 0.01, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = Ellipsis, output_dt: ArrayLike = 0.01, max_steps: int = 50000000, rank_tol: ArrayLike = 1e-08, progress: Callable[[float], Any] | None = None) -> Any:
     """Simulate the closed loop of Valverde 2018 ch. 4 (relative pose-error dynamics (2.58) of a spacecraft with
 mass properties `truth`, adaptive law (4.9) corrected, update law (4.13) or (4.29)) in the engine, and
@@ -375,6 +382,12 @@ stop_message, history (list of dicts), gap, timings (seconds and calls of the de
 and rollout blocks).
     """
 
+def difference(model: Model, q0: ArrayLike, q1: ArrayLike) -> Any:
+    """q1 ⊖ q0 (nv): the tangent displacement dq with integrate(q0, dq) == q1."""
+
+def difference_jacobians(model: Model, q0: ArrayLike, q1: ArrayLike) -> Any:
+    """Jacobians of difference(q0, q1), local tangents: (d/dq0, d/dq1), each (nv, nv)."""
+
 def dq_approach_slope(q_ga: ArrayLike, z_a: ArrayLike, half_angle: float) -> Any:
     ...
 
@@ -457,8 +470,20 @@ q_end (the configuration at the end, base pose integrated).
 def forward_kinematics(model: Model, q: ArrayLike) -> np.ndarray:
     """Placement of every body in the inertial frame: (nbodies, 7) = position, quaternion x y z w."""
 
+def frame_dq_pose_derivatives(model: Model, q: ArrayLike, name: str) -> Any:
+    """Dual quaternion of frame `name`'s pose (8: real w x y z, dual w x y z; translation first,
+q_r + ε ½ r q_r) and its Jacobian (8, nv) along the local tangent of q. The rotation part has a
+non-negative scalar; for the other sign negate both.
+    """
+
 def frame_jacobian(model: Model, q: ArrayLike, name: str, reference: str = 'local') -> np.ndarray:
     """Jacobian (6, nv) of a body or frame: its twist [linear; angular] is J @ v."""
+
+def frame_log_error_derivatives(model: Model, q: ArrayLike, name: str, target: ArrayLike) -> Any:
+    """Pose error of frame `name` against `target` (7: position, quaternion x y z w; inertial frame):
+(e (6,), de_dq (6, nv)) with e = log(T_target⁻¹ T(q)) = [linear; angular] (SE(3) logarithm, the
+residual of Crocoddyl's ResidualModelFramePlacement) and de_dq = Jlog(e) J_local(q).
+    """
 
 def frame_placement(model: Model, q: ArrayLike, name: str) -> np.ndarray:
     """Placement of a body or frame in the inertial frame: (7,) = position, quaternion x y z w."""
@@ -505,12 +530,20 @@ def inertia_standard_form(mass: ArrayLike, com: ArrayLike, inertia: ArrayLike) -
 inertias about the centre of mass (…, 3, 3) (`postcapture::equations::standard_form`).
     """
 
+def integrate(model: Model, q: ArrayLike, dq: ArrayLike) -> Any:
+    """q ⊕ dq (nq): the configuration reached from q by the tangent displacement dq (nv; for a free base
+a base-frame displacement and rotation vector), on R³ × SO(3).
+    """
+
 def integrate_base_poses(t: ArrayLike, twists: ArrayLike, pose0: ArrayLike) -> Any:
     """Base poses from sampled base twists by the trapezoidal rule on the group (`sim::integrate_base_poses`).
 Free base: `twists` (T, 6) = [v; ω] in the base frame, `pose0` (7) = position, quaternion x y z w;
 returns (T, 7). Planar base: `twists` (T, 3) = [vx, vy, yaw rate], `pose0` (3) = [x, y, yaw]; returns
 (T, 3). `t` (T,) the increasing sample times.
     """
+
+def integrate_jacobians(model: Model, q: ArrayLike, dq: ArrayLike) -> Any:
+    """Jacobians of integrate(q, dq), local tangents: (d/dq, d/d(dq)), each (nv, nv)."""
 
 def kinetic_energy(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
     ...
@@ -558,8 +591,25 @@ def quat_to_matrix(quat: ArrayLike) -> Any:
 def rnea(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
     """Inverse dynamics: generalized forces for accelerations `a`."""
 
+def rnea_derivatives(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fext: ArrayLike | None = None) -> Any:
+    """Derivatives of inverse dynamics tau = RNEA(q, v, a, fext): (dtau_dq, dtau_dv, dtau_da = M), each
+(nv, nv); q along its local tangent (see aba_derivatives).
+    """
+
 def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba') -> Any:
     ...
 
 def skew(v: ArrayLike) -> Any:
     """Cross-product matrices (…, 3, 3): `skew(a) @ b == a × b`."""
+
+def step(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, dt: float, method: str = 'euler') -> Any:
+    """One step of the forward dynamics with tau held over it: (q_next (nq), v_next (nv)).
+method "euler": semi-implicit Euler v+ = v + a dt, q+ = q ⊕ v+ dt (Crocoddyl's
+IntegratedActionModelEuler); "rk4": Runge-Kutta 4 on the Lie group (the simulator's step).
+    """
+
+def step_derivatives(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, dt: float, method: str = 'euler') -> Any:
+    """Derivatives of one step (see step) in the tangent error state: (Fx (2nv, 2nv), Fu (2nv, nv)),
+rows and columns [tangent of q; v], u = tau (all nv generalized forces). For an under-actuated
+robot with tau = B u use Fu @ B; a free-floating robot with an unactuated base keeps Fu[:, 6:].
+    """

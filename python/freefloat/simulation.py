@@ -273,6 +273,9 @@ def simulate(
             cb,
             formulation,
         )
+        if bar is not None:  # a finished run fills its bar (however fast it was: tqdm redraws at most every 0.1 s)
+            bar.update(bar.total - bar.n)
+            bar.refresh()
     finally:
         if bar is not None:
             bar.close()

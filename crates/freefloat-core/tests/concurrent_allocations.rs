@@ -5,52 +5,9 @@
 
 use freefloat_core::estimation::concurrent::{run_cl, ClParams, ClScenario, Excitation, Noise};
 use freefloat_core::model::builtin;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::cell::Cell;
 
-struct Counting;
-
-thread_local! {
-    // const-initialised: reading it never allocates (no lazy registration)
-    static COUNT: Cell<usize> = const { Cell::new(0) };
-}
-
-fn bump() {
-    let _ = COUNT.try_with(|c| c.set(c.get() + 1));
-}
-
-// SAFETY: every call is forwarded to the system allocator unchanged; only a thread-local counter is added.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        bump();
-        System.alloc(l)
-    }
-    unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
-        bump();
-        System.alloc_zeroed(l)
-    }
-    unsafe fn realloc(&self, p: *mut u8, l: Layout, n: usize) -> *mut u8 {
-        bump();
-        System.realloc(p, l, n)
-    }
-    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        System.dealloc(p, l)
-    }
-}
-
-#[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-fn allocations() -> usize {
-    COUNT.with(|c| c.get())
-}
-
-/// Allocations made by `f` on this thread.
-fn count(f: impl FnOnce()) -> usize {
-    let before = allocations();
-    f();
-    allocations() - before
-}
+mod counting_alloc;
+use counting_alloc::count;
 
 fn scenario(m: &freefloat_core::Model, t_final: f64, noise: Noise) -> ClScenario {
     ClScenario {

@@ -13,7 +13,24 @@ import sys
 import click
 
 from .. import _core
-from . import adaptive, campaign, concurrent, control, convert, ddp, demo, excite, export, identify, models, params, postcapture, reactions, report, simulate
+from . import (
+    adaptive,
+    campaign,
+    concurrent,
+    control,
+    convert,
+    ddp,
+    demo,
+    excite,
+    export,
+    identify,
+    models,
+    params,
+    postcapture,
+    reactions,
+    report,
+    simulate,
+)
 
 
 class FriendlyGroup(click.Group):

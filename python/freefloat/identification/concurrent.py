@@ -43,17 +43,12 @@ PARAM_NAMES = ("I11", "I12", "I13", "I22", "I23", "I33", "m")
 
 
 def realisable(v) -> bool:
-    """Whether a 7-parameter estimate is a rigid body: m > 0, inertia positive definite, triangle inequalities.
-
-    TEMPORARY local check, to be replaced by the engine's shared realisability test (being written with the
-    ch. 4 controller); this function is the one hook every caller here goes through."""
+    """Whether a 7-parameter estimate is a rigid body: m > 0, inertia positive definite, triangle inequalities
+    (the engine's one test; `freefloat.control.realisability(v)` says which condition fails)."""
     v = np.asarray(v, dtype=float)
-    if v.shape != (7,) or not np.all(np.isfinite(v)) or not v[6] > 0:
+    if v.shape != (7,) or not np.all(np.isfinite(v)):
         return False
-    inertia = np.array([[v[0], v[1], v[2]], [v[1], v[3], v[4]], [v[2], v[4], v[5]]])
-    e = np.linalg.eigvalsh(inertia)
-    tol = 1e-9 * np.max(np.abs(e))
-    return bool(np.all(e > 0) and e[0] + e[1] >= e[2] - tol)
+    return bool(_core.inertia_realisability(v)["realisable"])
 
 
 class ConcurrentLearningEstimator:

@@ -5,6 +5,7 @@
 //! the frame origin). Both are expressed in some frame's axes; `Se3` moves them between frames.
 
 mod inertia;
+pub mod lie;
 mod se3;
 mod so3;
 mod vectors;

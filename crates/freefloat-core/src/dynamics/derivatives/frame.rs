@@ -2,7 +2,6 @@
 //! the SE(3) logarithm error `e = log(T_ref⁻¹ T(q))` with `∂e/∂q = Jlog(e) J_frame(q)`, and the
 //! unit dual quaternion of the pose (Valverde 2018, (3.2)) with its 8 × nv Jacobian.
 
-use super::lie::so3_jr_inv;
 use super::rnea_derivatives::col;
 use crate::check::{check_args, check_body, check_shape, with_unit_q, Args};
 use crate::data::Data;
@@ -12,57 +11,20 @@ use crate::error::Result;
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::kinematics::{frame_jacobian, Reference};
 use crate::model::Model;
-use crate::spatial::{skew, so3_log, Se3, M3, M6, V3, V6};
+use crate::spatial::lie::{log6, se3_right_jacobian_inv};
+use crate::spatial::{Se3, M6, V3, V6};
 use nalgebra::DMatrix;
 
-/// Left Jacobian of SO(3) is `Jr(−θ) = Jr(θ)ᵀ`.
-#[inline]
-fn so3_jl_inv(th: &V3) -> M3 {
-    so3_jr_inv(th).transpose()
-}
-
-/// SE(3) logarithm `[ρ; φ]` (linear part first, as Pinocchio's `log6`): `T = Exp([ρ; φ])` with
-/// `R = Exp(φ)`, `p = Jl(φ) ρ` (Barfoot, State Estimation for Robotics, §7.1.9).
+/// SE(3) logarithm `[ρ; φ]` (linear part first, as Pinocchio's `log6`; the engine's `spatial::lie::log6`).
 pub fn se3_log(t: &Se3) -> [f64; 6] {
-    let phi = so3_log(&t.rot);
-    let rho = so3_jl_inv(&phi) * t.trans;
-    [rho.x, rho.y, rho.z, phi.x, phi.y, phi.z]
-}
-
-/// Barfoot's Q(ρ, φ), the off-diagonal block of the left Jacobian of SE(3) (eq. 7.86b).
-fn barfoot_q(rho: &V3, phi: &V3) -> M3 {
-    let t2 = phi.norm_squared();
-    let (a, b, c) = if t2 < 1e-4 {
-        (1.0 / 6.0 - t2 / 120.0, 1.0 / 24.0 - t2 / 720.0, 1.0 / 120.0 - t2 / 2520.0)
-    } else {
-        let t = t2.sqrt();
-        let (s, co) = t.sin_cos();
-        (
-            (t - s) / (t2 * t),
-            (t2 + 2.0 * co - 2.0) / (2.0 * t2 * t2),
-            (2.0 * t - 3.0 * s + t * co) / (2.0 * t2 * t2 * t),
-        )
-    };
-    let (r, p) = (skew(rho), skew(phi));
-    let pr = p * r;
-    let rp = r * p;
-    let prp = pr * p;
-    r * 0.5 + (pr + rp + prp) * a + (p * pr + rp * p - prp * 3.0) * b + (prp * p + p * prp) * c
+    let x = log6(t);
+    [x[0], x[1], x[2], x[3], x[4], x[5]]
 }
 
 /// Jacobian of the SE(3) logarithm, `Jr(e)⁻¹` (6 × 6, linear part first): if `T = Exp(e)` then
-/// `log(T Exp(ε)) = e + Jr(e)⁻¹ ε + O(ε²)` (Pinocchio's `Jlog6`). With `Jr(e) = [[Jr(φ), Q(−ρ, −φ)],
-/// [0, Jr(φ)]]`, the inverse is `[[Jr⁻¹, −Jr⁻¹ Q Jr⁻¹], [0, Jr⁻¹]]`.
+/// `log(T Exp(ε)) = e + Jr(e)⁻¹ ε + O(ε²)` (Pinocchio's `Jlog6`; the engine's `spatial::lie::se3_right_jacobian_inv`).
 pub fn se3_log_jacobian(e: &[f64; 6]) -> M6 {
-    let rho = V3::new(e[0], e[1], e[2]);
-    let phi = V3::new(e[3], e[4], e[5]);
-    let ji = so3_jr_inv(&phi);
-    let q = barfoot_q(&(-rho), &(-phi));
-    let mut out = M6::zeros();
-    out.fixed_view_mut::<3, 3>(0, 0).copy_from(&ji);
-    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-ji * q * ji));
-    out.fixed_view_mut::<3, 3>(3, 3).copy_from(&ji);
-    out
+    se3_right_jacobian_inv(&V6::from_column_slice(e))
 }
 
 /// Pose error of the frame `placement` on `body` against `reference` (inertial frame):

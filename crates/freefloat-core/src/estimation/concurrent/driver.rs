@@ -92,7 +92,7 @@ pub struct ClRun {
     pub truth: Vec<f64>,
     /// Final estimate, 7B.
     pub final_estimate: Vec<f64>,
-    /// Per body: whether the final estimate is a rigid body (temporary local check, see `realisable`).
+    /// Per body: whether the final estimate is a rigid body (`dualquat::realisability`).
     pub realisable: Vec<bool>,
     /// Largest |R̂_i v(M_i) − F_i| over the run with the true parameters and exact measurements (a check that
     /// the reaction wrenches and the regressor agree with the dynamics); NaN with noise.

@@ -96,19 +96,9 @@ impl ClParams {
 }
 
 /// Whether a 7-parameter estimate is a rigid body: mass > 0, inertia positive definite, and the triangle
-/// inequalities of the principal moments (I_a + I_b ≥ I_c), within a relative tolerance of 1e-9.
-///
-/// TEMPORARY local check: the engine's shared `realisability(v)` (dualquat, being written alongside the
-/// ch. 4 controller) replaces this at merge; this function is the hook (one call site per use).
+/// inequalities of the principal moments (the engine's one test, `dualquat::realisability`).
 pub fn realisable(v: &V7) -> bool {
-    if !v.iter().all(|x| x.is_finite()) || !(v[6] > 0.0) {
-        return false;
-    }
-    let i = nalgebra::Matrix3::new(v[0], v[1], v[2], v[1], v[3], v[4], v[2], v[4], v[5]);
-    let e = nalgebra::SymmetricEigen::new(i).eigenvalues;
-    let tol = 1e-9 * e.amax();
-    let (a, b, c) = (e[0], e[1], e[2]);
-    e.iter().all(|&x| x > 0.0) && a + b >= c - tol && a + c >= b - tol && b + c >= a - tol
+    crate::dualquat::realisability(v).is_realisable()
 }
 
 /// The concurrent-learning estimator of Valverde 2018 ch. 9 for B bodies, driven sample by sample:
