@@ -495,3 +495,14 @@ def test_dq_dynamics_with_cylindrical_and_universal_joints():
                 np.testing.assert_allclose(S @ W[i], tau[desc.v_slices()[i]], atol=1e-9)
     assert {"cylindrical", "universal"} <= kinds
     print(f"worst relative difference: accelerations {worst_a:.1e}, joint wrenches {worst_w:.1e}")
+
+
+def test_repr_is_the_constructors_order_and_evaluates_back():
+    from freefloat.dq import DualQuaternion
+
+    q = ff.dq.from_pose([0.0, 0.0, np.sin(0.3), np.cos(0.3)], [1.0, 2.0, 3.0])
+    text = repr(q)
+    assert text.startswith("DualQuaternion([") and "ε" not in text
+    back = eval(text, {"DualQuaternion": DualQuaternion})
+    assert back.tolist() == q.tolist()  # every digit kept
+    assert str(q).count("ε") == 1 and str(q).startswith("[")

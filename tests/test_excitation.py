@@ -230,3 +230,16 @@ def test_stacked_fourier_trajectory_file_round_trip(design, tmp_path):
     for a, b in zip(traj.evaluate(t), back.evaluate(t)):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-15)
     assert traj.duration == pytest.approx(6.0)
+
+
+@pytest.mark.slow
+def test_each_step_shows_a_bar_and_a_finished_step_fills_it(guess, capsys):
+    d = exc.ExcitationDesign(guess)
+    d.design(maxiter=4, progress=True)
+    err = capsys.readouterr().err
+    for step in ("step 1/3", "step 2/3", "step 3/3"):
+        assert step in err, step
+    n = len(d.all_directions)
+    last = {s: err.rsplit(s, 1)[1].split("\r")[0] for s in ("step 1/3", "step 3/3", "step 2/3")}
+    assert "4/4" in last["step 1/3"] and "4/4" in last["step 3/3"], last  # SQP steps end on full bars
+    assert f"{n}/{n}" in last["step 2/3"], last  # Algorithm 1 too

@@ -251,9 +251,16 @@ impl PyDualQuaternion {
         }
         Ok(self.inner.to_array()[i as usize])
     }
+    /// `DualQuaternion([rw, rx, ry, rz, dw, dx, dy, dz])`: the constructor's own order, every digit kept, so
+    /// the text evaluates back to the same value.
     fn __repr__(&self) -> String {
+        let a: Vec<String> = self.inner.to_array().iter().map(|x| format!("{x:?}")).collect();
+        format!("DualQuaternion([{}])", a.join(", "))
+    }
+    /// `[rw, rx, ry, rz] + ε[dw, dx, dy, dz]`: real and dual parts, each `(w, x, y, z)`.
+    fn __str__(&self) -> String {
         let a: Vec<String> = self.inner.to_array().iter().map(|x| format!("{x:.9}")).collect();
-        format!("DualQuaternion([{}] + ε[{}])", a[..4].join(", "), a[4..].join(", "))
+        format!("[{}] + ε[{}]", a[..4].join(", "), a[4..].join(", "))
     }
     fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let py = slf.py();

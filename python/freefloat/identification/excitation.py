@@ -269,7 +269,19 @@ class ExcitationDesign:
         s1 = self._run_step("step 1/3: SQP on all intervals", self.all_directions, x0, maxiter, progress)
         timings["step1"] = time.perf_counter() - t0
         t0 = time.perf_counter()
-        pr = self.prune(s1.x, min_gain=min_gain)
+        bar = None
+        if progress:
+            from tqdm.auto import tqdm
+
+            bar = tqdm(total=len(self.all_directions), desc="step 2/3: Algorithm 1 on the intervals", leave=False)
+        try:
+            pr = self.prune(s1.x, min_gain=min_gain)
+            if bar is not None:
+                bar.update(bar.total)
+                bar.set_postfix(kept=len(pr.kept))
+        finally:
+            if bar is not None:
+                bar.close()
         timings["step2"] = time.perf_counter() - t0
         kept_dirs = self.all_directions[pr.kept]
         t0 = time.perf_counter()
@@ -372,7 +384,11 @@ class ExcitationDesign:
                 bar.set_postfix(C=f"{c:.4g}")
 
         try:
-            return self.optimize(dirs, x0, maxiter, cb)
+            res = self.optimize(dirs, x0, maxiter, cb)
+            if bar is not None:  # converged before maxiter: the step is done, so its bar is full
+                bar.update(bar.total - bar.n)
+                bar.refresh()
+            return res
         finally:
             if bar is not None:
                 bar.close()
