@@ -397,8 +397,13 @@ def test_cli_bad_input_is_one_clear_line(tmp_path):
 
 @pytest.mark.slow
 def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_continues(tmp_path):
+    # runs long enough (about 1 s each) that the campaign is still running when its first rows reach the disk
+    # (the writer flushes every 5 s): with 3 s runs a quiet machine finishes all 16 before the first flush, and
+    # the Ctrl-C lands after the campaign instead of in it
+    spec = json.loads(json.dumps(MEDIUM_2X8))
+    spec["set"]["duration"] = 20.0
     spec_file = tmp_path / "spec.yaml"
-    spec_file.write_text(yaml.safe_dump(MEDIUM_2X8))
+    spec_file.write_text(yaml.safe_dump(spec))
     cmd = [
         sys.executable,
         "-m",
@@ -415,9 +420,10 @@ def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_continues(tmp_path)
     while not dataset.files(tmp_path / "o" / "runs"):  # wait until some rows are on disk
         assert time.monotonic() < deadline and p.poll() is None, "no rows written"
         time.sleep(0.3)
+    assert p.poll() is None, "the campaign finished before it could be interrupted (make its runs longer)"
     p.send_signal(signal.SIGINT)
     _, err = p.communicate(timeout=60)
-    assert p.returncode == 130 and "run the same command again to continue" in err
+    assert p.returncode == 130 and "run the same command again to continue" in err, (p.returncode, err[-2000:])
     res = json.loads((tmp_path / "o" / "results.json").read_text())
     assert res["interrupted"] is True and 1 <= res["runs_done"] < 16
     kept = res["runs_done"]

@@ -11,9 +11,12 @@ command continues where it stopped.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
+import signal
 import socket
+import threading
 import time
 import traceback
 import warnings
@@ -195,32 +198,57 @@ def run_campaign(
     except KeyboardInterrupt:
         state["interrupted"] = True
     finally:
-        writer.flush()
-        final = dataset.scan(root)
-        res = {
-            "campaign": spec.name,
-            "kind": spec.kind,
-            "description": spec.description,
-            "spec": spec.source,
-            "runs_total": len(all_runs),
-            "runs_selected": len(selected),
-            "runs_done": sum(1 for k in final.done if k in keys),
-            "runs_failed": sum(1 for k in final.failed if k in keys),
-            "runs_new": state["new_done"] + state["new_failed"],
-            "runs_new_failed": state["new_failed"],
-            "runs_skipped": len(selected) - len(todo),
-            "dataset": str(root.resolve()),
-            "dataset_format": "parquet, hive-partitioned by status",
-            "scheduler": state["scheduler"],
-            "workers": state["workers"],
-            "wall_s": time.perf_counter() - t_start,
-            "interrupted": state["interrupted"],
-            "failures": [{"run_key": k, "error": e} for k, e in list(final.failed.items())[:20] if k in keys],
-        }
-        res["runs_remaining"] = res["runs_total"] - res["runs_done"] - res["runs_failed"]
-        (out / "results.json").write_text(json.dumps(res, indent=1))
+        with _sigint_deferred(state):  # a second Ctrl-C must not lose the bookkeeping of what finished
+            res = _finish(spec, out, root, writer, state, all_runs, selected, todo, keys, t_start)
     if state["interrupted"]:
         raise KeyboardInterrupt
+    return res
+
+
+@contextlib.contextmanager
+def _sigint_deferred(state: dict):
+    """Hold Ctrl-C while the finished rows and results.json are written (main thread only; a Ctrl-C held here
+    marks the campaign interrupted once the writing is done)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def held(signum, frame):
+        state["interrupted"] = True
+
+    previous = signal.signal(signal.SIGINT, held)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def _finish(spec, out, root, writer, state, all_runs, selected, todo, keys, t_start) -> dict:
+    """Flush the rows still in memory and write `out/results.json` from what the dataset holds."""
+    writer.flush()
+    final = dataset.scan(root)
+    res = {
+        "campaign": spec.name,
+        "kind": spec.kind,
+        "description": spec.description,
+        "spec": spec.source,
+        "runs_total": len(all_runs),
+        "runs_selected": len(selected),
+        "runs_done": sum(1 for k in final.done if k in keys),
+        "runs_failed": sum(1 for k in final.failed if k in keys),
+        "runs_new": state["new_done"] + state["new_failed"],
+        "runs_new_failed": state["new_failed"],
+        "runs_skipped": len(selected) - len(todo),
+        "dataset": str(root.resolve()),
+        "dataset_format": "parquet, hive-partitioned by status",
+        "scheduler": state["scheduler"],
+        "workers": state["workers"],
+        "wall_s": time.perf_counter() - t_start,
+        "interrupted": state["interrupted"],
+        "failures": [{"run_key": k, "error": e} for k, e in list(final.failed.items())[:20] if k in keys],
+    }
+    res["runs_remaining"] = res["runs_total"] - res["runs_done"] - res["runs_failed"]
+    (out / "results.json").write_text(json.dumps(res, indent=1))
     return res
 
 
