@@ -1,4 +1,4 @@
-//! Cost algebra and derivatives of the DDP costs (Valverde 2018 ch. 8 digest §11 part A): keep-out table
+//! Cost algebra and derivatives of the DDP costs (Valverde 2018 ch. 8): keep-out table
 //! (§6.3), weight schedule (§6.2), the helical reference (§7.2), the initial end-effector pose of
 //! `valverde_ch8_arm`, and every analytic cost gradient against central differences in the tangent.
 
@@ -93,7 +93,7 @@ fn thesis_helix(n: usize, dt: f64) -> Vec<DualQuat> {
 }
 
 #[test]
-fn helical_reference_reproduces_the_digest_table() {
+fn helical_reference_reproduces_the_tabulated_poses() {
     let refs = thesis_helix(640, 0.05);
     let rows = [
         (0.0, [0.70711, 0.70711, 0.0, 0.0], [-2.20971, 2.20971, 1.89151, 1.64402]),
@@ -132,7 +132,7 @@ fn ch8_arm_initial_end_effector_pose() {
     let g = freefloat_core::control::ddp::costs::frame_dual_quat(&m, &x[..13], body, &place, &o).unwrap().to_array();
     let h = std::f64::consts::FRAC_PI_4.cos();
     assert!((g[0].abs() - h).abs() < 1e-9 && (g[1].abs() - h).abs() < 1e-9 && g[2].abs() < 1e-9 && g[3].abs() < 1e-9);
-    // Digest §11 A.7: ‖q_G − q_D‖² = ¼‖Δr‖² (equal real parts) against the phase-1 target; 0.087507 there with
+    // ‖q_G − q_D‖² = ¼‖Δr‖² (equal real parts) against the phase-1 target; 0.087507 there with
     // the rounded x = 6.727, ¼((6.72717 − 6.25)² + 0.35²) = 0.087548 with the model's exact position.
     let refs = thesis_helix(640, 0.05);
     let r = refs[0].to_array();

@@ -1,4 +1,4 @@
-//! DDP engine acceptance tests (Valverde 2018 ch. 8 digest §11 part C): LQ exactness against the batch
+//! DDP engine acceptance tests (Valverde 2018 ch. 8): LQ exactness against the batch
 //! least-squares solution, backward-pass equivalence with eqs. (8.32)–(8.33), full DDP vs iLQG on
 //! quadratic dynamics, regularisation and line-search behaviour, the feasibility-driven variant, bad input.
 

@@ -1,5 +1,5 @@
 //! Costs of the chapter 8 problems (Valverde 2018, eqs. (8.52), (8.56)): weighted squared residuals in
-//! the thesis' form `Σᵢ wᵢ rᵢ²` (no ½, no Δt: digest of eq. (8.11) vs (8.52)), with Gauss–Newton
+//! the thesis' form `Σᵢ wᵢ rᵢ²` (no ½, no Δt: eq. (8.52), not the ½-weighted form of (8.11)), with Gauss–Newton
 //! Hessians `2 Jᵀ W J`, and the soft keep-out bump with its exact derivatives.
 //!
 //! Residuals: the end-effector pose as `log6(M_ref⁻¹ M)` (the metric Crocoddyl uses) or as the thesis'
