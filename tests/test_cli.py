@@ -56,11 +56,11 @@ def test_simulate_writes_parquet_json_and_figure(tmp_path):
 
 
 @pytest.mark.slow
-def test_demo_runs(tmp_path):
-    r = run("demo", "--t-final", "2", "--out", str(tmp_path))
-    res = json.loads((tmp_path / "results.json").read_text())
+def test_demo_runs(demo_run):
+    _, out, r = demo_run
+    res = json.loads((out / "results.json").read_text())
     assert res["momentum_drift_linear_rel"] < 1e-10 and res["energy_minus_work_rel"] < 1e-9
-    assert "peak joint torques" in r.stdout and (tmp_path / "demo.png").exists()
+    assert "peak joint torques" in r.stdout and (out / "demo.png").exists()
 
 
 def test_bad_model_gives_one_clear_line(tmp_path):

@@ -122,10 +122,10 @@ def _ff(*args, cwd):
     return r.stdout
 
 
-def test_demo_report_in_chromium(tmp_path):
-    _ff("demo", "--out", "demo", "--t-final", "2", cwd=tmp_path)
-    _ff("report", "demo", cwd=tmp_path)
-    _check(tmp_path / "demo" / "report.html", tmp_path, min_figures=3, gl=1)  # motion, 3D view, parameter errors
+def test_demo_report_in_chromium(demo_run, tmp_path):
+    cwd, out, _ = demo_run
+    _ff("report", str(out), cwd=cwd)
+    _check(out / "report.html", tmp_path, min_figures=3, gl=1)  # motion, 3D view, parameter errors
 
 
 def test_postcapture_report_in_chromium(tmp_path):
