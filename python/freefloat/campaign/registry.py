@@ -284,6 +284,9 @@ def _builtin_kinds() -> None:
             headline=("ls.median_rel_error_pct", "eiv.median_rel_error_pct", "ls.max_rel_error_pct"),
         )
     )
+    from .file_kinds import register_all
+
+    register_all()
 
 
 _builtin_kinds()

@@ -41,7 +41,9 @@ def campaign_cmd(spec, out, list_, runs, workers, scheduler, retry_failed, repai
     scenario, fixed overrides (`set`), a `grid` of values per dotted parameter path (e.g.
     initial.base_velocity.0 for the initial Vx of a post-capture scenario), and `monte_carlo` draws (noise seeds,
     random parameters). Each run's inputs and summary numbers become one row of a Parquet dataset in
-    OUT/runs/ (readable by pyarrow, pandas, polars, DuckDB), written as runs finish.
+    OUT/runs/ (readable by pyarrow, pandas, polars, DuckDB), written as runs finish. Kinds: postcapture
+    (Zhang 2020), identify_minimal (Naveen et al.), identify_cl, control_adaptive and control_ddp (Valverde 2018
+    ch. 9, 4 and 8; their scenario files, e.g. valverde_ch9_two_arm with noise.wrench / noise.rate).
 
     Re-running the same command skips the runs already in OUT (each run is keyed by a hash of its inputs), so
     an interrupted campaign (Ctrl-C) continues where it stopped. A run that raises is recorded with its error;
