@@ -65,6 +65,12 @@ impl Weights {
         let current = start.clone();
         Ok(Weights { start, medium, end, breaks: Some(breaks), current })
     }
+    /// The End-column weights, held constant (what a receding-horizon controller uses: it re-solves from
+    /// warm starts and has no iteration count to schedule against).
+    pub fn frozen_end(&self) -> Weights {
+        let e = self.end.clone();
+        Weights { start: e.clone(), medium: e.clone(), end: e.clone(), breaks: None, current: e }
+    }
     /// Number of weights.
     pub fn len(&self) -> usize {
         self.current.len()
