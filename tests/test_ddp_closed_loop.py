@@ -10,14 +10,13 @@ import json
 import numpy as np
 import pytest
 from click.testing import CliRunner
+from test_ddp import short
 
 from freefloat import _core
 from freefloat._core import InputError
 from freefloat.cli import main
 from freefloat.control import ddp
 from freefloat.control import ddp_closed_loop as cl
-
-from test_ddp import short
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +55,9 @@ def test_policy_without_model_error_corrects_the_discretisation_mismatch(solved)
         assert r["xs"].shape == np.asarray(sol["xs"]).shape and r["us"].shape == np.asarray(sol["us"]).shape
         s[mode] = cl.summary(r, final_hold_s=1.0)
     # The policy applies ū_k exactly at the planned state and feedback on the error: node 0 is the plan's.
-    assert s["policy"]["ee_position_error_final_hold_max_m"] < 0.2 * s["open_loop"]["ee_position_error_final_hold_max_m"]
+    assert (
+        s["policy"]["ee_position_error_final_hold_max_m"] < 0.2 * s["open_loop"]["ee_position_error_final_hold_max_m"]
+    )
     assert s["open_loop"]["ee_position_error_final_hold_max_m"] > 0.01, s
 
 

@@ -484,9 +484,14 @@ impl PyDdpPolicy {
         let xs_r = rows3("xs", &xs, nx, n + 1)?;
         let g = gains.as_array();
         if g.shape() != [n, nu, 2 * nu] {
-            return Err(input_err(format!("argument `gains`: expected shape ({n}, {nu}, {}), got {:?}", 2 * nu, g.shape())));
+            return Err(input_err(format!(
+                "argument `gains`: expected shape ({n}, {nu}, {}), got {:?}",
+                2 * nu,
+                g.shape()
+            )));
         }
-        let gains_r: Vec<Vec<f64>> = (0..n).map(|k| g.index_axis(numpy::ndarray::Axis(0), k).iter().copied().collect()).collect();
+        let gains_r: Vec<Vec<f64>> =
+            (0..n).map(|k| g.index_axis(numpy::ndarray::Axis(0), k).iter().copied().collect()).collect();
         let robot = guard(|| FloatingRobot::new(m, 1.0, n, vec![], vec![], vec![]))?;
         let policy = guard(|| Policy::new(xs_r, us_r, gains_r, nx, 2 * nu, nu))?;
         Ok(PyDdpPolicy { robot, policy, out: vec![0.0; nu] })
@@ -494,7 +499,13 @@ impl PyDdpPolicy {
 
     /// Control (nv,) at node k for the measured state x = [q; v].
     #[pyo3(signature = (k, x, feedback = true))]
-    fn control<'py>(&mut self, py: Python<'py>, k: usize, x: Vec<f64>, feedback: bool) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    fn control<'py>(
+        &mut self,
+        py: Python<'py>,
+        k: usize,
+        x: Vec<f64>,
+        feedback: bool,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let (robot, policy, out) = (&self.robot, &mut self.policy, &mut self.out);
         guard(|| policy.control(robot, k, &x, feedback, out))?;
         Ok(PyArray1::from_slice(py, out))

@@ -40,6 +40,12 @@ from .._core import InputError
 @click.option("--variant", type=click.Choice(["ddp", "fddp"]), default=None, help="DDP or feasibility-driven DDP.")
 @click.option("--no-plots", is_flag=True, help="Write results.json only.")
 @click.option(
+    "--warm-start",
+    is_flag=True,
+    help="Start from the solution of an easier companion problem (same scenario with the log-SE(3) pose cost, "
+    "constant End weights, no keep-out, backtracking line search) instead of the scenario's initial controls.",
+)
+@click.option(
     "--closed-loop",
     is_flag=True,
     help="After the solve, run the optimised policy (feed-forward + Riccati gains on the measured state) in the "
@@ -79,6 +85,7 @@ def ddp_cmd(
     line_search,
     variant,
     no_plots,
+    warm_start,
     closed_loop,
     mpc,
     horizon,
@@ -131,6 +138,21 @@ def ddp_cmd(
         opts["alphas"] = [0.1]
     if variant:
         opts["variant"] = variant
+    warm = None
+    if warm_start:
+        guide = ddp.load_scenario(scenario, cost="log", schedule=False, keep_out=False)
+        click.echo("warm start: solving the companion problem (log-SE(3) cost, End weights, no keep-out) ...")
+        prob, gsol = ddp.warm_started(prob, guide)
+        warm = {
+            "iterations": int(gsol["iterations"]),
+            "final_cost": float(gsol["cost"]),
+            "solve_time_s": float(gsol["solve_time_s"]),
+            "stop": gsol["stop"],
+        }
+        click.echo(
+            f"  companion: {warm['iterations']} iterations, cost {warm['final_cost']:.8g}, {warm['solve_time_s']:.2f} s"
+            f" ({gsol['stop_message']})"
+        )
     click.echo(
         f"{prob.name}: {prob.model.name}, N = {prob.horizon}, dt = {prob.dt} s, pose cost '{prob.cost_kind}', "
         f"up to {({**prob.options, **opts}).get('max_iter', 100)} iterations"
@@ -149,9 +171,13 @@ def ddp_cmd(
     sol = ddp.solve(prob, progress=progress, **opts)
     res = ddp.results(prob, sol)
     res["timings"] = sol["timings"]
+    if warm is not None:
+        res["warm_start"] = warm
     runs = {}
     if closed_loop:
-        runs, res["closed_loop"] = _closed_loop(prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps)
+        runs, res["closed_loop"] = _closed_loop(
+            prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps
+        )
     click.echo(f"\nstopped: {res['stop_message']}")
     click.echo(
         f"  {res['iterations']} iterations, cost {res['initial_cost']:.6g} -> {res['final_cost']:.10g}, "
@@ -201,7 +227,7 @@ def _closed_loop(prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_b
     for mode in modes:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=prob.horizon, desc=f"  {mode}", unit="step", leave=False)
+        bar = tqdm(total=prob.horizon, desc=f"  {mode}", unit="step", leave=False, disable=None)
 
         def progress(k, n, bar=bar):
             bar.update(k - bar.n)

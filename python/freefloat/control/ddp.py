@@ -443,3 +443,16 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
         "gap": float(sol["gap"]),
         "cost_history": [float(h["cost"]) for h in sol["history"]],
     }
+
+
+def warm_started(problem: Problem, guide: Problem, max_iter: int = 100, progress=None) -> tuple[Problem, dict]:
+    """`problem` with its initial guess (controls and, for the feasibility-driven variant, states) replaced by the
+    solution of `guide`, an easier problem on the same robot, horizon and reference (e.g. the same scenario with
+    the log-SE(3) pose cost, constant End weights and no keep-out, which converges in a few tens of iterations
+    with a backtracking line search). Returns (the warm-started problem, the guide's solution)."""
+    if (guide.horizon, guide.model.nv, guide.model.nq) != (problem.horizon, problem.model.nv, problem.model.nq):
+        raise InputError("argument `guide`: its horizon and robot sizes must equal the problem's")
+    sol = solve(guide, progress=progress, max_iter=max_iter, alphas=[0.5**k for k in range(10)])
+    from dataclasses import replace
+
+    return replace(problem, us0=np.asarray(sol["us"], float), xs0=np.asarray(sol["xs"], float)), sol

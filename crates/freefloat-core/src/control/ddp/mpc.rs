@@ -29,13 +29,23 @@ pub struct Policy {
 impl Policy {
     /// A policy from nominal states `xs` (N + 1 or N, nx each), controls `us` (N, nu) and gains (N, nu × ndx
     /// row-major), all checked (sizes, finite).
-    pub fn new(xs: Vec<Vec<f64>>, us: Vec<Vec<f64>>, gains: Vec<Vec<f64>>, nx: usize, ndx: usize, nu: usize) -> Result<Policy> {
+    pub fn new(
+        xs: Vec<Vec<f64>>,
+        us: Vec<Vec<f64>>,
+        gains: Vec<Vec<f64>>,
+        nx: usize,
+        ndx: usize,
+        nu: usize,
+    ) -> Result<Policy> {
         let n = us.len();
         if n == 0 {
             return Err(FfError::arg("us", "the policy needs at least one node"));
         }
         if xs.len() < n {
-            return Err(FfError::arg("xs", format!("need at least {n} nominal states (one per control), got {}", xs.len())));
+            return Err(FfError::arg(
+                "xs",
+                format!("need at least {n} nominal states (one per control), got {}", xs.len()),
+            ));
         }
         if gains.len() != n {
             return Err(FfError::arg("gains", format!("need one gain matrix per control ({n}), got {}", gains.len())));
@@ -80,7 +90,14 @@ impl Policy {
     /// `out = ū_k + L_k (x ⊖ x̄_k)` (`feedback = false`: `ū_k` only). Nodes past the end use the last one.
     /// Valverde 2018, eq. (8.45) with α = 1, on the measured state. `model` supplies `⊖` (its sizes must
     /// match). Does not allocate.
-    pub fn control(&mut self, model: &dyn ActionModel, k: usize, x: &[f64], feedback: bool, out: &mut [f64]) -> Result<()> {
+    pub fn control(
+        &mut self,
+        model: &dyn ActionModel,
+        k: usize,
+        x: &[f64],
+        feedback: bool,
+        out: &mut [f64],
+    ) -> Result<()> {
         if model.nx() != self.nx || model.ndx() != self.ndx || model.nu() != self.nu {
             return Err(FfError::arg("model", "the model's sizes differ from the policy's"));
         }

@@ -148,7 +148,11 @@ impl FloatingRobot {
         let freeze = |terms: &[CostTerm]| -> Vec<CostTerm> {
             terms
                 .iter()
-                .map(|t| CostTerm { name: t.name.clone(), residual: t.residual.clone(), weights: t.weights.frozen_end() })
+                .map(|t| CostTerm {
+                    name: t.name.clone(),
+                    residual: t.residual.clone(),
+                    weights: t.weights.frozen_end(),
+                })
                 .collect()
         };
         Ok(Self::build(
