@@ -43,7 +43,9 @@ from .._core import InputError
     "--warm-start",
     is_flag=True,
     help="Start from the solution of an easier companion problem (same scenario with the log-SE(3) pose cost, "
-    "constant End weights, no keep-out, backtracking line search) instead of the scenario's initial controls.",
+    "constant End weights, no keep-out, backtracking line search), with whole joint turns made within one step "
+    "removed (they put the dual quaternion on the opposite sign; docs/ddp.md), instead of the scenario's initial "
+    "controls.",
 )
 @click.option(
     "--closed-loop",
@@ -148,6 +150,7 @@ def ddp_cmd(
             "final_cost": float(gsol["cost"]),
             "solve_time_s": float(gsol["solve_time_s"]),
             "stop": gsol["stop"],
+            "unwound_turns": gsol["unwound"],
         }
         click.echo(
             f"  companion: {warm['iterations']} iterations, cost {warm['final_cost']:.8g}, {warm['solve_time_s']:.2f} s"

@@ -14,6 +14,9 @@ use crate::check::{check_finite, check_vec};
 use crate::error::{FfError, Result};
 use std::time::Instant;
 
+/// An initial guess over a whole task: states (N + 1) and controls (N).
+pub type Guess = (Vec<Vec<f64>>, Vec<Vec<f64>>);
+
 /// A time-varying affine feedback policy `u_k = ū_k + L_k (x ⊖ x̄_k)` over N nodes.
 #[derive(Clone, Debug)]
 pub struct Policy {
@@ -178,7 +181,7 @@ pub struct Mpc {
     window: FloatingRobot,
     solver: Solver,
     opts: MpcOptions,
-    guess: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>,
+    guess: Option<Guess>,
     plan: Option<(usize, Policy)>,
     warm_us: Vec<f64>,
     warm_xs: Vec<f64>,
@@ -190,7 +193,7 @@ impl Mpc {
     /// A controller for `task` (its costs and reference tables; scheduled weights frozen at End). `guess`:
     /// optional states (N + 1) and controls (N) over the whole task (e.g. an offline solve) that start the
     /// first window; without it the first window starts from zero controls.
-    pub fn new(task: &FloatingRobot, opts: MpcOptions, guess: Option<(Vec<Vec<f64>>, Vec<Vec<f64>>)>) -> Result<Mpc> {
+    pub fn new(task: &FloatingRobot, opts: MpcOptions, guess: Option<Guess>) -> Result<Mpc> {
         opts.validate()?;
         let window = task.window(opts.horizon)?;
         let (nx, nu) = (window.nx(), window.nu());
