@@ -71,6 +71,10 @@ impl Weights {
         let e = self.end.clone();
         Weights { start: e.clone(), medium: e.clone(), end: e.clone(), breaks: None, current: e }
     }
+    /// The last iteration at which the weights change (the fourth breakpoint; 0 for constant weights).
+    pub fn schedule_end(&self) -> usize {
+        self.breaks.map(|b| b[3]).unwrap_or(0)
+    }
     /// Number of weights.
     pub fn len(&self) -> usize {
         self.current.len()

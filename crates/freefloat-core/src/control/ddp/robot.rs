@@ -435,6 +435,9 @@ impl ActionModel for FloatingRobot {
         d.clear();
         self.cost_diff(self.n, x, None, d)
     }
+    fn schedule_end(&self) -> usize {
+        self.running.iter().chain(self.terminal.iter()).map(|t| t.weights.schedule_end()).max().unwrap_or(0)
+    }
     fn set_iteration(&mut self, i: usize) -> bool {
         let mut changed = false;
         for t in self.running.iter_mut().chain(self.terminal.iter_mut()) {

@@ -285,6 +285,7 @@ impl Solver {
         let mut stop = StopReason::MaxIterations;
         let mut iterations = 0;
         let mut tm = Timings::default();
+        let schedule_end = model.schedule_end();
         for iter in 1..=opts.max_iter {
             iterations = iter;
             if iter > 1 && model.set_iteration(iter) {
@@ -358,6 +359,16 @@ impl Solver {
                     backward_passes: passes,
                 };
                 history.push(info.clone());
+                if iter < schedule_end {
+                    // Converged at this iteration's weights, but the schedule will still change them: go on
+                    // (the next iteration re-evaluates the nominal at the new weights).
+                    if !callback(&info) {
+                        stop = StopReason::Interrupted;
+                        break;
+                    }
+                    need_diff = false;
+                    continue;
+                }
                 callback(&info);
                 stop = StopReason::Converged;
                 break;
