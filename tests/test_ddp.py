@@ -148,3 +148,56 @@ def test_tracking_reaches_crocoddyls_cost_in_no_more_iterations():
     assert abs(croc_cost - 204.19) < 0.01
     res = ddp.results(prob, sol)
     assert res["ee_position_error_final_m"] < 0.01
+
+
+def test_unwinding_a_one_step_joint_turn_restores_the_dual_quaternion_sign():
+    """A wrist that spins by a whole turn between two nodes ends at the same pose with the chain quaternion's
+    sign flipped (a 2π rotation is -1); unwinding the turn puts it back on the reference's sheet, and the pose
+    itself (the frame's placement) is unchanged. Oracle: the engine's chain dual quaternion before and after."""
+    from freefloat import _core
+
+    prob = ddp.load_scenario("valverde_ch8_tracking")
+    m = prob.model
+    n = 20
+    xs = np.tile(prob.x0, (n + 1, 1))
+    us = np.zeros((n, m.nv))
+    j = m.joint_names.index("wrist_x")
+    iq = m.idx_q[j]
+    xs[:, iq] = np.linspace(0.0, 0.3, n + 1)
+    xs[11:, iq] -= 2 * math.pi  # a whole turn between nodes 10 and 11
+    us[10, m.idx_v[j]], us[11, m.idx_v[j]] = 50.0, -50.0
+    g0 = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(xs[:, : m.nq]), "ee")
+    assert np.dot(g0[0, :4], g0[-1, :4]) < -0.9  # opposite sheet
+    xu, uu, done = ddp.unwind_joint_turns(m, xs, us)
+    assert done == [("wrist_x", 10, -1.0)]
+    np.testing.assert_allclose(xu[:, iq], np.linspace(0.0, 0.3, n + 1), atol=1e-12)
+    assert abs(uu[10, m.idx_v[j]]) < 1e-12 and abs(uu[11, m.idx_v[j]]) < 1e-12
+    g1 = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(xu[:, : m.nq]), "ee")
+    assert np.dot(g1[0, :4], g1[-1, :4]) > 0.9
+    np.testing.assert_allclose(np.abs(g1[-1]), np.abs(g0[-1]), atol=1e-12)  # same pose, sign aside
+
+
+@pytest.mark.slow
+def test_thesis_settings_meet_d18_from_the_unwound_log_se3_warm_start():
+    """Acceptance D.18 with the thesis' settings (dq cost, Table 8.2 schedule, keep-out, alpha = 0.1, 150 iterations),
+    started from the unwound solution of the log-SE(3) companion problem (docs/ddp.md §2.3): final hold within 5 cm
+    and 5 deg, phase-2 RMS position error within 5 cm, and the guess on the reference's sign throughout."""
+    from freefloat import _core
+
+    prob = ddp.load_scenario("valverde_ch8_tracking")
+    guide = ddp.load_scenario("valverde_ch8_tracking", cost="log", schedule=False, keep_out=False)
+    warm, gsol = ddp.warm_started(prob, guide)
+    assert gsol["stop"] == "converged" and gsol["unwound"], gsol["unwound"]
+    m = prob.model
+    g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(warm.xs0[:, : m.nq]), "ee")
+    assert np.sum(g[:, :4] * prob.reference_dq[:, :4], axis=1).min() > 0.99
+    sol = ddp.solve(warm)
+    xs = np.asarray(sol["xs"])
+    g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(xs[:, : m.nq]), "ee")
+    e = ddp.pose_errors(g, prob.reference_dq)
+    t = np.arange(len(xs)) * prob.dt
+    pos, ang = np.linalg.norm(e["position"], axis=1), np.degrees(e["angle"])
+    hold, move = t >= 27 - 1e-9, (t >= 7) & (t <= 27)
+    assert pos[hold].max() <= 0.05 and ang[hold].max() <= 5.0, (pos[hold].max(), ang[hold].max())
+    assert np.sqrt(np.mean(pos[move] ** 2)) <= 0.05
+    assert sol["cost"] < sol["history"][0]["cost"]

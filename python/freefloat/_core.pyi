@@ -87,6 +87,34 @@ the estimate by one RK4 step of (9.15), or of (9.23) with the SVD gain once the 
     def time(self) -> Any:
         """Current time (advanced by `step`; settable)."""
 
+class DdpMpc:
+    """Receding-horizon DDP (model-predictive control) over a task: the problem description of `ddp_solve`
+(model, dt, task horizon N, running/terminal costs, keep_out; scheduled weights frozen at their End column).
+`control(k, x)` re-solves the window of `mpc_horizon` nodes starting at task node k from the measured state
+every `replan` nodes (warm-started by the previous window shifted in time; the first window by
+`guess_xs`/`guess_us` over the whole task if given, else zero controls), and in between applies that
+window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
+`first_max_iter` bounds the first solve. `stats()`: re-plans, iterations, solve time, slowest re-plan,
+troubled re-plans, last stop reason, the cost of each re-plan.
+    """
+    def __init__(self, model: Model, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, mpc_horizon: ArrayLike, replan: ArrayLike, keep_out: ArrayLike | None = None, options: ArrayLike | None = None, first_max_iter: ArrayLike = 50, guess_xs: ArrayLike | None = None, guess_us: ArrayLike | None = None) -> None: ...
+    def control(self, k: ArrayLike, x: Any) -> Any:
+        """Control (nv,) at task node k for the measured state x = [q; v] (re-plans when due; Ctrl-C is checked
+between re-plans by the caller's loop).
+        """
+    def stats(self) -> Any:
+        """What the controller did so far (dict)."""
+
+class DdpPolicy:
+    """The feedback policy of a DDP solution (Valverde 2018, eq. (8.45) with α = 1 on the measured state):
+`control(k, x)` = `us[k] + gains[k] (x ⊖ xs[k])`, the state error in the tangent space (base twist, joint
+angles, velocities), as the backward pass linearised it; `feedback=False` gives the open-loop `us[k]`.
+Nodes past the end use the last one. `xs` (N + 1, nq + nv), `us` (N, nv), `gains` (N, nv, 2 nv).
+    """
+    def __init__(self, model: Model, xs: ArrayLike, us: ArrayLike, gains: ArrayLike) -> None: ...
+    def control(self, k: ArrayLike, x: Any, feedback: ArrayLike = True) -> Any:
+        """Control (nv,) at node k for the measured state x = [q; v]."""
+
 class DualQuaternion:
     """A dual quaternion `r + ε d`; poses are unit (`q q* = 1`), twists `ω + εv`, wrenches `f + ετ`."""
     def __init__(self, coeffs: ArrayLike) -> None: ...
@@ -379,7 +407,8 @@ best_alpha, accept_ratio, reg_init, reg_min, reg_max, reg_factor, tol_expected, 
 `callback(info: dict)` is called after every iteration; returning False stops (so does Ctrl-C), keeping
 the best iterate. Returns a dict: xs, us, gains (horizon, nu, ndx), cost, initial_cost, iterations, stop,
 stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
-and rollout blocks).
+and rollout blocks). Option `refresh_gains` (default False): recompute the gains at the returned iterate
+(one more derivative evaluation and backward pass), as closed-loop use of the policy needs.
     """
 
 def difference(model: Model, q0: ArrayLike, q1: ArrayLike) -> Any:

@@ -379,3 +379,43 @@ fn bad_input_names_the_argument() {
     let e = solver.solve(&mut big, &[1.0; 3], &vec![0.0; 800], None, &mut |_| true).unwrap_err();
     assert!(e.to_string().contains("diverged"), "{e}");
 }
+
+/// Closed loop: on an LQ problem the affine DDP policy `u = ū + L (x − x̄)` is the global optimal feedback, so
+/// running it from a *different* initial state must give that state's batch least-squares optimum (an
+/// independent oracle), while the open-loop feed-forward ū does not.
+#[test]
+fn lq_policy_from_a_perturbed_start_is_the_optimum_from_there() {
+    use freefloat_core::control::ddp::Policy;
+    let mut m = Lq::random(4, 5, 2, 25);
+    let x0 = DVector::from_vec(vec![1.0, -0.5, 0.3, 0.2, -1.0]);
+    let mut opts = lq_opts(vec![1.0]);
+    opts.max_iter = 1;
+    let mut solver = Solver::new(&m, opts).unwrap();
+    let sol = solver.solve(&mut m, x0.as_slice(), &vec![0.0; 50], None, &mut |_| true).unwrap();
+    let gains = solver.refresh_gains(&mut m, 0.0).unwrap().expect("LQ: Quu is positive definite");
+    let mut policy = Policy::new(sol.xs.clone(), sol.us.clone(), gains, 5, 5, 2).unwrap();
+    let x1 = &x0 + DVector::from_vec(vec![0.4, 0.3, -0.6, 0.1, 0.5]);
+    let u_opt = batch_optimum(&m, &x1);
+    for feedback in [true, false] {
+        let mut x = x1.clone();
+        let mut us = vec![];
+        let mut u = vec![0.0; 2];
+        let mut xn = vec![0.0; 5];
+        for k in 0..25 {
+            policy.control(&m, k, x.as_slice(), feedback, &mut u).unwrap();
+            m.calc(k, x.as_slice(), &u, &mut xn).unwrap();
+            us.extend_from_slice(&u);
+            x = DVector::from_column_slice(&xn);
+        }
+        let err = (DVector::from_vec(us) - &u_opt).amax();
+        if feedback {
+            assert!(err < 1e-8, "the policy's controls are {err} from the optimum from the perturbed start");
+        } else {
+            assert!(err > 1e-3, "the open-loop controls should not be optimal from the perturbed start ({err})");
+        }
+    }
+    // Bad input: a gain of the wrong size, a non-finite measured state.
+    assert!(Policy::new(sol.xs.clone(), sol.us.clone(), vec![vec![0.0; 3]; 25], 5, 5, 2).is_err());
+    let mut u = vec![0.0; 2];
+    assert!(policy.control(&m, 0, &[f64::NAN, 0.0, 0.0, 0.0, 0.0], true, &mut u).is_err());
+}

@@ -6,7 +6,9 @@ use crate::batch::model_arg;
 use crate::errors::{guard, input_err};
 use freefloat_core::control::ddp::costs::{frame_dual_quat, CostTerm, KeepOut, Residual, Weights};
 use freefloat_core::control::ddp::reference::screw_reference;
-use freefloat_core::control::ddp::{DdpOptions, FloatingRobot, IterInfo, RegOptions, Solver, StopReason, Variant};
+use freefloat_core::control::ddp::{
+    ActionModel, DdpOptions, FloatingRobot, IterInfo, Mpc, MpcOptions, Policy, RegOptions, Solver, StopReason, Variant,
+};
 use freefloat_core::dualquat::DualQuat;
 use freefloat_core::spatial::{rot_from_quat, Se3, V3};
 use freefloat_core::{FfError, Model};
@@ -121,9 +123,9 @@ fn cost_list(m: &Model, l: &Bound<'_, PyList>) -> PyResult<Vec<CostTerm>> {
     Ok(out)
 }
 
-fn parse_options(d: Option<&Bound<'_, PyDict>>) -> PyResult<DdpOptions> {
+fn parse_options(d: Option<&Bound<'_, PyDict>>) -> PyResult<(DdpOptions, bool)> {
     let mut o = DdpOptions::default();
-    let Some(d) = d else { return Ok(o) };
+    let Some(d) = d else { return Ok((o, false)) };
     let ctx = "options";
     for key in d.keys() {
         let k: String = key.extract()?;
@@ -140,6 +142,7 @@ fn parse_options(d: Option<&Bound<'_, PyDict>>) -> PyResult<DdpOptions> {
             "reg_factor",
             "tol_expected",
             "tol_cost",
+            "refresh_gains",
         ];
         if !known.contains(&k.as_str()) {
             return Err(input_err(format!("options: unknown key `{k}` (known: {})", known.join(", "))));
@@ -187,7 +190,8 @@ fn parse_options(d: Option<&Bound<'_, PyDict>>) -> PyResult<DdpOptions> {
     if let Some(v) = get(d, ctx, "tol_cost")? {
         o.tol_cost = v;
     }
-    Ok(o)
+    let refresh = get(d, ctx, "refresh_gains")?.unwrap_or(false);
+    Ok((o, refresh))
 }
 
 fn info_dict<'py>(py: Python<'py>, i: &IterInfo) -> PyResult<Bound<'py, PyDict>> {
@@ -205,48 +209,17 @@ fn info_dict<'py>(py: Python<'py>, i: &IterInfo) -> PyResult<Bound<'py, PyDict>>
     Ok(d)
 }
 
-/// Solve a floating-robot optimal-control problem by DDP (Valverde 2018, ch. 8).
-///
-/// State `x = [q; v]` (nq + nv), control `u = τ` (nv: base force and torque in the base frame, then joint
-/// torques), semi-implicit Euler steps of `dt` over `horizon` nodes. `running` / `terminal`: lists of cost
-/// dicts with keys `name`, `kind` ('frame_placement' with `frame` and `reference` (M, 7) [p, quat xyzw];
-/// 'frame_dq' with `frame` and `reference` (M, 8) thesis-layout dual quaternions; 'state' with optional
-/// `reference` (M, nx); 'control' with optional `reference` (M, nu)), and `weights` (one per residual
-/// entry) or `weights_start`/`weights_medium`/`weights_end` + `breakpoints` [i1, i2, i3, i4] (Table 8.2
-/// schedule). M is 1 or one per node. Cost = Σ w r² (no ½, no Δt). `keep_out`: dicts with `joint`,
-/// `center`, `width`, `height` (rad). `us0`: (horizon, nu); `xs0`: optional (horizon + 1, nx) initial
-/// states (feasibility-driven variant). `options`: variant ('ddp'/'fddp'), second_order, max_iter, alphas,
-/// best_alpha, accept_ratio, reg_init, reg_min, reg_max, reg_factor, tol_expected, tol_cost.
-/// `callback(info: dict)` is called after every iteration; returning False stops (so does Ctrl-C), keeping
-/// the best iterate. Returns a dict: xs, us, gains (horizon, nu, ndx), cost, initial_cost, iterations, stop,
-/// stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
-/// and rollout blocks).
-#[pyfunction]
-#[pyo3(signature = (model, x0, dt, horizon, running, terminal, us0, keep_out = None, xs0 = None, options = None, callback = None))]
-#[allow(clippy::too_many_arguments)]
-pub fn ddp_solve<'py>(
-    py: Python<'py>,
-    model: &Bound<'py, PyAny>,
-    x0: Vec<f64>,
+/// The robot action model of a problem description (shared by `ddp_solve` and `DdpMpc`).
+fn build_robot(
+    model: &Bound<'_, PyAny>,
     dt: f64,
     horizon: usize,
-    running: &Bound<'py, PyList>,
-    terminal: &Bound<'py, PyList>,
-    us0: PyReadonlyArray2<'py, f64>,
-    keep_out: Option<&Bound<'py, PyList>>,
-    xs0: Option<PyReadonlyArray2<'py, f64>>,
-    options: Option<&Bound<'py, PyDict>>,
-    callback: Option<Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyDict>> {
+    running: &Bound<'_, PyList>,
+    terminal: &Bound<'_, PyList>,
+    keep_out: Option<&Bound<'_, PyList>>,
+) -> PyResult<FloatingRobot> {
     let mb = model_arg(model)?;
     let m: Model = (*mb.get().inner).clone();
-    let (nx, nu) = (m.nq + m.nv, m.nv);
-    if x0.len() != nx {
-        return Err(input_err(format!("argument `x0`: expected {nx} entries (nq + nv), got {}", x0.len())));
-    }
-    if x0.iter().any(|v| !v.is_finite()) {
-        return Err(input_err("argument `x0`: non-finite entries (NaN or inf) in the initial state"));
-    }
     let run_terms = cost_list(&m, running)?;
     let term_terms = cost_list(&m, terminal)?;
     let mut kos = vec![];
@@ -272,6 +245,56 @@ pub fn ddp_solve<'py>(
             });
         }
     }
+    guard(|| FloatingRobot::new(m, dt, horizon, run_terms, term_terms, kos))
+}
+
+fn check_x0(x0: &[f64], nx: usize) -> PyResult<()> {
+    if x0.len() != nx {
+        return Err(input_err(format!("argument `x0`: expected {nx} entries (nq + nv), got {}", x0.len())));
+    }
+    if x0.iter().any(|v| !v.is_finite()) {
+        return Err(input_err("argument `x0`: non-finite entries (NaN or inf) in the initial state"));
+    }
+    Ok(())
+}
+
+/// Solve a floating-robot optimal-control problem by DDP (Valverde 2018, ch. 8).
+///
+/// State `x = [q; v]` (nq + nv), control `u = τ` (nv: base force and torque in the base frame, then joint
+/// torques), semi-implicit Euler steps of `dt` over `horizon` nodes. `running` / `terminal`: lists of cost
+/// dicts with keys `name`, `kind` ('frame_placement' with `frame` and `reference` (M, 7) [p, quat xyzw];
+/// 'frame_dq' with `frame` and `reference` (M, 8) thesis-layout dual quaternions; 'state' with optional
+/// `reference` (M, nx); 'control' with optional `reference` (M, nu)), and `weights` (one per residual
+/// entry) or `weights_start`/`weights_medium`/`weights_end` + `breakpoints` [i1, i2, i3, i4] (Table 8.2
+/// schedule). M is 1 or one per node. Cost = Σ w r² (no ½, no Δt). `keep_out`: dicts with `joint`,
+/// `center`, `width`, `height` (rad). `us0`: (horizon, nu); `xs0`: optional (horizon + 1, nx) initial
+/// states (feasibility-driven variant). `options`: variant ('ddp'/'fddp'), second_order, max_iter, alphas,
+/// best_alpha, accept_ratio, reg_init, reg_min, reg_max, reg_factor, tol_expected, tol_cost.
+/// `callback(info: dict)` is called after every iteration; returning False stops (so does Ctrl-C), keeping
+/// the best iterate. Returns a dict: xs, us, gains (horizon, nu, ndx), cost, initial_cost, iterations, stop,
+/// stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
+/// and rollout blocks). Option `refresh_gains` (default False): recompute the gains at the returned iterate
+/// (one more derivative evaluation and backward pass), as closed-loop use of the policy needs.
+#[pyfunction]
+#[pyo3(signature = (model, x0, dt, horizon, running, terminal, us0, keep_out = None, xs0 = None, options = None, callback = None))]
+#[allow(clippy::too_many_arguments)]
+pub fn ddp_solve<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    x0: Vec<f64>,
+    dt: f64,
+    horizon: usize,
+    running: &Bound<'py, PyList>,
+    terminal: &Bound<'py, PyList>,
+    us0: PyReadonlyArray2<'py, f64>,
+    keep_out: Option<&Bound<'py, PyList>>,
+    xs0: Option<PyReadonlyArray2<'py, f64>>,
+    options: Option<&Bound<'py, PyDict>>,
+    callback: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut robot = build_robot(model, dt, horizon, running, terminal, keep_out)?;
+    let (nx, nu) = (robot.nx(), robot.nu());
+    check_x0(&x0, nx)?;
     let s = us0.shape();
     if s != [horizon, nu] {
         return Err(input_err(format!("argument `us0`: expected shape ({horizon}, {nu}), got {s:?}")));
@@ -290,8 +313,7 @@ pub fn ddp_solve<'py>(
             Some(a.as_array().iter().copied().collect())
         }
     };
-    let opts = parse_options(options)?;
-    let mut robot = guard(|| FloatingRobot::new(m, dt, horizon, run_terms, term_terms, kos))?;
+    let (opts, refresh) = parse_options(options)?;
     let mut solver = guard(|| Solver::new(&robot, opts))?;
     let mut py_err: Option<PyErr> = None;
     let mut interrupted = false;
@@ -330,7 +352,14 @@ pub fn ddp_solve<'py>(
     let ndx = 2 * nu;
     let xs = PyArray2::from_vec2(py, &sol.xs).map_err(|e| input_err(e.to_string()))?;
     let us = PyArray2::from_vec2(py, &sol.us).map_err(|e| input_err(e.to_string()))?;
-    let gains_flat: Vec<f64> = sol.gains.concat();
+    let mut gains_flat: Vec<f64> = sol.gains.concat();
+    if refresh {
+        // Gains at the returned iterate (closed-loop use), not at the one before the last step.
+        let lambda = sol.history.last().map(|i| i.lambda).filter(|l| l.is_finite()).unwrap_or(0.0);
+        if let Some(g) = guard(|| solver.refresh_gains(&mut robot, lambda))? {
+            gains_flat = g.concat();
+        }
+    }
     let gains = PyArray1::from_vec(py, gains_flat).reshape([n, nu, ndx])?;
     out.set_item("xs", xs)?;
     out.set_item("us", us)?;
@@ -417,4 +446,144 @@ pub fn ddp_frame_dual_quats<'py>(
     });
     let out = guard(|| out)?;
     PyArray2::from_vec2(py, &out).map_err(|e| input_err(e.to_string()))
+}
+
+fn rows3(name: &str, a: &PyReadonlyArray2<f64>, cols: usize, n: usize) -> PyResult<Vec<Vec<f64>>> {
+    let r = rows(name, a, cols)?;
+    if r.len() != n {
+        return Err(input_err(format!("argument `{name}`: expected {n} rows, got {}", r.len())));
+    }
+    Ok(r)
+}
+
+/// The feedback policy of a DDP solution (Valverde 2018, eq. (8.45) with α = 1 on the measured state):
+/// `control(k, x)` = `us[k] + gains[k] (x ⊖ xs[k])`, the state error in the tangent space (base twist, joint
+/// angles, velocities), as the backward pass linearised it; `feedback=False` gives the open-loop `us[k]`.
+/// Nodes past the end use the last one. `xs` (N + 1, nq + nv), `us` (N, nv), `gains` (N, nv, 2 nv).
+#[pyclass(name = "DdpPolicy", module = "freefloat._core")]
+pub struct PyDdpPolicy {
+    robot: FloatingRobot,
+    policy: Policy,
+    out: Vec<f64>,
+}
+
+#[pymethods]
+impl PyDdpPolicy {
+    #[new]
+    fn new(
+        model: &Bound<'_, PyAny>,
+        xs: PyReadonlyArray2<'_, f64>,
+        us: PyReadonlyArray2<'_, f64>,
+        gains: numpy::PyReadonlyArray3<'_, f64>,
+    ) -> PyResult<Self> {
+        let mb = model_arg(model)?;
+        let m: Model = (*mb.get().inner).clone();
+        let (nx, nu) = (m.nq + m.nv, m.nv);
+        let us_r = rows("us", &us, nu)?;
+        let n = us_r.len();
+        let xs_r = rows3("xs", &xs, nx, n + 1)?;
+        let g = gains.as_array();
+        if g.shape() != [n, nu, 2 * nu] {
+            return Err(input_err(format!(
+                "argument `gains`: expected shape ({n}, {nu}, {}), got {:?}",
+                2 * nu,
+                g.shape()
+            )));
+        }
+        let gains_r: Vec<Vec<f64>> =
+            (0..n).map(|k| g.index_axis(numpy::ndarray::Axis(0), k).iter().copied().collect()).collect();
+        let robot = guard(|| FloatingRobot::new(m, 1.0, n, vec![], vec![], vec![]))?;
+        let policy = guard(|| Policy::new(xs_r, us_r, gains_r, nx, 2 * nu, nu))?;
+        Ok(PyDdpPolicy { robot, policy, out: vec![0.0; nu] })
+    }
+
+    /// Control (nv,) at node k for the measured state x = [q; v].
+    #[pyo3(signature = (k, x, feedback = true))]
+    fn control<'py>(
+        &mut self,
+        py: Python<'py>,
+        k: usize,
+        x: Vec<f64>,
+        feedback: bool,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (robot, policy, out) = (&self.robot, &mut self.policy, &mut self.out);
+        guard(|| policy.control(robot, k, &x, feedback, out))?;
+        Ok(PyArray1::from_slice(py, out))
+    }
+
+    /// Number of nodes N.
+    fn __len__(&self) -> usize {
+        self.policy.len()
+    }
+}
+
+/// Receding-horizon DDP (model-predictive control) over a task: the problem description of `ddp_solve`
+/// (model, dt, task horizon N, running/terminal costs, keep_out; scheduled weights frozen at their End column).
+/// `control(k, x)` re-solves the window of `mpc_horizon` nodes starting at task node k from the measured state
+/// every `replan` nodes (warm-started by the previous window shifted in time; the first window by
+/// `guess_xs`/`guess_us` over the whole task if given, else zero controls), and in between applies that
+/// window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
+/// `first_max_iter` bounds the first solve. `stats()`: re-plans, iterations, solve time, slowest re-plan,
+/// troubled re-plans, last stop reason, the cost of each re-plan.
+#[pyclass(name = "DdpMpc", module = "freefloat._core")]
+pub struct PyDdpMpc {
+    mpc: Mpc,
+    out: Vec<f64>,
+}
+
+#[pymethods]
+impl PyDdpMpc {
+    #[new]
+    #[pyo3(signature = (model, dt, horizon, running, terminal, mpc_horizon, replan, keep_out = None, options = None, first_max_iter = 50, guess_xs = None, guess_us = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn new(
+        model: &Bound<'_, PyAny>,
+        dt: f64,
+        horizon: usize,
+        running: &Bound<'_, PyList>,
+        terminal: &Bound<'_, PyList>,
+        mpc_horizon: usize,
+        replan: usize,
+        keep_out: Option<&Bound<'_, PyList>>,
+        options: Option<&Bound<'_, PyDict>>,
+        first_max_iter: usize,
+        guess_xs: Option<PyReadonlyArray2<'_, f64>>,
+        guess_us: Option<PyReadonlyArray2<'_, f64>>,
+    ) -> PyResult<Self> {
+        let robot = build_robot(model, dt, horizon, running, terminal, keep_out)?;
+        let (nx, nu) = (robot.nx(), robot.nu());
+        let (solver, _) = parse_options(options)?;
+        let guess = match (guess_xs, guess_us) {
+            (Some(x), Some(u)) => Some((rows3("guess_xs", &x, nx, horizon + 1)?, rows3("guess_us", &u, nu, horizon)?)),
+            (None, None) => None,
+            _ => return Err(input_err("give both `guess_xs` and `guess_us`, or neither")),
+        };
+        let opts = MpcOptions { horizon: mpc_horizon, replan, solver, first_max_iter };
+        let mpc = guard(|| Mpc::new(&robot, opts, guess))?;
+        Ok(PyDdpMpc { mpc, out: vec![0.0; nu] })
+    }
+
+    /// Control (nv,) at task node k for the measured state x = [q; v] (re-plans when due; Ctrl-C is checked
+    /// between re-plans by the caller's loop).
+    fn control<'py>(&mut self, py: Python<'py>, k: usize, x: Vec<f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (mpc, out) = (&mut self.mpc, &mut self.out);
+        guard(|| mpc.control(k, &x, out))?;
+        Ok(PyArray1::from_slice(py, out))
+    }
+
+    /// What the controller did so far (dict).
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let s = &self.mpc.stats;
+        let d = PyDict::new(py);
+        d.set_item("replans", s.replans)?;
+        d.set_item("iterations", s.iterations)?;
+        d.set_item("solve_time_s", s.solve_time_s)?;
+        d.set_item("max_replan_s", s.max_replan_s)?;
+        d.set_item("troubled_replans", s.troubled)?;
+        d.set_item("last_stop", s.last_stop.clone())?;
+        d.set_item("replan_costs", s.costs.clone())?;
+        d.set_item("horizon", self.mpc.options().horizon)?;
+        d.set_item("replan", self.mpc.options().replan)?;
+        Ok(d)
+    }
 }

@@ -76,6 +76,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ddp::ddp_solve, m)?)?;
     m.add_function(wrap_pyfunction!(ddp::ddp_screw_reference, m)?)?;
     m.add_function(wrap_pyfunction!(ddp::ddp_frame_dual_quats, m)?)?;
+    m.add_class::<ddp::PyDdpPolicy>()?;
+    m.add_class::<ddp::PyDdpMpc>()?;
     m.add_function(wrap_pyfunction!(dqdynamics::dq_condition_number, m)?)?;
     m.add_function(wrap_pyfunction!(concurrent::cl_run, m)?)?;
     m.add_function(wrap_pyfunction!(concurrent::cl_sample, m)?)?;

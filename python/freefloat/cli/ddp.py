@@ -39,7 +39,64 @@ from .._core import InputError
 )
 @click.option("--variant", type=click.Choice(["ddp", "fddp"]), default=None, help="DDP or feasibility-driven DDP.")
 @click.option("--no-plots", is_flag=True, help="Write results.json only.")
-def ddp_cmd(scenario, out, cost, max_iter, no_schedule, no_keep_out, initial_controls, line_search, variant, no_plots):
+@click.option(
+    "--warm-start",
+    is_flag=True,
+    help="Start from the solution of an easier companion problem (same scenario with the log-SE(3) pose cost, "
+    "constant End weights, no keep-out, backtracking line search), with whole joint turns made within one step "
+    "removed (they put the dual quaternion on the opposite sign; docs/ddp.md), instead of the scenario's initial "
+    "controls.",
+)
+@click.option(
+    "--closed-loop",
+    is_flag=True,
+    help="After the solve, run the optimised policy (feed-forward + Riccati gains on the measured state) in the "
+    "simulator with the true dynamics (RK4), next to the open-loop feed-forward, and report both.",
+)
+@click.option(
+    "--mpc",
+    is_flag=True,
+    help="With --closed-loop: also run receding-horizon DDP (re-solve a window from the measured state every "
+    "--replan steps, warm-started by the previous window shifted in time).",
+)
+@click.option("--horizon", type=int, default=100, show_default=True, help="MPC window, in DDP steps.")
+@click.option("--replan", type=int, default=5, show_default=True, help="MPC re-plan period, in DDP steps.")
+@click.option(
+    "--mpc-iter", type=int, default=5, show_default=True, help="DDP iterations per MPC re-plan (warm-started)."
+)
+@click.option(
+    "--model-error",
+    type=float,
+    default=0.0,
+    show_default=True,
+    help="Relative mass (and inertia) error of the simulated plant's --error-body against the model the "
+    "controller was optimised on, e.g. 0.1 for +10 %.",
+)
+@click.option("--error-body", default=None, help="Body whose mass is wrong in the plant (default: the last body).")
+@click.option(
+    "--substeps", type=int, default=5, show_default=True, help="Simulator RK4 steps per DDP step (closed loop)."
+)
+def ddp_cmd(
+    scenario,
+    out,
+    cost,
+    max_iter,
+    no_schedule,
+    no_keep_out,
+    initial_controls,
+    line_search,
+    variant,
+    no_plots,
+    warm_start,
+    closed_loop,
+    mpc,
+    horizon,
+    replan,
+    mpc_iter,
+    model_error,
+    error_body,
+    substeps,
+):
     """Solve a DDP end-effector problem (Valverde 2018, ch. 8) on a built-in scenario or your own YAML file.
 
     Built-in: valverde_ch8_tracking (three-phase helicoidal reference, 640 steps of 0.05 s) and
@@ -47,8 +104,13 @@ def ddp_cmd(scenario, out, cost, max_iter, no_schedule, no_keep_out, initial_con
     (cost, step length, regularisation); Ctrl-C stops and keeps the best iterate. With --out, results.json and the
     figures (poses in 3D, pose errors, base wrench, joint torques, cost per iteration) go to DIR.
 
-    Note: until analytic dynamics derivatives land, the step Jacobians are central finite differences, so an
-    iteration takes about a second or two."""
+    With --closed-loop the optimised policy u = u_k + L_k (x - x_k) runs in the simulator (true continuous
+    dynamics, RK4, optionally a plant with a --model-error mass error) next to the open-loop feed-forward, and with
+    --mpc a receding-horizon DDP as well; results.json gets a `closed_loop` block and the figures
+    closed_loop_errors.png and closed_loop_base_wrench.png.
+
+    Example: freefloat control ddp valverde_ch8_tracking --cost log --no-schedule --line-search backtracking
+    --closed-loop --mpc --horizon 100 --replan 5 --model-error 0.1 --out out/"""
     from ..control import ddp
 
     try:
@@ -62,6 +124,15 @@ def ddp_cmd(scenario, out, cost, max_iter, no_schedule, no_keep_out, initial_con
         )
     except InputError as e:
         raise click.UsageError(str(e)) from None
+    if mpc and not closed_loop:
+        raise click.UsageError("--mpc needs --closed-loop")
+    if closed_loop:
+        if horizon < 1 or replan < 1 or replan > horizon:
+            raise click.UsageError(f"--replan must be between 1 and --horizon ({horizon}), got {replan}")
+        if mpc_iter < 1 or substeps < 1:
+            raise click.UsageError("--mpc-iter and --substeps must be at least 1")
+        if not (model_error > -1.0):
+            raise click.UsageError(f"--model-error must be > -1 (relative), got {model_error}")
     opts = {}
     if line_search == "backtracking":
         opts["alphas"] = [0.5**k for k in range(10)]
@@ -69,6 +140,22 @@ def ddp_cmd(scenario, out, cost, max_iter, no_schedule, no_keep_out, initial_con
         opts["alphas"] = [0.1]
     if variant:
         opts["variant"] = variant
+    warm = None
+    if warm_start:
+        guide = ddp.load_scenario(scenario, cost="log", schedule=False, keep_out=False)
+        click.echo("warm start: solving the companion problem (log-SE(3) cost, End weights, no keep-out) ...")
+        prob, gsol = ddp.warm_started(prob, guide)
+        warm = {
+            "iterations": int(gsol["iterations"]),
+            "final_cost": float(gsol["cost"]),
+            "solve_time_s": float(gsol["solve_time_s"]),
+            "stop": gsol["stop"],
+            "unwound_turns": gsol["unwound"],
+        }
+        click.echo(
+            f"  companion: {warm['iterations']} iterations, cost {warm['final_cost']:.8g}, {warm['solve_time_s']:.2f} s"
+            f" ({gsol['stop_message']})"
+        )
     click.echo(
         f"{prob.name}: {prob.model.name}, N = {prob.horizon}, dt = {prob.dt} s, pose cost '{prob.cost_kind}', "
         f"up to {({**prob.options, **opts}).get('max_iter', 100)} iterations"
@@ -82,9 +169,18 @@ def ddp_cmd(scenario, out, cost, max_iter, no_schedule, no_keep_out, initial_con
         )
         return True
 
+    if closed_loop:
+        opts["refresh_gains"] = True  # gains at the returned iterate, for the closed loop
     sol = ddp.solve(prob, progress=progress, **opts)
     res = ddp.results(prob, sol)
     res["timings"] = sol["timings"]
+    if warm is not None:
+        res["warm_start"] = warm
+    runs = {}
+    if closed_loop:
+        runs, res["closed_loop"] = _closed_loop(
+            prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps
+        )
     click.echo(f"\nstopped: {res['stop_message']}")
     click.echo(
         f"  {res['iterations']} iterations, cost {res['initial_cost']:.6g} -> {res['final_cost']:.10g}, "
@@ -107,6 +203,65 @@ def ddp_cmd(scenario, out, cost, max_iter, no_schedule, no_keep_out, initial_con
             from ..control.ddp_plots import plot_all
 
             paths = plot_all(prob, sol, d)
+            if runs:
+                from ..control.ddp_closed_loop import plot
+
+                paths += plot(runs, prob, d)
             click.echo(f"  wrote {d / 'results.json'} and {len(paths)} figures")
         else:
             click.echo(f"  wrote {d / 'results.json'}")
+
+
+def _closed_loop(prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps):
+    from ..control import ddp_closed_loop as cl
+
+    try:
+        plant = cl.perturbed_model(prob.model, model_error, error_body) if model_error else prob.model
+    except InputError as e:
+        raise click.UsageError(str(e)) from None
+    body = error_body or prob.model.body_names[-1]
+    click.echo(
+        f"\nclosed loop: plant = {prob.model.name}"
+        + (f" with {body} {100 * model_error:+g} % mass" if model_error else " (no model error)")
+        + f", simulated by RK4 at dt/{substeps}"
+    )
+    modes = ["open_loop", "policy"] + (["mpc"] if mpc else [])
+    runs, block = {}, {"plant": {"model_error": model_error, "error_body": body, "substeps": substeps}}
+    for mode in modes:
+        from tqdm.auto import tqdm
+
+        bar = tqdm(total=prob.horizon, desc=f"  {mode}", unit="step", leave=False, disable=None)
+
+        def progress(k, n, bar=bar):
+            bar.update(k - bar.n)
+            return True
+
+        try:
+            r = cl.run(
+                prob,
+                mode,
+                plant,
+                solution=sol,
+                substeps=substeps,
+                mpc_horizon=horizon,
+                replan=replan,
+                mpc_options={"max_iter": mpc_iter},
+                progress=progress,
+            )
+        finally:
+            bar.close()
+        runs[mode] = r
+        s = cl.summary(r)
+        block[mode] = s
+        extra = ""
+        if mode == "mpc":
+            m = s["mpc"]
+            extra = (
+                f"; {m['replans']} re-plans of {horizon} steps every {replan}, {m['iterations']} iterations, "
+                f"{m['solve_time_s']:.2f} s solving (slowest re-plan {1e3 * m['max_replan_s']:.0f} ms)"
+            )
+        click.echo(
+            f"  {mode:>9}: final-hold error <= {1e3 * s['ee_position_error_final_hold_max_m']:.2f} mm, "
+            f"{s['ee_angle_error_final_hold_max_deg']:.3f} deg; RMS {1e3 * s['ee_position_error_rms_m']:.2f} mm{extra}"
+        )
+    return runs, block

@@ -443,3 +443,55 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
         "gap": float(sol["gap"]),
         "cost_history": [float(h["cost"]) for h in sol["history"]],
     }
+
+
+def unwind_joint_turns(model: Model, xs, us) -> tuple[np.ndarray, np.ndarray, list]:
+    """Remove whole turns that a revolute joint makes within one step of a trajectory (xs (N + 1, nx), us (N, nu)).
+
+    A light joint can spin by ~2π between two nodes at no visible cost in a pose cost that only sees the nodes (the
+    converged log-SE(3) tracking solution does it with the wrist at t = 17 s); the pose is the same, but the chain
+    quaternion ends on the opposite sign, where the thesis' component-wise dual-quaternion cost is maximal. Where one
+    step changes a revolute angle by more than π, the whole turns are subtracted from the rest of the trajectory, the
+    spike's velocity is replaced by the mean of its neighbours and the two impulse controls by their neighbours.
+    Returns (xs, us, [(joint, node, turns), ...]); the result is a guess with a gap, for the feasibility-driven
+    solver."""
+    xs, us = np.array(xs, dtype=float), np.array(us, dtype=float)
+    n, nq = len(us), model.nq
+    done = []
+    for i, jt in enumerate(model.joint_types):
+        if jt != "revolute":
+            continue
+        iq, iv = model.idx_q[i], nq + model.idx_v[i]
+        step = np.diff(xs[:, iq])
+        for k in np.flatnonzero(np.abs(step) > math.pi):
+            turns = float(np.round(step[k] / (2 * math.pi)))
+            if turns == 0:
+                continue
+            xs[k + 1 :, iq] -= turns * 2 * math.pi
+            xs[k + 1, iv] = 0.5 * (xs[k, iv] + xs[min(k + 2, n), iv])
+            if k >= 1:
+                us[k, model.idx_v[i]] = us[k - 1, model.idx_v[i]]
+            if k + 2 < n:
+                us[k + 1, model.idx_v[i]] = us[k + 2, model.idx_v[i]]
+            done.append((model.joint_names[i], int(k), turns))
+    return xs, us, done
+
+
+def warm_started(
+    problem: Problem, guide: Problem, max_iter: int = 100, progress=None, unwind: bool = True
+) -> tuple[Problem, dict]:
+    """`problem` with its initial guess (controls and, for the feasibility-driven variant, states) replaced by the
+    solution of `guide`, an easier problem on the same robot, horizon and reference (e.g. the same scenario with
+    the log-SE(3) pose cost, constant End weights and no keep-out, which converges in a few tens of iterations
+    with a backtracking line search), with one-step whole joint turns removed (`unwind_joint_turns`) unless
+    `unwind=False`. Returns (the warm-started problem, the guide's solution, with `unwound` listing the turns)."""
+    if (guide.horizon, guide.model.nv, guide.model.nq) != (problem.horizon, problem.model.nv, problem.model.nq):
+        raise InputError("argument `guide`: its horizon and robot sizes must equal the problem's")
+    sol = solve(guide, progress=progress, max_iter=max_iter, alphas=[0.5**k for k in range(10)])
+    xs, us = np.asarray(sol["xs"], float), np.asarray(sol["us"], float)
+    sol["unwound"] = []
+    if unwind:
+        xs, us, sol["unwound"] = unwind_joint_turns(problem.model, xs, us)
+    from dataclasses import replace
+
+    return replace(problem, us0=us, xs0=xs), sol

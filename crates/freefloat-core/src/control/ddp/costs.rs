@@ -65,6 +65,16 @@ impl Weights {
         let current = start.clone();
         Ok(Weights { start, medium, end, breaks: Some(breaks), current })
     }
+    /// The End-column weights, held constant (what a receding-horizon controller uses: it re-solves from
+    /// warm starts and has no iteration count to schedule against).
+    pub fn frozen_end(&self) -> Weights {
+        let e = self.end.clone();
+        Weights { start: e.clone(), medium: e.clone(), end: e.clone(), breaks: None, current: e }
+    }
+    /// The last iteration at which the weights change (the fourth breakpoint; 0 for constant weights).
+    pub fn schedule_end(&self) -> usize {
+        self.breaks.map(|b| b[3]).unwrap_or(0)
+    }
     /// Number of weights.
     pub fn len(&self) -> usize {
         self.current.len()

@@ -24,6 +24,8 @@ pub use workspace::Workspace;
 pub mod costs;
 pub mod fd_step;
 pub mod lie;
+pub mod mpc;
+pub use mpc::{Mpc, MpcOptions, MpcStats, Policy};
 pub mod robot;
 pub mod step_jacobians;
 pub use robot::FloatingRobot;

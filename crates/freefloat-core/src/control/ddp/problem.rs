@@ -121,4 +121,9 @@ pub trait ActionModel {
     fn set_iteration(&mut self, _i: usize) -> bool {
         false
     }
+    /// The last iteration at which `set_iteration` can still change the cost (0: never). The solver does not
+    /// declare convergence before it: a problem converged at Medium weights is not the problem of the End ones.
+    fn schedule_end(&self) -> usize {
+        0
+    }
 }

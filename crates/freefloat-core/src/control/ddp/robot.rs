@@ -46,6 +46,9 @@ pub struct FloatingRobot {
     pub(crate) tbuf: Vec<f64>,
     /// Forward-dynamics derivatives workspace (analytic step Jacobians).
     pub(crate) deriv: Derivatives,
+    /// Node k of this horizon reads reference k + offset (receding-horizon windows over a longer task; 0
+    /// for an ordinary problem). Past the end of a reference table the last entry holds.
+    pub(crate) offset: usize,
 }
 
 impl FloatingRobot {
@@ -95,8 +98,22 @@ impl FloatingRobot {
                 return Err(FfError::arg("keep_out", format!("bad keep-out term {k:?}")));
             }
         }
+        Ok(Self::build(model, dt, n, running, terminal, keep_out))
+    }
+
+    /// The fields, without the checks of `new` (its callers have checked, or cloned a checked robot).
+    fn build(
+        model: Model,
+        dt: f64,
+        n: usize,
+        running: Vec<CostTerm>,
+        terminal: Vec<CostTerm>,
+        keep_out: Vec<KeepOut>,
+    ) -> FloatingRobot {
+        let (nq, nv) = (model.nq, model.nv);
         let data = Data::new(&model);
-        Ok(FloatingRobot {
+        FloatingRobot {
+            offset: 0,
             data,
             deriv: Derivatives::new(&model),
             dt,
@@ -117,7 +134,45 @@ impl FloatingRobot {
             dxbuf2: vec![0.0; 2 * nv],
             tbuf: vec![0.0; 2 * nv],
             model,
-        })
+        }
+    }
+
+    /// The same problem over a window of `horizon` nodes that starts at node `offset()` of this one
+    /// (receding-horizon control): same model, step, costs and reference tables (node k of the window reads
+    /// reference k + offset, the last entry holding past the end). The window's terminal node uses this
+    /// problem's terminal costs. Iteration-scheduled weights (Table 8.2) are frozen at their End column.
+    pub fn window(&self, horizon: usize) -> Result<FloatingRobot> {
+        if horizon == 0 {
+            return Err(FfError::arg("horizon", "the receding horizon must have at least one node (>= 1)"));
+        }
+        let freeze = |terms: &[CostTerm]| -> Vec<CostTerm> {
+            terms
+                .iter()
+                .map(|t| CostTerm {
+                    name: t.name.clone(),
+                    residual: t.residual.clone(),
+                    weights: t.weights.frozen_end(),
+                })
+                .collect()
+        };
+        Ok(Self::build(
+            self.model.clone(),
+            self.dt,
+            horizon,
+            freeze(&self.running),
+            freeze(&self.terminal),
+            self.keep_out.clone(),
+        ))
+    }
+
+    /// Reference offset of node 0 (see `window`).
+    pub fn offset(&self) -> usize {
+        self.offset
+    }
+
+    /// Make node 0 read reference `offset` (see `window`).
+    pub fn set_offset(&mut self, offset: usize) {
+        self.offset = offset;
     }
 
     /// The robot.
@@ -187,17 +242,17 @@ impl FloatingRobot {
             match &t.residual {
                 Residual::FramePlacement { body, placement, refs } => {
                     let o_mf = self.data.o_mi[*body].compose(placement);
-                    let r = super::lie::log6(&refs[k.min(refs.len() - 1)].inv_compose(&o_mf));
+                    let r = super::lie::log6(&refs[(k + self.offset).min(refs.len() - 1)].inv_compose(&o_mf));
                     total += (0..6).map(|i| w[i] * r[i] * r[i]).sum::<f64>();
                 }
                 Residual::FrameDualQuat { body, placement, refs } => {
                     let o_mf = self.data.o_mi[*body].compose(placement);
                     let g = frame_dual_quat(&self.model, q, *body, placement, &o_mf)?.to_array();
-                    let rf = &refs[k.min(refs.len() - 1)];
+                    let rf = &refs[(k + self.offset).min(refs.len() - 1)];
                     total += (0..8).map(|i| w[i] * (g[i] - rf[i]).powi(2)).sum::<f64>();
                 }
                 Residual::State { refs } => {
-                    let xr = &refs[k.min(refs.len() - 1)];
+                    let xr = &refs[(k + self.offset).min(refs.len() - 1)];
                     Self::difference_q(&self.model, &xr[..nq], q, &mut self.dxbuf[..nv]);
                     for i in 0..nv {
                         self.dxbuf[nv + i] = x[nq + i] - xr[nq + i];
@@ -206,7 +261,7 @@ impl FloatingRobot {
                 }
                 Residual::Control { refs } => {
                     let u = u.expect("control terms are running only");
-                    let ur = &refs[k.min(refs.len() - 1)];
+                    let ur = &refs[(k + self.offset).min(refs.len() - 1)];
                     total += (0..nv).map(|i| w[i] * (u[i] - ur[i]).powi(2)).sum::<f64>();
                 }
             }
@@ -233,7 +288,7 @@ impl FloatingRobot {
                 Residual::FramePlacement { body, placement, refs } => {
                     frame_jacobian(&self.model, &mut self.data, q, *body, placement, Reference::Local, &mut self.jac)?;
                     let o_mf = self.data.o_mi[*body].compose(placement);
-                    let (r, jl) = placement_residual(&o_mf, &refs[k.min(refs.len() - 1)]);
+                    let (r, jl) = placement_residual(&o_mf, &refs[(k + self.offset).min(refs.len() - 1)]);
                     // J = Jr⁻¹(r) J_local (6 × nv), then 2 Jᵀ W r and 2 Jᵀ W J.
                     for c in 0..nv {
                         let col = jl * V6::from_iterator((0..6).map(|i| self.jac[(i, c)]));
@@ -252,14 +307,14 @@ impl FloatingRobot {
                     let g = frame_dual_quat(&self.model, q, *body, placement, &o_mf)?;
                     dual_quat_jacobian(&g, &o_mf, &self.jac, &mut self.jres);
                     let ga = g.to_array();
-                    let rf = &refs[k.min(refs.len() - 1)];
+                    let rf = &refs[(k + self.offset).min(refs.len() - 1)];
                     for i in 0..8 {
                         self.res[i] = ga[i] - rf[i];
                     }
                     add_gauss_newton(&self.jres, 8, &self.res, w, d, nv);
                 }
                 Residual::State { refs } => {
-                    let xr = &refs[k.min(refs.len() - 1)];
+                    let xr = &refs[(k + self.offset).min(refs.len() - 1)];
                     Self::difference_q(&self.model, &xr[..nq], q, &mut self.dxbuf[..nv]);
                     for i in 0..nv {
                         self.dxbuf[nv + i] = x[nq + i] - xr[nq + i];
@@ -296,7 +351,7 @@ impl FloatingRobot {
                 }
                 Residual::Control { refs } => {
                     let u = u.expect("control terms are running only");
-                    let ur = &refs[k.min(refs.len() - 1)];
+                    let ur = &refs[(k + self.offset).min(refs.len() - 1)];
                     for i in 0..nv {
                         d.lu[i] += 2.0 * w[i] * (u[i] - ur[i]);
                         d.luu[(i, i)] += 2.0 * w[i];
@@ -379,6 +434,9 @@ impl ActionModel for FloatingRobot {
     fn calc_diff_terminal(&mut self, x: &[f64], d: &mut NodeDiff) -> Result<()> {
         d.clear();
         self.cost_diff(self.n, x, None, d)
+    }
+    fn schedule_end(&self) -> usize {
+        self.running.iter().chain(self.terminal.iter()).map(|t| t.weights.schedule_end()).max().unwrap_or(0)
     }
     fn set_iteration(&mut self, i: usize) -> bool {
         let mut changed = false;

@@ -212,6 +212,37 @@ impl Solver {
         &self.opts
     }
 
+    /// Replace the options (checked), keeping the workspace: a receding-horizon controller gives its first,
+    /// cold solve more iterations than the warm-started re-plans.
+    pub fn set_options(&mut self, opts: DdpOptions) -> Result<()> {
+        opts.validate()?;
+        self.opts = opts;
+        Ok(())
+    }
+
+    /// Feedback gains at the iterate `solve` returned (still in the workspace), for closed-loop use: the
+    /// gains in `Solution::gains` come from the last backward pass, which ran at the nominal *before* the
+    /// last accepted step. This runs the derivatives and one backward pass at the returned nominal, starting
+    /// at `lambda` and raising it by the regularisation schedule until Q_uu + λI is positive definite.
+    /// Returns the gains (N, each nu × ndx row-major) or None if no λ up to the maximum works (then the
+    /// caller keeps `Solution::gains`).
+    pub fn refresh_gains(&mut self, model: &mut dyn ActionModel, lambda: f64) -> Result<Option<Vec<Vec<f64>>>> {
+        self.calc_diff(model)?;
+        let gaps = self.opts.variant == Variant::Fddp && !self.ws.is_feasible(self.opts.tol_gap);
+        let mut reg = Regularisation::new(RegOptions { init: lambda.max(0.0), ..self.opts.reg });
+        loop {
+            match backward_pass(model, &mut self.ws, reg.lambda, self.opts.second_order, gaps)? {
+                Backward::Done => break,
+                Backward::NotPositiveDefinite(_) => {
+                    if !reg.increase() {
+                        return Ok(None);
+                    }
+                }
+            }
+        }
+        Ok(Some(self.ws.kfb.iter().map(|k| k.transpose().as_slice().to_vec()).collect()))
+    }
+
     /// Solve from `x0` with the initial controls `us0` (N × nu, flat) and, for the feasibility-driven
     /// variant, optionally an initial state trajectory `xs0` ((N + 1) × nx, flat; default: the rollout).
     /// `callback` sees every iteration and returns false to stop (the best iterate is kept).
@@ -254,6 +285,7 @@ impl Solver {
         let mut stop = StopReason::MaxIterations;
         let mut iterations = 0;
         let mut tm = Timings::default();
+        let schedule_end = model.schedule_end();
         for iter in 1..=opts.max_iter {
             iterations = iter;
             if iter > 1 && model.set_iteration(iter) {
@@ -327,6 +359,16 @@ impl Solver {
                     backward_passes: passes,
                 };
                 history.push(info.clone());
+                if iter < schedule_end {
+                    // Converged at this iteration's weights, but the schedule will still change them: go on
+                    // (the next iteration re-evaluates the nominal at the new weights).
+                    if !callback(&info) {
+                        stop = StopReason::Interrupted;
+                        break;
+                    }
+                    need_diff = false;
+                    continue;
+                }
                 callback(&info);
                 stop = StopReason::Converged;
                 break;
