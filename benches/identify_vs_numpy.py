@@ -368,7 +368,11 @@ def main():
             f"| {row['what']} | {row['freefloat_s']:.4f} ({f_lo:.4f}-{f_hi:.4f}) | {row['peer_s']:.4f} "
             f"({p_lo:.4f}-{p_hi:.4f}) | {row['ratio']:.1f}x | {row['target']} ({'met' if row['met'] else 'not met'}) |"
         )
-    md += ["", f"Solve routes of the peer on the full {6 * T:,} x {mp.n_min} matrix (timed once each, build excluded):", ""]
+    md += [
+        "",
+        f"Solve routes of the peer on the full {6 * T:,} x {mp.n_min} matrix (timed once each, build excluded):",
+        "",
+    ]
     md += ["| route | seconds | agreement with freefloat |", "|---|---|---|"]
     for name, v in routes.items():
         md.append(f"| {name} | {v['seconds_once']:.3f} | {v['agreement_with_freefloat']:.1e} |")
