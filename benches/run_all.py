@@ -97,7 +97,8 @@ def rows_identify(res: dict) -> list[Row]:
                 what=f"{r['what']}, {res['samples']:,} samples, {cores} core(s)",
                 peer=r["peer"],
                 ratio=r["ratio"],
-                spread=_range(*r["ratio_range"]),
+                spread=_range(*r["ratio_range"])
+                + (f"; CPU-time ratio {r['cpu_ratio']:.2f}" if "cpu_ratio" in r else ""),
                 freefloat=fmt_s(r["freefloat_s"]),
                 peer_value=fmt_s(r["peer_s"]),
                 target=f"{r['target']} ({'met' if r['met'] else 'not met'})",
