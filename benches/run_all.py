@@ -192,16 +192,20 @@ def rows_derivatives(res: dict) -> list[Row]:
 def rows_cl(res: dict) -> list[Row]:
     out = []
     for r in res.get("rows", []):
-        if isinstance(r, dict):
-            ns = r.get("N_s", r.get("ns", "?"))
-            ratio = r.get("estimator_ratio", r.get("ratio"))
-            out.append(
-                Row(
-                    f"concurrent learning (Valverde ch. 9), N_s = {ns}, estimator",
-                    "numpy (batched)",
-                    ratio if isinstance(ratio, (int, float)) else None,
-                )
+        ns = r.get("ns", "?")
+        spread = _range(r["numpy_min"] / r["estimator_max"], r["numpy_max"] / r["estimator_min"])
+        out.append(
+            Row(
+                f"concurrent learning (Valverde ch. 9), N_s = {ns}, estimator",
+                "numpy (batched)",
+                r["ratio_estimator"],
+                spread,
+                fmt_s(r["estimator_s"]),
+                fmt_s(r["numpy_s"]),
+                ">= 10",
+                note=f"whole run {r['ratio_whole_run']:.2f}",
             )
+        )
     return out
 
 
