@@ -254,6 +254,7 @@ def _row(title, med, spread, k):
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default="benches/results")
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     ap.add_argument("--quick", action="store_true", help="5 s runs, 1 repeat")
     ap.add_argument("--repeats", type=int, default=None)
     a = ap.parse_args(argv)
@@ -312,6 +313,8 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "adaptive_bench.json").write_text(json.dumps(res, indent=1))
+    if a.json:
+        Path(a.json).write_text(json.dumps(res, indent=1, default=str))
     lines = [
         "# ch. 4 adaptive pose tracking: freefloat vs numpy/scipy",
         "",

@@ -83,6 +83,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="small problem, one repeat (CI smoke run)")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "results"))
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     ap.add_argument("--runs", type=int, help="runs per campaign (default 16; quick 4)")
     ap.add_argument("--duration", type=float, help="simulated seconds per run (default 20: ~1 s of work)")
     ap.add_argument("--repeats", type=int, help="interleaved repeats (default 3; quick 1)")
@@ -157,6 +158,8 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "campaign_bench.json").write_text(json.dumps(res, indent=1))
+    if a.json:
+        Path(a.json).write_text(json.dumps(res, indent=1, default=str))
     md = [
         "# Campaign throughput on Dask (LocalCluster)",
         "",

@@ -191,6 +191,7 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--repeats", type=int, default=None)
     ap.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     a = ap.parse_args()
     ns_list = [10, 50] if a.quick else [10, 50, 100, 200, 300]
     repeats = a.repeats or (1 if a.quick else 5)
@@ -271,6 +272,8 @@ def main():
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "cl_vs_numpy.json").write_text(json.dumps(res, indent=2))
+    if a.json:
+        Path(a.json).write_text(json.dumps(res, indent=1, default=str))
     md = [
         f"# freefloat vs numpy: Valverde 2018 ch. 9 concurrent learning ({res['when']})",
         "",

@@ -90,6 +90,7 @@ def parse_args(argv=None):
     p.add_argument("--t-final", type=float, default=None, help="simulated time in s (default 10)")
     p.add_argument("--dt", type=float, default=1e-3, help="RK4 step (default 1e-3)")
     p.add_argument("--seed", type=int, default=0, help="random seed for the states")
+    p.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     a = p.parse_args(argv)
     a.repeats = a.repeats or (2 if a.quick else 5)
     a.batch = a.batch or (2000 if a.quick else 20000)
@@ -821,6 +822,8 @@ def main(argv=None):
         "targets_met": checks,
     }
     (args.out / "compare_pinocchio.json").write_text(json.dumps(result, indent=1))
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1, default=str))
     (args.out / "compare_pinocchio.md").write_text(report + "\n")
     print(f"[compare_pinocchio] wrote {args.out / 'compare_pinocchio.json'} and .md", file=sys.stderr)
     return 0

@@ -202,6 +202,7 @@ def crocoddyl_blocks(solver, n: int, reps: int = 10) -> dict:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", required=True, help="Directory for ddp_vs_crocoddyl.json and .md")
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     ap.add_argument("--quick", action="store_true", help="N = 80 and 1 repeat (smoke run)")
     ap.add_argument("--repeats", type=int, default=None)
     a = ap.parse_args(argv)
@@ -281,6 +282,8 @@ def main(argv=None) -> int:
     out = Path(a.out)
     out.mkdir(parents=True, exist_ok=True)
     (out / "ddp_vs_crocoddyl.json").write_text(json.dumps(res, indent=2))
+    if a.json:
+        Path(a.json).write_text(json.dumps(res, indent=1, default=str))
     ra = res["ratios_freefloat_over_crocoddyl"]
     md = [
         "# freefloat DDP vs Crocoddyl 3.2.1 (ch. 8 tracking, log-SE(3) cost, End weights, zero start)",

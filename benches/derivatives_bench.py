@@ -289,6 +289,7 @@ def main(argv=None):
     ap.add_argument("--states", type=int, default=None, help="states per repeat (default 640, quick 40)")
     ap.add_argument("--repeats", type=int, default=None, help="interleaved repeats (default 7, quick 2)")
     ap.add_argument("--out", type=Path, default=None, help="folder for derivatives_bench.json/.md")
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     args = ap.parse_args(argv)
     n = args.states or (40 if args.quick else 640)
     reps = args.repeats or (2 if args.quick else 7)
@@ -326,6 +327,8 @@ def main(argv=None):
         (args.out / "derivatives_bench.md").write_text(
             "# freefloat dynamics derivatives vs Pinocchio and Crocoddyl\n" + "\n".join(md) + "\n"
         )
+    if args.json:
+        Path(args.json).write_text(json.dumps(out, indent=1, default=str))
     return 0
 
 

@@ -14,6 +14,7 @@ Before timing, dq_dynamics is checked against ABA (abort above 1e-9 relative).
 from __future__ import annotations
 
 import argparse
+import json
 import time
 from pathlib import Path
 
@@ -87,6 +88,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--out", default=str(Path(__file__).parent / "results"))
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     args = ap.parse_args()
     n, reps = (200, 3) if args.quick else (2000, 7)
     rng = np.random.default_rng(1)
@@ -116,6 +118,9 @@ def main():
         f"Per-evaluation cost, batch of {n} states, median of {reps} interleaved repeats "
         f"({time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}).\n\n" + "\n".join(md) + "\n"
     )
+    if args.json:
+        keys = ["robot", "bodies", "nv", "dq_us", "decoupled_us", "aba_us", "aba_rnea_us", "rel_diff"]
+        Path(args.json).write_text(json.dumps({"rows": [dict(zip(keys, r)) for r in rows], "repeats": reps}, indent=1))
     print("\n".join(md))
 
 

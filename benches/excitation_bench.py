@@ -281,6 +281,7 @@ def main():
     ap.add_argument("--repeats", type=int, default=None, help="timing repeats (default 31, quick 5)")
     ap.add_argument("--design-repeats", type=int, default=None, help="full-design repeats (default 2, quick 1)")
     ap.add_argument("--out", type=Path, default=None)
+    ap.add_argument("--json", default=None, help="also write the results (JSON) to this file (read by run_all.py)")
     args = ap.parse_args()
     if args.out is None:
         args.out = Path(__file__).resolve().parent / "results" / ("quick" if args.quick else "")
@@ -484,6 +485,8 @@ def main():
     text = "\n".join(md) + "\n"
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "excitation_bench.json").write_text(json.dumps(res, indent=2))
+    if args.json:
+        Path(args.json).write_text(json.dumps(res, indent=1, default=str))
     (args.out / "excitation_bench.md").write_text(text)
     print(text)
 

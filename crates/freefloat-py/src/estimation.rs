@@ -55,7 +55,11 @@ pub fn identify_momentum<'py>(
     d.set_item("rows", res.rows)?;
     d.set_item(
         "method",
-        if res.method == Method::GramRefined { "normal equations + refinement" } else { "streaming QR" },
+        match res.method {
+            Method::GramRefined => "normal equations + refinement",
+            Method::Gram => "normal equations",
+            Method::StreamingQr => "streaming QR",
+        },
     )?;
     Ok(d)
 }

@@ -31,7 +31,7 @@ class LeastSquaresResult:
     dof: int  # rows - n_min
     condition_number: float  # 2-norm condition number of the weighted regressor G_m
     rows: int  # 6 x samples
-    method: str  # "normal equations + refinement" or "streaming QR"
+    method: str  # "normal equations", "normal equations + refinement" or "streaming QR"
     names: list = field(default_factory=list)
 
     @property

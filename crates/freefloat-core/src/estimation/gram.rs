@@ -52,10 +52,53 @@ impl GramLs {
         self.rows += rows;
     }
 
+    /// Add rows `start..start + rows` of `block` = `[A_b | y_b]` (column-major, n+1 columns, weighted).
+    pub fn add_augmented_range(&mut self, block: &DMatrix<f64>, start: usize, rows: usize) {
+        let cap = block.nrows();
+        assert!(start + rows <= cap, "rows {start}..{} outside the block of {cap}", start + rows);
+        let n1 = self.n + 1;
+        let s = &block.as_slice()[start..];
+        let b = strided(s, rows, n1, 1, cap);
+        let bt = strided(s, n1, rows, cap, 1);
+        self.g.gemm(1.0, &bt, &b, 1.0);
+        self.rows += rows;
+    }
+
+    /// Add `small` ((k × k), the Gram matrix of rows whose only nonzero entries are in the augmented
+    /// columns `idx`) into the accumulated matrix, counting `rows` rows.
+    pub(super) fn add_scattered(&mut self, idx: &[usize], small: &DMatrix<f64>, rows: usize) {
+        for (a, &i) in idx.iter().enumerate() {
+            for (b, &j) in idx.iter().enumerate() {
+                self.g[(i, j)] += small[(a, b)];
+            }
+        }
+        self.rows += rows;
+    }
+
     /// Add another accumulator's rows (the parallel reduction).
     pub fn merge(&mut self, other: &GramLs) {
         self.g += &other.g;
         self.rows += other.rows;
+    }
+
+    /// Residual sum of squares at `x` from the accumulated matrix alone: `yᵀy − 2xᵀAᵀy + xᵀAᵀAx`, and
+    /// `yᵀy`. The subtraction cancels digits: the absolute error is about n·ε·yᵀy, so the caller
+    /// only trusts it when the RSS is not tiny against yᵀy (see [`super::identify_momentum`]).
+    pub fn rss_at(&self, x: &DVector<f64>) -> (f64, f64) {
+        let n = self.n;
+        let g = &self.g;
+        let mut quad = 0.0;
+        let mut lin = 0.0;
+        for j in 0..n {
+            let mut row = 0.0;
+            for i in 0..n {
+                row += g[(i, j)] * x[i];
+            }
+            quad += row * x[j];
+            lin += g[(j, n)] * x[j];
+        }
+        let yty = g[(n, n)];
+        (yty - 2.0 * lin + quad, yty)
     }
 
     /// Factor the normal equations, or None if the Cholesky fails (numerically singular).

@@ -257,7 +257,7 @@ impl ModifiedRls {
             w: &mut self.w,
         };
         match (n_th, n_d) {
-            (12, 20) => theta_rows(12, 20, st, s, &self.d_new)?,
+            (12, 20) => theta_rows_fixed::<12, 20>(st, s, &self.d_new)?,
             _ => theta_rows(n_th, n_d, st, s, &self.d_new)?,
         }
         std::mem::swap(&mut self.d_prev, &mut self.d_new);
@@ -308,6 +308,39 @@ fn theta_rows(n_th: usize, n_d: usize, st: ThetaState, s: &CoupledSample, d_new:
             let (g, row) = (st.u[i], &mut sens[i * n_d..(i + 1) * n_d]);
             for c in 0..n_d {
                 row[c] += g * w[c];
+            }
+        }
+    }
+    Ok(())
+}
+
+/// [`theta_rows`] for sizes known at compile time (the 3D problem: n_θ = 12, n_D = 20): M as rows of
+/// arrays, so the two M passes per row have constant trip counts and no bounds checks.
+#[inline(always)]
+fn theta_rows_fixed<const NT: usize, const ND: usize>(st: ThetaState, s: &CoupledSample, d_new: &[f64]) -> Result<()> {
+    let (rows, _) = st.sens[..NT * ND].as_chunks_mut::<ND>();
+    let sens: &mut [[f64; ND]; NT] = rows.try_into().expect("n_θ × n_D sensitivity");
+    let d_new: &[f64; ND] = d_new[..ND].try_into().expect("n_D entries of D(μ)");
+    for j in 0..s.y.len() {
+        let phi: &[f64; NT] = s.phi[j * NT..(j + 1) * NT].try_into().expect("n_θ regressors");
+        let psi: &[f64; ND] = s.psi[j * ND..(j + 1) * ND].try_into().expect("n_D coupling entries");
+        let mut y = s.y[j];
+        for c in 0..ND {
+            y += psi[c] * d_new[c];
+        }
+        row_update(st.p, st.theta, phi, y, st.u)?;
+        // u now holds the gain k; w = ψ_j − φ_jᵀ M, then M += k wᵀ (eq. 38)
+        let mut w = *psi;
+        for i in 0..NT {
+            let f = phi[i];
+            for c in 0..ND {
+                w[c] -= f * sens[i][c];
+            }
+        }
+        for i in 0..NT {
+            let g = st.u[i];
+            for c in 0..ND {
+                sens[i][c] += g * w[c];
             }
         }
     }
