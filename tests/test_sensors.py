@@ -41,6 +41,7 @@ def overlapping_allan(y, dt, ms):
 
 
 # ---------------------------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_gyro_allan_deviation_recovers_angle_random_walk_and_bias_instability():
     m = models.load("zhang2020_3d")
     rate, hours = 50.0, 2.0
@@ -264,8 +265,10 @@ def test_uneven_run_and_missing_velocity_sensor_are_errors():
     with pytest.raises(InputError, match="evenly spaced"):
         sn.measure(m, run, sn.naveen())
     run = still_run(m, 100, 1e-3)
+    meas = sn.measure(m, run, [sn.Gyro(), sn.Tachometer()])
+    assert meas.telemetry is None and len(meas.streams["gyro"].t) == 100
     with pytest.raises(InputError, match=r"no sensor measures v\.base\.vx"):
-        sn.measure(m, run, [sn.Gyro(), sn.Tachometer()])
+        meas.require_telemetry()
     with pytest.raises(InputError, match="telemetry.poses"):
         sn.SensorSet([], poses="guess")
 
@@ -298,6 +301,7 @@ def test_slower_sensors_are_held_and_measured_poses_come_from_the_sensors():
 
 
 # ---------------------------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_naveen_preset_is_the_same_measurement_model_as_add_noise():
     """The preset and `add_noise` draw from different generators (ChaCha8 in the engine, numpy's PCG64), so the
     draws differ; the model is the same: zero-mean white noise of the paper's σ on each rate group, poses rebuilt
@@ -331,12 +335,15 @@ def test_naveen_preset_is_the_same_measurement_model_as_add_noise():
                 ("preset", sn.measure(m, clean, "naveen", seed=seed).telemetry),
                 ("add_noise", add_noise(clean, m, np.random.default_rng(seed))),
             ):
-                errs[name].append(idf.identify_minimal(m, tel, rate_noise="none", check="off").errors(m)["median_rel_error_pct"])
+                errs[name].append(
+                    idf.identify_minimal(m, tel, rate_noise="none", check="off").errors(m)["median_rel_error_pct"]
+                )
     a, b = np.median(errs["preset"]), np.median(errs["add_noise"])
     assert 0.33 < a / b < 3.0, errs
 
 
 # ---------------------------------------------------------------------------------------------------------------
+@pytest.mark.slow
 def test_cli_simulate_measure_identify(tmp_path):
     from click.testing import CliRunner
 
@@ -357,7 +364,9 @@ def test_cli_simulate_measure_identify(tmp_path):
         + models.load("naveen_dual_arm").joint_names[6]
         + ", force_noise: 0.01}\n"
     )
-    res = r.invoke(main, ["measure", str(run_dir), "--sensors", str(sensors_file), "--out", str(tel_dir), "--seed", "3"])
+    res = r.invoke(
+        main, ["measure", str(run_dir), "--sensors", str(sensors_file), "--out", str(tel_dir), "--seed", "3"]
+    )
     assert res.exit_code == 0, res.output
     assert (tel_dir / "telemetry.csv").exists() and (tel_dir / "sensor_wrist.csv").exists()
     info = json.loads((tel_dir / "results.json").read_text())

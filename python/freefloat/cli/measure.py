@@ -87,13 +87,16 @@ def measure_cmd(run, sensors_spec, out, seed, model_spec):
         )
     meas = sn.measure(m, traj, sset, seed=seed)
     tel = meas.telemetry
-    click.echo(
-        f"{m.name}: {len(traj.t)} run samples -> {len(tel.t)} telemetry samples "
-        f"({tel.t[0]:.6g} .. {tel.t[-1]:.6g} s), seed {seed}"
-    )
+    if tel is None:
+        click.echo(f"{m.name}: {len(traj.t)} run samples, seed {seed}; no telemetry table: {meas.why_no_telemetry}")
+    else:
+        click.echo(
+            f"{m.name}: {len(traj.t)} run samples -> {len(tel.t)} telemetry samples "
+            f"({tel.t[0]:.6g} .. {tel.t[-1]:.6g} s), seed {seed}"
+        )
     for name, s in meas.streams.items():
         click.echo(f"  {name:16s} {1.0 / s.period:10.6g} Hz  {len(s.t):8d} samples  {len(s.columns)} columns")
-    if tel.rate_noise is not None:
+    if tel is not None and tel.rate_noise is not None:
         click.echo("  declared white rate noise (for identification): " + ", ".join(f"{x:.3g}" for x in tel.rate_noise))
     written = meas.write(out)
     click.echo(f"  wrote {', '.join(map(str, written))}")

@@ -215,9 +215,7 @@ def load(spec) -> SensorSet:
     if isinstance(spec, (str, Path)):
         p = Path(spec)
         if not p.exists():
-            raise FileNotFoundError(
-                f"sensors file not found: {p} (or a preset: {', '.join(PRESETS)})"
-            )
+            raise FileNotFoundError(f"sensors file not found: {p} (or a preset: {', '.join(PRESETS)})")
         import yaml
 
         try:
@@ -229,7 +227,9 @@ def load(spec) -> SensorSet:
     if isinstance(spec, dict):
         unknown = set(spec) - {"sensors", "telemetry", "preset"}
         if unknown:
-            raise InputError(f"sensors file: unknown top-level key(s) {sorted(unknown)} (known: sensors, telemetry, preset)")
+            raise InputError(
+                f"sensors file: unknown top-level key(s) {sorted(unknown)} (known: sensors, telemetry, preset)"
+            )
         tel = spec.get("telemetry") or {}
         if not isinstance(tel, dict) or set(tel) - {"rate", "poses"}:
             raise InputError(f"telemetry: expected a mapping with keys rate, poses; got {tel!r}")
@@ -271,32 +271,46 @@ class Measurement:
     """The result of `measure`: every sensor's stream, and their assembly into one Telemetry."""
 
     streams: dict
+    #: the assembled Telemetry, or None when the sensors do not measure every velocity (see why_no_telemetry)
     telemetry: object
     sensors: SensorSet
     seed: int
+    why_no_telemetry: str = ""
+
+    def require_telemetry(self):
+        """The Telemetry, or an InputError saying which columns no sensor measures."""
+        if self.telemetry is None:
+            raise InputError(self.why_no_telemetry)
+        return self.telemetry
 
     def summary(self) -> dict:
         return {
             "seed": int(self.seed),
             "sensors": self.sensors.to_dict(),
             "streams": {
-                n: {"samples": len(s.t), "period_s": s.period, "columns": list(s.columns)} for n, s in self.streams.items()
+                n: {"samples": len(s.t), "period_s": s.period, "columns": list(s.columns)}
+                for n, s in self.streams.items()
             },
-            "telemetry": {
+            "telemetry": None
+            if self.telemetry is None
+            else {
                 "samples": len(self.telemetry.t),
                 "t_start": float(self.telemetry.t[0]),
                 "t_end": float(self.telemetry.t[-1]),
                 "rate_noise": self.telemetry.rate_noise,
             },
+            **({"why_no_telemetry": self.why_no_telemetry} if self.telemetry is None else {}),
         }
 
     def write(self, out) -> list:
-        """Write DIR/telemetry.csv (what `freefloat identify minimal` reads), DIR/sensor_<name>.csv for each
+        """Write DIR/telemetry.csv (what `freefloat identify minimal` reads; when assembled), DIR/sensor_<name>.csv for each
         sensor, and DIR/results.json. Returns the paths written."""
         d = Path(out)
         d.mkdir(parents=True, exist_ok=True)
-        written = [d / "telemetry.csv"]
-        self.telemetry.to_csv(written[0])
+        written = []
+        if self.telemetry is not None:
+            written.append(d / "telemetry.csv")
+            self.telemetry.to_csv(written[0])
         for n, s in self.streams.items():
             p = d / f"sensor_{n}.csv"
             s.to_csv(p)
@@ -312,7 +326,9 @@ def _run_arrays(model, run):
     get = (lambda k: run.get(k)) if isinstance(run, dict) else (lambda k: getattr(run, k, None))
     t, q, v = get("t"), get("q"), get("v")
     if t is None or q is None or v is None:
-        raise InputError(f"argument `run`: expected a Trajectory, Telemetry or dict with t, q, v; got {type(run).__name__}")
+        raise InputError(
+            f"argument `run`: expected a Trajectory, Telemetry or dict with t, q, v; got {type(run).__name__}"
+        )
     ddq = get("ddq")
     if ddq is not None and np.asarray(ddq).size == 0:
         ddq = None
@@ -330,7 +346,8 @@ def measure(model, run, sensors, seed: int = 0) -> Measurement:
     column holds its sensor's latest sample (zero-order hold). Every v column must come from a sensor; q columns
     too with poses="measured", else they are rebuilt by integrating the measured v (poses="integrate"). The
     momentum column, if the run has one, is the true momentum at the grid times (a known quantity, as in
-    Naveen, Shah, Misra). `rate_noise` of the telemetry is the per-component white-noise standard deviation the
+    Naveen, Shah, Misra). When the sensors do not measure every velocity, `telemetry` is None (the streams are
+    still there; `Measurement.require_telemetry()` raises the reason). `rate_noise` of the telemetry is the per-component white-noise standard deviation the
     rate sensors declare (for identification's errors-in-variables bias removal), None if all are zero."""
     from ..io.telemetry import Telemetry, integrate_poses
 
@@ -357,11 +374,12 @@ def measure(model, run, sensors, seed: int = 0) -> Measurement:
     need_q = [f"q.{n}" for n in qlab] if sset.poses == "measured" else []
     missing += [c for c in need_q if c not in owner]
     if missing:
-        raise InputError(
+        why = (
             f"sensors: no sensor measures {', '.join(missing)} (velocities need a base_velocity, a gyro and "
             "tachometers on the joints; with poses: measured the configuration needs base_position, star_tracker "
             "and encoders)"
         )
+        return Measurement(streams=streams, telemetry=None, sensors=sset, seed=int(seed), why_no_telemetry=why)
     feeders = sorted({owner[c][0] for c in need_v + need_q}, key=lambda n: streams[n].period)
     if sset.telemetry_rate is None:
         grid = streams[feeders[0]].t

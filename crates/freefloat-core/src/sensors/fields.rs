@@ -35,9 +35,7 @@ impl Fields {
     }
 
     fn number(&self, k: &str, v: &Value) -> Result<f64> {
-        let x = v
-            .as_f64()
-            .ok_or_else(|| FfError::arg(&self.key(k), format!("expected a number, got {}", show(v))))?;
+        let x = v.as_f64().ok_or_else(|| FfError::arg(&self.key(k), format!("expected a number, got {}", show(v))))?;
         if !x.is_finite() {
             return Err(FfError::arg(&self.key(k), format!("must be finite, got {x}")));
         }

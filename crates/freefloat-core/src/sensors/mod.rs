@@ -121,13 +121,18 @@ pub(crate) struct SensorRun<'a> {
 /// force_torque), optional `name` (default: the type), `rate` [Hz], `latency` [s], and its sensor's keys.
 /// Unknown keys, negative noise, a non-positive rate, duplicate names: errors naming the key.
 pub fn parse_sensors(text: &str) -> Result<Vec<Sensor>> {
-    let doc: Value = serde_norway::from_str(text).map_err(|e| FfError::arg("sensors", format!("not YAML/JSON: {e}")))?;
+    let doc: Value =
+        serde_norway::from_str(text).map_err(|e| FfError::arg("sensors", format!("not YAML/JSON: {e}")))?;
     let list = match doc {
         Value::Sequence(s) => s,
         Value::Mapping(mut m) => match m.remove(Value::String("sensors".into())) {
             Some(Value::Sequence(s)) => s,
-            Some(other) => return Err(FfError::arg("sensors", format!("expected a list of sensors, got {}", show(&other)))),
-            None => return Err(FfError::arg("sensors", "expected a list of sensors (or a mapping with a `sensors:` list)")),
+            Some(other) => {
+                return Err(FfError::arg("sensors", format!("expected a list of sensors, got {}", show(&other))))
+            }
+            None => {
+                return Err(FfError::arg("sensors", "expected a list of sensors (or a mapping with a `sensors:` list)"))
+            }
         },
         other => return Err(FfError::arg("sensors", format!("expected a list of sensors, got {}", show(&other)))),
     };
@@ -135,10 +140,14 @@ pub fn parse_sensors(text: &str) -> Result<Vec<Sensor>> {
     for (i, item) in list.into_iter().enumerate() {
         let map = match item {
             Value::Mapping(m) => m,
-            other => return Err(FfError::arg(&format!("sensors[{i}]"), format!("expected a mapping, got {}", show(&other)))),
+            other => {
+                return Err(FfError::arg(&format!("sensors[{i}]"), format!("expected a mapping, got {}", show(&other))))
+            }
         };
         let mut f = Fields::new(map, format!("sensors[{i}]"));
-        let ty = f.string("type")?.ok_or_else(|| FfError::arg(&format!("sensors[{i}].type"), format!("missing (one of: {})", TYPES.join(", "))))?;
+        let ty = f.string("type")?.ok_or_else(|| {
+            FfError::arg(&format!("sensors[{i}].type"), format!("missing (one of: {})", TYPES.join(", ")))
+        })?;
         let name = f.string("name")?.unwrap_or_else(|| ty.clone());
         f.ctx = format!("sensors.{name}");
         let rate = f.positive("rate", "Hz")?;
@@ -151,11 +160,19 @@ pub fn parse_sensors(text: &str) -> Result<Vec<Sensor>> {
             "base_velocity" => SensorKind::Navigation(NavigationConfig::parse(&mut f, NavQuantity::Velocity)?),
             "base_position" => SensorKind::Navigation(NavigationConfig::parse(&mut f, NavQuantity::Position)?),
             "force_torque" => SensorKind::ForceTorque(ForceTorqueConfig::parse(&mut f)?),
-            other => return Err(FfError::arg(&format!("sensors[{i}].type"), format!("unknown sensor type '{other}' (known: {})", TYPES.join(", ")))),
+            other => {
+                return Err(FfError::arg(
+                    &format!("sensors[{i}].type"),
+                    format!("unknown sensor type '{other}' (known: {})", TYPES.join(", ")),
+                ))
+            }
         };
         f.finish()?;
         if out.iter().any(|s| s.name == name) {
-            return Err(FfError::arg(&format!("sensors[{i}].name"), format!("'{name}' names two sensors (names must be unique)")));
+            return Err(FfError::arg(
+                &format!("sensors[{i}].name"),
+                format!("'{name}' names two sensors (names must be unique)"),
+            ));
         }
         out.push(Sensor { name, rate, latency, kind });
     }
@@ -163,14 +180,21 @@ pub fn parse_sensors(text: &str) -> Result<Vec<Sensor>> {
 }
 
 /// The sensor types `parse_sensors` knows.
-pub const TYPES: [&str; 7] = ["gyro", "star_tracker", "encoder", "tachometer", "base_velocity", "base_position", "force_torque"];
+pub const TYPES: [&str; 7] =
+    ["gyro", "star_tracker", "encoder", "tachometer", "base_velocity", "base_position", "force_torque"];
 
 /// Sample the run `s` of model `m` with every sensor (see the module documentation for the resampling
 /// rule), each from its own random stream of `seed`. Returns one stream per sensor, in order.
 pub fn measure(m: &Model, s: &Samples, sensors: &[Sensor], seed: u64) -> Result<Vec<Stream>> {
     let n = s.t.len();
     if s.nq != m.nq || s.nv != m.nv {
-        return Err(FfError::arg("trajectory", format!("rows of {} and {} numbers (q, v), model '{}' has nq = {}, nv = {}", s.nq, s.nv, m.name, m.nq, m.nv)));
+        return Err(FfError::arg(
+            "trajectory",
+            format!(
+                "rows of {} and {} numbers (q, v), model '{}' has nq = {}, nv = {}",
+                s.nq, s.nv, m.name, m.nq, m.nv
+            ),
+        ));
     }
     crate::check::check_len("trajectory.q", s.q.len(), n * m.nq)?;
     crate::check::check_len("trajectory.v", s.v.len(), n * m.nv)?;
@@ -192,7 +216,11 @@ pub fn measure(m: &Model, s: &Samples, sensors: &[Sensor], seed: u64) -> Result<
         if (step - dt).abs() > GRID_TOLERANCE * dt {
             return Err(FfError::arg(
                 "trajectory.t",
-                format!("samples must be evenly spaced (a fixed-step run): step {k} is {} s, the mean step {} s", sig(step), sig(dt)),
+                format!(
+                    "samples must be evenly spaced (a fixed-step run): step {k} is {} s, the mean step {} s",
+                    sig(step),
+                    sig(dt)
+                ),
             ));
         }
     }
@@ -203,7 +231,10 @@ pub fn measure(m: &Model, s: &Samples, sensors: &[Sensor], seed: u64) -> Result<
             None => 1usize,
             Some(rate) => {
                 if !(rate > 0.0) || !rate.is_finite() {
-                    return Err(FfError::arg(&format!("{ctx}.rate"), format!("must be a positive number of Hz, got {rate}")));
+                    return Err(FfError::arg(
+                        &format!("{ctx}.rate"),
+                        format!("must be a positive number of Hz, got {rate}"),
+                    ));
                 }
                 let ratio = 1.0 / (rate * dt);
                 if ratio < 1.0 - GRID_TOLERANCE {
@@ -231,12 +262,19 @@ pub fn measure(m: &Model, s: &Samples, sensors: &[Sensor], seed: u64) -> Result<
         if !(sensor.latency >= 0.0) || (lat - lat_steps).abs() > GRID_TOLERANCE * lat_steps.max(1.0) {
             return Err(FfError::arg(
                 &format!("{ctx}.latency"),
-                format!("{} s must be ≥ 0 and a whole number of the run's sample spacing {} s ({lat:.6} spacings)", sensor.latency, sig(dt)),
+                format!(
+                    "{} s must be ≥ 0 and a whole number of the run's sample spacing {} s ({lat:.6} spacings)",
+                    sensor.latency,
+                    sig(dt)
+                ),
             ));
         }
         let lat_steps = lat_steps as usize;
         if lat_steps >= n {
-            return Err(FfError::arg(&format!("{ctx}.latency"), format!("{} s is longer than the run", sensor.latency)));
+            return Err(FfError::arg(
+                &format!("{ctx}.latency"),
+                format!("{} s is longer than the run", sensor.latency),
+            ));
         }
         let idx: Vec<usize> = (0..).map(|j| j * every).take_while(|&k| k + lat_steps < n).collect();
         let stamps: Vec<f64> = idx.iter().map(|&k| s.t[k + lat_steps]).collect();
@@ -311,14 +349,26 @@ pub(crate) fn joint_list(m: &Model, ctx: &str, names: Option<&[String]>) -> Resu
         Some(names) => names
             .iter()
             .map(|n| {
-                let known = || (1..m.nbodies()).filter(|&i| one_dof(i)).map(|i| m.joint_names[i].as_str()).collect::<Vec<_>>().join(", ");
+                let known = || {
+                    (1..m.nbodies())
+                        .filter(|&i| one_dof(i))
+                        .map(|i| m.joint_names[i].as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                };
                 match (1..m.nbodies()).find(|&i| &m.joint_names[i] == n) {
                     Some(i) if one_dof(i) => Ok(i),
                     Some(i) => Err(FfError::arg(
                         &format!("{ctx}.joints"),
-                        format!("joint '{n}' is {} (only revolute and prismatic joints have encoders and tachometers here)", m.joint_types[i].name()),
+                        format!(
+                            "joint '{n}' is {} (only revolute and prismatic joints have encoders and tachometers here)",
+                            m.joint_types[i].name()
+                        ),
                     )),
-                    None => Err(FfError::arg(&format!("{ctx}.joints"), format!("'{n}' is not a joint of model '{}' (joints: {})", m.name, known()))),
+                    None => Err(FfError::arg(
+                        &format!("{ctx}.joints"),
+                        format!("'{n}' is not a joint of model '{}' (joints: {})", m.name, known()),
+                    )),
                 }
             })
             .collect(),

@@ -30,7 +30,11 @@ pub struct NavigationConfig {
 
 impl NavigationConfig {
     pub(crate) fn parse(f: &mut Fields, quantity: NavQuantity) -> Result<Self> {
-        Ok(NavigationConfig { quantity, noise: f.vec3("noise", [0.0; 3], true)?, bias: f.vec3("bias", [0.0; 3], false)? })
+        Ok(NavigationConfig {
+            quantity,
+            noise: f.vec3("noise", [0.0; 3], true)?,
+            bias: f.vec3("bias", [0.0; 3], false)?,
+        })
     }
 
     pub(crate) fn run(&self, r: &mut SensorRun, rng: &mut GaussianRng) -> Result<()> {

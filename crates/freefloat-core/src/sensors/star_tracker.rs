@@ -9,8 +9,8 @@
 use super::fields::Fields;
 use super::{base_label, require_free_base, GaussianRng, SensorRun};
 use crate::error::Result;
-use crate::spatial::{quat_exp, quat_mul};
 use crate::spatial::V3;
+use crate::spatial::{quat_exp, quat_mul};
 
 /// A star tracker's attitude noise.
 #[derive(Clone, Debug, PartialEq)]
