@@ -303,8 +303,8 @@ class Measurement:
         }
 
     def write(self, out) -> list:
-        """Write DIR/telemetry.csv (what `freefloat identify minimal` reads; when assembled), DIR/sensor_<name>.csv for each
-        sensor, and DIR/results.json. Returns the paths written."""
+        """Write DIR/telemetry.csv (what `freefloat identify minimal` reads; when assembled), DIR/sensor_<name>.csv
+        for each sensor, and DIR/results.json. Returns the paths written."""
         d = Path(out)
         d.mkdir(parents=True, exist_ok=True)
         written = []
@@ -347,8 +347,9 @@ def measure(model, run, sensors, seed: int = 0) -> Measurement:
     too with poses="measured", else they are rebuilt by integrating the measured v (poses="integrate"). The
     momentum column, if the run has one, is the true momentum at the grid times (a known quantity, as in
     Naveen, Shah, Misra). When the sensors do not measure every velocity, `telemetry` is None (the streams are
-    still there; `Measurement.require_telemetry()` raises the reason). `rate_noise` of the telemetry is the per-component white-noise standard deviation the
-    rate sensors declare (for identification's errors-in-variables bias removal), None if all are zero."""
+    still there; `Measurement.require_telemetry()` raises the reason). `rate_noise` of the telemetry is the
+    per-component white-noise standard deviation the rate sensors declare (for identification's
+    errors-in-variables bias removal), None if all are zero."""
     from ..io.telemetry import Telemetry, integrate_poses
 
     sset = load(sensors)
