@@ -13,7 +13,15 @@ fn rows(obj: &Bound<'_, PyAny>, name: &str, t: usize, n: usize) -> PyResult<Vec<
     if a.shape() != [t, n] {
         return Err(input_err(format!("argument `{name}`: expected shape ({t}, {n}), got {:?}", a.shape())));
     }
-    Ok(a.as_array().iter().copied().collect())
+    Ok(contiguous(&a))
+}
+
+/// A row-major copy (one memcpy when the array is already C-contiguous).
+fn contiguous(a: &numpy::PyReadonlyArrayDyn<'_, f64>) -> Vec<f64> {
+    match a.as_slice() {
+        Ok(s) => s.to_vec(),
+        Err(_) => a.as_array().iter().copied().collect(),
+    }
 }
 
 /// Sample a recorded run with a sensor set (`sensors`: YAML or JSON text of a `sensors:` list) from the
@@ -40,7 +48,7 @@ pub fn measure<'py>(
     if ta.ndim() != 1 {
         return Err(input_err(format!("argument `t`: expected a 1-D array, got shape {:?}", ta.shape())));
     }
-    let tv: Vec<f64> = ta.as_array().iter().copied().collect();
+    let tv = contiguous(&ta);
     let n = tv.len();
     let qv = rows(q, "q", n, m.nq)?;
     let vv = rows(v, "v", n, m.nv)?;
