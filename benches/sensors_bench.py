@@ -6,7 +6,7 @@ at every step by a full sensor set: a gyro (angle random walk, Gauss-Markov bias
 constant bias), a star tracker (small random rotation), a base velocity sensor, encoders (4096 counts/rev, noise)
 and tachometers (resolution, noise, bias) on all nine joints.
 
-freefloat: `freefloat._core.measure` (the engine: one ChaCha8 stream per sensor, Box-Muller normals, exact
+freefloat: `freefloat._core.measure` (the engine: one ChaCha8 stream per sensor, ziggurat normals, exact
   discretisations) — the streams only, no telemetry assembly (timed: the engine call).
 numpy peer: the same models with numpy's PCG64 `standard_normal` on whole arrays, the Gauss-Markov recursion with
   `scipy.signal.lfilter` (a compiled first-order filter), the random walk with `cumsum`, quantisation with

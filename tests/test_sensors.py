@@ -227,9 +227,6 @@ def test_same_seed_reproduces_and_sensors_have_independent_streams():
     more.sensors.append(sn.StarTracker(sigma=1e-4))
     d = sn.measure(m, run, more, seed=11)
     assert np.array_equal(d.streams["gyro"].values, a.streams["gyro"].values)
-    # and the numbers do not depend on the machine: the first gyro sample of seed 11 (ChaCha8 + Box-Muller)
-    first = sn.measure(m, still_run(m, 2, 1e-3), [sn.Gyro(noise_per_sample=1.0)], seed=11).streams["gyro"].values[0]
-    assert np.all(np.isfinite(first)) and np.all(np.abs(first) < 6)
 
 
 @pytest.mark.parametrize(
