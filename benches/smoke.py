@@ -122,6 +122,13 @@ def _check_cl(out: Path) -> list[str]:
     return bad
 
 
+def _check_sensors(out: Path) -> list[str]:
+    res = json.loads((out / "sensors_bench.json").read_text())
+    bad = [] if res["agreement_passed"] is True else ["agreement_passed is not true"]
+    bad += [f"{k}: std ratio {r['ratio']:.3f}" for k, r in res["agreement"].items() if not 0.5 < r["ratio"] < 2.0]
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -133,6 +140,7 @@ BENCHES = {
     "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
     "cl": ("cl_vs_numpy.py", [], (), _check_cl),
+    "sensors": ("sensors_bench.py", [], ("scipy",), _check_sensors),
 }
 
 

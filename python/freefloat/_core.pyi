@@ -351,6 +351,9 @@ def center_of_mass(model: Model, q: ArrayLike) -> np.ndarray:
 def centroidal_momentum_matrix(model: Model, q: ArrayLike) -> np.ndarray:
     """Centroidal momentum matrix about the inertial origin (6, nv): momentum == A @ v."""
 
+def check_sensors(sensors: ArrayLike) -> Any:
+    """Check a sensor set (YAML or JSON text) without running it; returns the sensors' names in order."""
+
 def cl_estimate(r: ArrayLike, f: ArrayLike, dt: float, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1) -> Any:
     """The ch. 9 estimator alone over recorded data points: R (n, B, 8, 7), F (n, B, 8) taken every `dt` from
 t = 0; the same sequence as `cl_run` (offer, record, step) without the robot. Returns the estimates (n, 7B).
@@ -580,6 +583,13 @@ def kinetic_energy(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
 def matrix_to_quat(rot: ArrayLike) -> Any:
     """Unit quaternions (…, 4), x, y, z, w with w ≥ 0, of rotation matrices (…, 3, 3) (Shepperd's method).
 Matrices farther than 1e-6 from a rotation are rejected.
+    """
+
+def measure(model: Model, sensors: ArrayLike, t: ArrayLike, q: ArrayLike, v: ArrayLike, ddq: ArrayLike | None = None, seed: ArrayLike = 0) -> Any:
+    """Sample a recorded run with a sensor set (`sensors`: YAML or JSON text of a `sensors:` list) from the
+random streams of `seed`. t (T,), q (T, nq), v (T, nv), ddq (T, nv) or None. Returns one dict per
+sensor: sensor, columns (list of names), t (N,), values (N, len(columns)), white_sigma (per-column
+standard deviation of the white part of a rate sensor's errors; empty otherwise), period [s].
     """
 
 def momentum(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:

@@ -37,6 +37,8 @@ pub mod model;
 pub mod postcapture;
 /// Momentum and inverse-dynamics regressors, linear in the standard inertial parameters.
 pub mod regressors;
+/// Sensor models (gyro, star tracker, encoders, tachometers, F/T) and `measure`: a run turned into telemetry.
+pub mod sensors;
 /// Lie-group Runge-Kutta simulation (RK4, Dormand-Prince 5(4)) with inputs and trajectories.
 pub mod sim;
 /// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers.

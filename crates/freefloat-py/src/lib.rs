@@ -15,6 +15,7 @@ mod estimation;
 mod excitation;
 mod model;
 mod postcapture;
+mod sensors;
 mod simulate;
 mod spatial;
 
@@ -55,6 +56,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(derivatives::frame_log_error_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(derivatives::frame_dq_pose_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(sensors::measure, m)?)?;
+    m.add_function(wrap_pyfunction!(sensors::check_sensors, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
     m.add_function(wrap_pyfunction!(excitation::excitation_objective, m)?)?;

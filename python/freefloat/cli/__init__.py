@@ -24,6 +24,7 @@ from . import (
     excite,
     export,
     identify,
+    measure,
     models,
     params,
     postcapture,
@@ -56,6 +57,7 @@ def main():
 main.add_command(models.models_cmd)
 main.add_command(simulate.simulate_cmd)
 main.add_command(reactions.reactions_cmd)
+main.add_command(measure.measure_cmd)
 main.add_command(demo.demo_cmd)
 main.add_command(params.params_group)
 main.add_command(identify.identify_group)

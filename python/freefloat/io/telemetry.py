@@ -1,7 +1,9 @@
 """Measured motion ("telemetry"): time, configuration and velocity samples of a robot, read from and
 written to Parquet or CSV with named columns, validated on reading, and the measurement model of
 Naveen, Shah, Misra (Sec. VI.C and Appendix C): white Gaussian noise on the measured rates and poses rebuilt by
-integrating those noisy rates.
+integrating those noisy rates. Realistic sensors (gyro bias and random walks, star tracker, quantised
+encoders and tachometers, latency, force/torque) are `freefloat.sensors.measure`, which builds a Telemetry;
+its preset `sensors.naveen()` is the same measurement model as `add_noise` (docs/sensors.md).
 
 Columns are named like `Trajectory.to_parquet`: `t`, `q.<label>` for `model.q_labels()` and `v.<label>`
 for `model.v_labels()`, optionally `momentum.<px…Lz>` (the total momentum, when it is measured or known) or
