@@ -57,6 +57,7 @@ from .identification import (
 )
 from .io import Telemetry, telemetry
 from .model import Model
+from .batch_simulation import Trajectories, simulate_many
 from .simulation import Trajectory, simulate
 
 __version__ = "0.1.0"
@@ -73,6 +74,8 @@ __all__ = [
     "online",
     "reactions",
     "simulate",
+    "simulate_many",
+    "Trajectories",
     "telemetry",
     "trajectories",
     "excitation",

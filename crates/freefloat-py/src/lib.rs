@@ -16,6 +16,7 @@ mod excitation;
 mod model;
 mod postcapture;
 mod simulate;
+mod simulate_many;
 mod spatial;
 
 use pyo3::prelude::*;
@@ -55,6 +56,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(derivatives::frame_log_error_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(derivatives::frame_dq_pose_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_many::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
     m.add_function(wrap_pyfunction!(excitation::excitation_objective, m)?)?;

@@ -12,11 +12,12 @@ use crate::spatial::Motion;
 /// Checks `q` and that `d` belongs to `m`.
 pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
     let fix = check_args(m, Some(d), &Args::q(q))?;
+    d.ensure_mass_matrix(m)?;
     with_unit_q(m, d, q, fix, |d, q| crba_unchecked(m, d, q));
     Ok(())
 }
 
-/// `crba` without the argument check.
+/// `crba` without the argument check; `d.mass_matrix` must be nv × nv (`Data::ensure_mass_matrix`).
 pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     forward_kinematics_unchecked(m, d, q);
     world_composite_inertias_unchecked(m, d);
