@@ -57,7 +57,7 @@ from .identification import (
 )
 from .io import Telemetry, telemetry
 from .model import Model
-from .batch_simulation import Trajectories, simulate_many
+from .batch_simulation import Trajectories, simulate_many, torque_table
 from .simulation import Trajectory, simulate
 
 __version__ = "0.1.0"
@@ -75,6 +75,7 @@ __all__ = [
     "reactions",
     "simulate",
     "simulate_many",
+    "torque_table",
     "Trajectories",
     "telemetry",
     "trajectories",

@@ -126,6 +126,13 @@ impl Data {
             return Ok(());
         }
         let len = m.nv.checked_mul(m.nv).ok_or_else(|| too_big_matrix(m))?;
+        // Linux overcommits: a reservation larger than the free memory can succeed and the process is killed when
+        // the zeros are written. Refuse up front when /proc/meminfo says it cannot fit.
+        if let Some(avail) = available_memory_bytes() {
+            if (len as u64).saturating_mul(8) > avail {
+                return Err(too_big_matrix(m));
+            }
+        }
         let mut buf: Vec<f64> = Vec::new();
         buf.try_reserve_exact(len).map_err(|_| too_big_matrix(m))?;
         buf.resize(len, 0.0);
@@ -184,4 +191,12 @@ fn too_big_matrix(m: &Model) -> FfError {
          allocate (ABA, RNEA and the kinematics do not need it)",
         m.name, m.nv, m.nv, m.nv
     ))
+}
+
+/// `MemAvailable` of /proc/meminfo in bytes, where the system has it (Linux).
+fn available_memory_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
 }

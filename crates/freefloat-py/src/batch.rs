@@ -12,7 +12,8 @@ pub fn model_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyModel>> 
     if let Ok(m) = obj.downcast::<PyModel>() {
         return Ok(m.clone());
     }
-    obj.getattr("_core").ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(|| {
+    // interned: the attribute name is made once, not on every call (binding overhead, issue 16)
+    obj.getattr(pyo3::intern!(obj.py(), "_core")).ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(|| {
         PyTypeError::new_err(format!(
             "expected a freefloat.Model, got {}",
             obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()

@@ -35,6 +35,12 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
 pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
     let s = &d.s[i];
     let k0 = m.idx_v[i];
+    // revolute [0; a] and prismatic [a; 0]: one 3-vector scaled, not a 6 × nv product
+    match m.joint_types[i] {
+        JointType::Revolute => return Motion::new(V3::zeros(), V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]) * qd[k0]),
+        JointType::Prismatic => return Motion::new(V3::new(s[(0, 0)], s[(1, 0)], s[(2, 0)]) * qd[k0], V3::zeros()),
+        _ => {}
+    }
     let mut out = [0.0; 6];
     for c in 0..m.nvs[i] {
         let x = qd[k0 + c];
