@@ -117,9 +117,9 @@ def seed_robot(tmp: Path):
 
 
 def random_robot(nv: int, seed: int):
-    import random_trees as rt
-
     import freefloat as ff
+
+    import random_trees as rt
 
     n_joints = nv - 6
     desc = rt.random_tree(

@@ -42,6 +42,7 @@ from .algorithms import (
     rnea,
     skew,
 )
+from .batch_simulation import Trajectories, simulate_many, torque_table
 from .derivatives import aba_derivatives, rnea_derivatives, step_derivatives
 from .dq import reactions
 from .identification import (
@@ -57,7 +58,6 @@ from .identification import (
 )
 from .io import Telemetry, telemetry
 from .model import Model
-from .batch_simulation import Trajectories, simulate_many, torque_table
 from .simulation import Trajectory, simulate
 
 __version__ = "0.1.0"

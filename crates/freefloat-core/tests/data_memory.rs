@@ -8,9 +8,13 @@ use freefloat_core::{Data, JointType};
 
 fn chain(n: usize) -> freefloat_core::Model {
     let rod = Inertia::from_com(1.0, V3::new(0.05, 0.0, 0.0), M3::from_diagonal(&V3::new(1e-3, 2e-3, 2e-3)));
-    let mut b =
-        ModelBuilder::new("chain", "base", JointType::Free, Inertia::from_com(100.0, V3::zeros(), M3::identity() * 10.0))
-            .expect("builder");
+    let mut b = ModelBuilder::new(
+        "chain",
+        "base",
+        JointType::Free,
+        Inertia::from_com(100.0, V3::zeros(), M3::identity() * 10.0),
+    )
+    .expect("builder");
     for i in 1..=n {
         b.add_body(BodySpec {
             name: format!("l{i}"),

@@ -13,12 +13,14 @@ pub fn model_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyModel>> 
         return Ok(m.clone());
     }
     // interned: the attribute name is made once, not on every call (binding overhead, issue 16)
-    obj.getattr(pyo3::intern!(obj.py(), "_core")).ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(|| {
-        PyTypeError::new_err(format!(
-            "expected a freefloat.Model, got {}",
-            obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
-        ))
-    })
+    obj.getattr(pyo3::intern!(obj.py(), "_core")).ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(
+        || {
+            PyTypeError::new_err(format!(
+                "expected a freefloat.Model, got {}",
+                obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+            ))
+        },
+    )
 }
 
 /// Any array-like as a float64 numpy array (no copy when it already is one), naming the argument

@@ -79,7 +79,10 @@ pub fn batch_size(m: &Model, spec: &BatchSpec) -> Result<usize> {
                 Some((r, first)) if r != s.rows => {
                     return Err(FfError::arg(
                         name,
-                        format!("has {} members but `{first}` has {r}: batched arguments must have the same size", s.rows),
+                        format!(
+                            "has {} members but `{first}` has {r}: batched arguments must have the same size",
+                            s.rows
+                        ),
                     ))
                 }
                 _ => {}
