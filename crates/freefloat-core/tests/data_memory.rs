@@ -44,7 +44,8 @@ fn fifty_thousand_links_run_aba_without_the_mass_matrix() {
     let tau = vec![0.0; m.nv];
     aba(&m, &mut d, &q, &v, &tau, None).expect("aba");
     assert!(d.ddq.iter().all(|x| x.is_finite()));
-    rnea(&m, &mut d, &q, &v, &d.ddq.clone(), None).expect("rnea");
+    let ddq = d.ddq.clone();
+    rnea(&m, &mut d, &q, &v, &ddq, None).expect("rnea");
     // RNEA of ABA's accelerations gives back the torques (zero): the long chain is solved, not just run
     let worst = d.tau.iter().fold(0.0f64, |a, x| a.max(x.abs()));
     assert!(worst < 1e-6, "rnea(aba(tau)) - tau = {worst}");

@@ -17,13 +17,17 @@ pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
     Ok(())
 }
 
-/// `crba` without the argument check; `d.mass_matrix` must be nv × nv (`Data::ensure_mass_matrix`).
+/// `crba` without the argument check (allocates `d.mass_matrix` infallibly if `crba` has not).
 pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     forward_kinematics_unchecked(m, d, q);
     world_composite_inertias_unchecked(m, d);
     let n = m.nbodies();
     let nv = m.nv;
-    debug_assert_eq!(d.mass_matrix.shape(), (nv, nv));
+    if d.mass_matrix.shape() != (nv, nv) {
+        // Internal callers (derivatives, post-capture control) come here without `crba`'s fallible allocation; the
+        // writes below rely on the nv × nv shape, so make sure of it.
+        d.mass_matrix = nalgebra::DMatrix::zeros(nv, nv);
+    }
     d.mass_matrix.fill(0.0);
     let mm = d.mass_matrix.as_mut_slice();
     // Entry (r, c) of the column-major nv × nv matrix. SAFETY: every index below is idx_v[j] + k with k < nvs[j],
