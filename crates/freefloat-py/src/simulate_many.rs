@@ -16,9 +16,11 @@ fn stacked(obj: &Bound<'_, PyAny>, name: &str, inner: usize) -> PyResult<(Vec<f6
     let rows = match shape.as_slice() {
         [w] if *w == inner => 1,
         [b, rest @ ..] if !rest.is_empty() && rest.iter().product::<usize>() == inner => *b,
-        _ => return Err(input_err(format!(
+        _ => {
+            return Err(input_err(format!(
             "argument `{name}`: expected shape ({inner},) for all members or (B, {inner}) for B members, got {shape:?}"
-        ))),
+        )))
+        }
     };
     if let Some(k) = data.iter().position(|x| !x.is_finite()) {
         return Err(input_err(format!("argument `{name}`: entry {k} is {} (must be finite)", data[k])));
