@@ -129,6 +129,26 @@ def _check_sensors(out: Path) -> list[str]:
     return bad
 
 
+def _check_kernels(out: Path) -> list[str]:
+    res = json.loads((out / "kernels_vs_pinocchio.json").read_text())
+    bad = []
+    for robot, r in res["results"].items():
+        bad += [f"{robot}: agreement {k} = {v:.3g} > 1e-9" for k, v in r["agreement_max_rel"].items() if not v <= 1e-9]
+    if len(res["results"]) != 3:
+        bad.append(f"expected 3 robots, got {sorted(res['results'])}")
+    return bad
+
+
+def _check_sim_vs_mujoco(out: Path) -> list[str]:
+    res = json.loads((out / "sim_vs_mujoco.json").read_text())
+    a, bad = res["agreement"], []
+    if not a["ff_vs_mujoco_max_abs"] < 1e-5:
+        bad.append(f"freefloat vs MuJoCo trajectories differ by {a['ff_vs_mujoco_max_abs']:.3g}")
+    if a["simulate_many"] != 0.0:
+        bad.append(f"simulate_many differs from sequential simulate by {a['simulate_many']:.3g}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -141,6 +161,8 @@ BENCHES = {
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
     "cl": ("cl_vs_numpy.py", [], (), _check_cl),
     "sensors": ("sensors_bench.py", [], ("scipy",), _check_sensors),
+    "kernels": ("kernels_vs_pinocchio.py", [], ("pinocchio",), _check_kernels),
+    "mujoco": ("sim_vs_mujoco.py", [], ("mujoco",), _check_sim_vs_mujoco),
 }
 
 

@@ -42,6 +42,7 @@ from .algorithms import (
     rnea,
     skew,
 )
+from .batch_simulation import Trajectories, simulate_many, torque_table
 from .derivatives import aba_derivatives, rnea_derivatives, step_derivatives
 from .dq import reactions
 from .identification import (
@@ -73,6 +74,9 @@ __all__ = [
     "online",
     "reactions",
     "simulate",
+    "simulate_many",
+    "torque_table",
+    "Trajectories",
     "telemetry",
     "trajectories",
     "excitation",

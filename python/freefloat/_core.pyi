@@ -638,6 +638,11 @@ def rnea_derivatives(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fex
 def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba') -> Any:
     ...
 
+def simulate_many(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', params: ArrayLike | None = None, threads: int = 0, max_steps: int = 50000000) -> Any:
+    """Simulate B members at once (RK4 or RK45, table torques): returns (list of B trajectory dicts or None, list of
+(index, exception) for the members that failed).
+    """
+
 def skew(v: ArrayLike) -> Any:
     """Cross-product matrices (…, 3, 3): `skew(a) @ b == a × b`."""
 

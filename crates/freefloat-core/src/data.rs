@@ -1,6 +1,7 @@
 //! `Data`: every work buffer the algorithms need, allocated once per model (Model/Data split).
 
 use crate::dqdynamics::DqData;
+use crate::error::{FfError, Result};
 use crate::model::Model;
 use crate::spatial::{Force, Inertia, Motion, Se3, M6};
 use nalgebra::DMatrix;
@@ -52,7 +53,9 @@ pub struct Data {
     pub ddq: Vec<f64>,
     /// Joint forces (RNEA output; hybrid dynamics: the torques the prescribed joints needed).
     pub tau: Vec<f64>,
-    /// Joint-space inertia matrix (CRBA output, full symmetric).
+    /// Joint-space inertia matrix (CRBA output, full symmetric). The only nv × nv buffer: it is empty (0 × 0)
+    /// until the first call that needs it (CRBA and what uses it), so loading a model with tens of thousands of
+    /// bodies and running ABA or RNEA on it costs memory linear in the number of bodies.
     pub mass_matrix: DMatrix<f64>,
     /// 6×nv scratch for Jacobians and the centroidal momentum matrix.
     pub jac: DMatrix<f64>,
@@ -90,12 +93,51 @@ impl Data {
             ic: vec![Inertia::zero(); n],
             ddq: vec![0.0; m.nv],
             tau: vec![0.0; m.nv],
-            mass_matrix: DMatrix::zeros(m.nv, m.nv),
+            mass_matrix: DMatrix::zeros(0, 0),
             jac: DMatrix::zeros(6, m.nv),
             qbuf: Vec::with_capacity(m.nq),
             dq: DqData::new(m),
             model_id: m.id(),
         }
+    }
+
+    /// Every buffer sized for `m` as `Data::new` makes them, but with fallible reservation: a model too large for
+    /// the memory at hand gives an error naming the size instead of aborting the process.
+    pub fn try_new(m: &Model) -> Result<Data> {
+        let n = m.nbodies();
+        // The per-body buffers dominate (about 2 kB per body); reserve their total up front to fail cleanly.
+        let per_body = 2 * std::mem::size_of::<Se3>()
+            + 6 * std::mem::size_of::<Motion>()
+            + 2 * std::mem::size_of::<Force>()
+            + 5 * std::mem::size_of::<M6>()
+            + std::mem::size_of::<[f64; 6]>()
+            + std::mem::size_of::<Inertia>();
+        let bytes = n.checked_mul(per_body).ok_or_else(|| too_big(m, usize::MAX))?;
+        let mut probe: Vec<u8> = Vec::new();
+        probe.try_reserve_exact(bytes).map_err(|_| too_big(m, bytes))?;
+        drop(probe);
+        Ok(Data::new(m))
+    }
+
+    /// Allocate the nv × nv mass matrix on first use (fallible reservation: a clear error, never an abort, when
+    /// nv² numbers do not fit in memory). A no-op once allocated.
+    pub fn ensure_mass_matrix(&mut self, m: &Model) -> Result<()> {
+        if self.mass_matrix.shape() == (m.nv, m.nv) {
+            return Ok(());
+        }
+        let len = m.nv.checked_mul(m.nv).ok_or_else(|| too_big_matrix(m))?;
+        // Linux overcommits: a reservation larger than the free memory can succeed and the process is killed when
+        // the zeros are written. Refuse up front when /proc/meminfo says it cannot fit.
+        if let Some(avail) = available_memory_bytes() {
+            if (len as u64).saturating_mul(8) > avail {
+                return Err(too_big_matrix(m));
+            }
+        }
+        let mut buf: Vec<f64> = Vec::new();
+        buf.try_reserve_exact(len).map_err(|_| too_big_matrix(m))?;
+        buf.resize(len, 0.0);
+        self.mass_matrix = DMatrix::from_vec(m.nv, m.nv, buf);
+        Ok(())
     }
 
     /// Identity of the model this Data was made for (see `check::check_data`).
@@ -128,7 +170,33 @@ impl Data {
         per_body.iter().all(|&l| l == n)
             && self.ddq.len() == m.nv
             && self.tau.len() == m.nv
-            && self.mass_matrix.shape() == (m.nv, m.nv)
+            && (self.mass_matrix.shape() == (m.nv, m.nv) || self.mass_matrix.shape() == (0, 0))
             && self.jac.shape() == (6, m.nv)
     }
+}
+
+fn too_big(m: &Model, bytes: usize) -> FfError {
+    FfError::Numerical(format!(
+        "model '{}' has {} bodies: its work buffers need {:.1} GB, more than this machine can allocate",
+        m.name,
+        m.nbodies(),
+        bytes as f64 / 1e9
+    ))
+}
+
+fn too_big_matrix(m: &Model) -> FfError {
+    let gb = (m.nv as f64).powi(2) * 8.0 / 1e9;
+    FfError::Numerical(format!(
+        "model '{}' has nv = {}: its {} x {} joint-space inertia matrix needs {gb:.1} GB, more than this machine can \
+         allocate (ABA, RNEA and the kinematics do not need it)",
+        m.name, m.nv, m.nv, m.nv
+    ))
+}
+
+/// `MemAvailable` of /proc/meminfo in bytes, where the system has it (Linux).
+fn available_memory_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb.saturating_mul(1024))
 }

@@ -2,7 +2,7 @@
 
 use crate::errors::input_err;
 use crate::model::PyModel;
-use numpy::{IntoPyArray, PyArrayDyn, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyTypeError;
 use pyo3::prelude::*;
 
@@ -12,12 +12,15 @@ pub fn model_arg<'py>(obj: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyModel>> 
     if let Ok(m) = obj.downcast::<PyModel>() {
         return Ok(m.clone());
     }
-    obj.getattr("_core").ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(|| {
-        PyTypeError::new_err(format!(
-            "expected a freefloat.Model, got {}",
-            obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
-        ))
-    })
+    // interned: the attribute name is made once, not on every call (binding overhead, issue 16)
+    obj.getattr(pyo3::intern!(obj.py(), "_core")).ok().and_then(|c| c.downcast_into::<PyModel>().ok()).ok_or_else(
+        || {
+            PyTypeError::new_err(format!(
+                "expected a freefloat.Model, got {}",
+                obj.get_type().name().map(|n| n.to_string()).unwrap_or_default()
+            ))
+        },
+    )
 }
 
 /// Any array-like as a float64 numpy array (no copy when it already is one), naming the argument
@@ -58,18 +61,33 @@ impl Batch {
     /// Shape only (one sample or a leading time axis): for the arguments the engine's own check
     /// (`freefloat_core::check`) validates per sample — finiteness, quaternions, sizes.
     pub fn shape(name: &str, obj: &Bound<'_, PyAny>, inner: &[usize]) -> PyResult<Batch> {
+        // Fast path (binding overhead, issue 16): a C-contiguous float64 array is copied straight out, without
+        // registering a borrow with numpy's borrow checker (the copy happens now, with the GIL held, before any
+        // Python code can run, so nothing can write to the array meanwhile).
+        if let Ok(a) = obj.downcast::<PyArrayDyn<f64>>() {
+            if a.is_c_contiguous() {
+                let shape = a.shape();
+                let stacked = if shape == inner {
+                    false
+                } else if shape.len() == inner.len() + 1 && &shape[1..] == inner {
+                    true
+                } else {
+                    return Err(Batch::shape_error(name, inner, shape));
+                };
+                // SAFETY: contiguous float64 data of this array, read once under the GIL (see above).
+                let data = unsafe { a.as_slice() }.map_err(|e| input_err(format!("argument `{name}`: {e}")))?.to_vec();
+                let rows = if stacked { shape[0] } else { 1 };
+                return Ok(Batch { data, rows, width: inner.iter().product(), stacked });
+            }
+        }
         let a = array_arg(obj, name)?;
         let shape = a.shape().to_vec();
-        let expect = || {
-            let s: Vec<String> = inner.iter().map(|x| x.to_string()).collect();
-            format!("({}) or (T, {})", s.join(", "), s.join(", "))
-        };
         let stacked = if shape.as_slice() == inner {
             false
         } else if shape.len() == inner.len() + 1 && &shape[1..] == inner {
             true
         } else {
-            return Err(input_err(format!("argument `{name}`: expected shape {}, got {:?}", expect(), shape)));
+            return Err(Batch::shape_error(name, inner, &shape));
         };
         let data: Vec<f64> = match a.as_slice() {
             Ok(s) => s.to_vec(),
@@ -78,6 +96,12 @@ impl Batch {
         let width: usize = inner.iter().product();
         let rows = if stacked { shape[0] } else { 1 };
         Ok(Batch { data, rows, width, stacked })
+    }
+
+    fn shape_error(name: &str, inner: &[usize], shape: &[usize]) -> PyErr {
+        let s: Vec<String> = inner.iter().map(|x| x.to_string()).collect();
+        let expect = format!("({}) or (T, {})", s.join(", "), s.join(", "));
+        input_err(format!("argument `{name}`: expected shape {expect}, got {shape:?}"))
     }
 
     #[inline]
@@ -122,6 +146,16 @@ pub fn output<'py>(
     shape.extend_from_slice(inner);
     if shape.is_empty() {
         return Ok(data[0].into_pyobject(py)?.into_any());
+    }
+    // Small results are copied into a fresh numpy array: cheaper than handing numpy the Vec, which needs a
+    // Python object to own it (binding overhead of single calls, issue 16). Large ones are handed over uncopied.
+    if data.len() <= 4096 {
+        let arr = PyArrayDyn::<f64>::zeros(py, shape, false);
+        // SAFETY: the array was just created here, is C-contiguous and no one else holds it yet.
+        unsafe { arr.as_slice_mut() }
+            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("internal array error: {e}")))?
+            .copy_from_slice(&data);
+        return Ok(arr.into_any());
     }
     // Build the array with its final shape directly (a reshape would be a second numpy call).
     let arr = numpy::ndarray::ArrayD::from_shape_vec(shape, data)

@@ -17,6 +17,7 @@ mod model;
 mod postcapture;
 mod sensors;
 mod simulate;
+mod simulate_many;
 mod spatial;
 
 use pyo3::prelude::*;
@@ -58,6 +59,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::measure, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::check_sensors, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate_many::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;
     m.add_function(wrap_pyfunction!(excitation::excitation_objective, m)?)?;

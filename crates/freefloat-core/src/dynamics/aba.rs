@@ -2,7 +2,7 @@ use super::gravity_acceleration;
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::{forward_kinematics_unchecked, joint_bias};
+use crate::kinematics::{forward_kinematics_unchecked, joint_bias, world_subspace_column};
 use crate::model::{JointType, Model};
 use crate::spatial::{Force, Motion, M6, V6};
 use nalgebra::Matrix3;
@@ -68,14 +68,31 @@ pub(crate) fn hybrid_aba_unchecked(
     let (mut h_total, mut ke) = (Force::ZERO, 0.0);
     for i in 0..n {
         let omi = d.o_mi[i];
-        let k = m.nvs[i];
         let iv = m.idx_v[i];
-        let mut vj = Motion::ZERO;
-        for c in 0..k {
-            let s = omi.act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
-            d.os[i].set_column(c, &s.to_v6());
-            vj += s * v[iv + c];
-        }
+        // Joint twist oS q̇, specialised by joint type: a revolute joint's child-frame subspace is [0; a]
+        // (oS = [p × R a; R a]) and a prismatic one's [a; 0] (oS = [R a; 0]), so neither needs the
+        // general 6-column frame change; a free root's oS is the base placement's motion transform
+        // itself, applied to the base twist in one step (its columns are not needed, see pass 3).
+        let vj = match m.joint_types[i] {
+            JointType::Revolute | JointType::Prismatic => {
+                let col = world_subspace_column(m, d, i, 0);
+                d.os[i].set_column(0, &col.to_v6());
+                col * v[iv]
+            }
+            JointType::Free if m.parents[i].is_none() && !is_presc(i) => {
+                omi.act_motion(&Motion::from_slice(&v[iv..iv + 6]))
+            }
+            JointType::FixedBase | JointType::Fixed => Motion::ZERO,
+            _ => {
+                let mut vj = Motion::ZERO;
+                for c in 0..m.nvs[i] {
+                    let s = omi.act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
+                    d.os[i].set_column(c, &s.to_v6());
+                    vj += s * v[iv + c];
+                }
+                vj
+            }
+        };
         let vi = match m.parents[i] {
             Some(p) => d.ov[p] + vj,
             None => vj,
@@ -138,15 +155,10 @@ pub(crate) fn hybrid_aba_unchecked(
             // Multi-DoF joint (k = 2: cylindrical; 3: spherical or planar; 6: free).
             let ia = d.ia[i];
             if k == 6 {
-                // Only the base can have a free joint (the model builder enforces it), so there is
-                // no reduction to pass on: keep D itself and solve with it in pass 3, which is
-                // cheaper than forming D⁻¹.
+                // Only the base can have a free joint (the model builder enforces it), so there is no
+                // reduction to pass on, and pass 3 solves the root's articulated equation in closed form.
                 debug_assert!(parent.is_none(), "a 6-DoF joint is always the root");
-                let u = ia * s;
-                d.dinv[i] = s.transpose() * u;
-                let uu = V6::from_column_slice(&tau[iv..iv + 6]) - s.transpose() * pa6;
-                d.u[i] = u;
-                d.uu[i].copy_from_slice(uu.as_slice());
+                let _ = (ia, iv);
                 continue;
             }
             // k = 2 (cylindrical) or 3 (spherical, planar base): fixed-size products.
@@ -192,7 +204,28 @@ pub(crate) fn hybrid_aba_unchecked(
                 d.ddq[iv + c] = ddq[iv + c];
                 d.tau[iv + c] = s.column(c).dot(&f);
             }
+        } else if k == 1 {
+            // Single DoF: q̈ = (u − Uᵀ a) / D, then a += oS q̈ (RBDA eq. 7.45, scalar D⁻¹).
+            let u = &d.u[i];
+            let x = d.dinv[i][(0, 0)] * (d.uu[i][0] - u.column(0).dot(&a));
+            d.ddq[iv] = x;
+            d.tau[iv] = tau[iv];
+            a += s.column(0) * x;
         } else {
+            if m.parents[i].is_none() && k == 6 {
+                // Free root: oS is the base placement's motion transform X₀, invertible, so the joint
+                // equation τ₀ = X₀ᵀ (Iᴬ a₀ + pᴬ) gives the root acceleration from one 6×6 SPD solve,
+                // Iᴬ a₀ = X₀⁻ᵀ τ₀ − pᴬ, and then q̈₀ = X₀⁻¹ (a₀ − a_g − c₀) (RBDA §7.3 with S = X₀; this
+                // avoids forming U = Iᴬ X₀ and D = X₀ᵀ U, two 6×6×6 products).
+                let omi = d.o_mi[i];
+                let rhs0 = omi.act_force(&Force::from_slice(&tau[iv..iv + 6])) - d.of[i];
+                let a0 = solve_spd6(&d.ia[i], &rhs0.to_v6()).ok_or_else(|| singular(m, i))?;
+                let qdd = omi.inv_act_motion(&Motion::from_v6(&(a0 - a)));
+                qdd.write(&mut d.ddq[iv..iv + 6]);
+                d.tau[iv..iv + 6].copy_from_slice(&tau[iv..iv + 6]);
+                d.oa[i] = Motion::from_v6(&a0);
+                continue;
+            }
             let mut rhs = [0.0; 6];
             for c in 0..k {
                 rhs[c] = d.uu[i][c] - d.u[i].column(c).dot(&a);
@@ -270,6 +303,50 @@ fn solve_spd(dm: &M6, k: usize, b: &[f64; 6]) -> Option<[f64; 6]> {
             x.copy_from_slice(r.as_slice());
         }
         _ => unreachable!("a multi-DoF root has 3 or 6 velocity coordinates"),
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// Solve `A x = b` for a symmetric positive-definite 6×6 `A` (lower triangle read) by an unrolled Cholesky
+/// factorisation `A = L Lᵀ`; `None` if `A` is not numerically positive definite or the result is not finite.
+/// Fixed loop bounds let the compiler unroll it completely (nalgebra's general Cholesky keeps its loops).
+#[inline]
+fn solve_spd6(a: &M6, b: &V6) -> Option<V6> {
+    let mut l = [[0.0f64; 6]; 6];
+    for j in 0..6 {
+        let mut djj = a[(j, j)];
+        for k in 0..j {
+            djj -= l[j][k] * l[j][k];
+        }
+        if !(djj > 0.0) {
+            return None;
+        }
+        let ljj = djj.sqrt();
+        l[j][j] = ljj;
+        let inv = 1.0 / ljj;
+        for i in j + 1..6 {
+            let mut x = a[(i, j)];
+            for k in 0..j {
+                x -= l[i][k] * l[j][k];
+            }
+            l[i][j] = x * inv;
+        }
+    }
+    let mut y = [0.0f64; 6];
+    for i in 0..6 {
+        let mut x = b[i];
+        for k in 0..i {
+            x -= l[i][k] * y[k];
+        }
+        y[i] = x / l[i][i];
+    }
+    let mut x = V6::zeros();
+    for i in (0..6).rev() {
+        let mut s = y[i];
+        for k in i + 1..6 {
+            s -= l[k][i] * x[k];
+        }
+        x[i] = s / l[i][i];
     }
     x.iter().all(|v| v.is_finite()).then_some(x)
 }

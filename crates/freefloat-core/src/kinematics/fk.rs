@@ -35,6 +35,12 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
 pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
     let s = &d.s[i];
     let k0 = m.idx_v[i];
+    // revolute [0; a] and prismatic [a; 0]: one 3-vector scaled, not a 6 × nv product
+    match m.joint_types[i] {
+        JointType::Revolute => return Motion::new(V3::zeros(), V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]) * qd[k0]),
+        JointType::Prismatic => return Motion::new(V3::new(s[(0, 0)], s[(1, 0)], s[(2, 0)]) * qd[k0], V3::zeros()),
+        _ => {}
+    }
     let mut out = [0.0; 6];
     for c in 0..m.nvs[i] {
         let x = qd[k0 + c];
@@ -43,6 +49,23 @@ pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motio
         }
     }
     Motion::from_slice(&out)
+}
+
+/// Column `c` of joint i's motion subspace in inertial coordinates (about the inertial origin), after
+/// `forward_kinematics`. A revolute joint's child-frame column is [0; a], so it is `[p × R a; R a]`, and a
+/// prismatic one's [a; 0] gives `[R a; 0]`: one 3×3 product instead of the general motion transform.
+#[inline]
+pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> Motion {
+    let o = &d.o_mi[i];
+    let s = &d.s[i];
+    match m.joint_types[i] {
+        JointType::Revolute => {
+            let w = o.rot * V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]);
+            Motion::new(o.trans.cross(&w), w)
+        }
+        JointType::Prismatic => Motion::new(o.rot * V3::new(s[(0, 0)], s[(1, 0)], s[(2, 0)]), V3::zeros()),
+        _ => o.act_motion(&Motion::from_v6(&s.column(c).into_owned())),
+    }
 }
 
 /// Joint bias acceleration `Ṡ q̇` of body i, child frame: zero but for a universal joint (RBDA

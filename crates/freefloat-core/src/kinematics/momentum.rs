@@ -1,4 +1,4 @@
-use super::{forward_kinematics_unchecked, forward_velocities_unchecked};
+use super::{forward_kinematics_unchecked, forward_velocities_unchecked, world_subspace_column};
 use crate::check::{check_args, check_data, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
@@ -83,7 +83,7 @@ pub fn world_motion_subspaces(m: &Model, d: &mut Data) -> Result<()> {
 pub(crate) fn world_motion_subspaces_unchecked(m: &Model, d: &mut Data) {
     for i in 0..m.nbodies() {
         for c in 0..m.nvs[i] {
-            let s = d.o_mi[i].act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
+            let s = world_subspace_column(m, d, i, c);
             d.os[i].set_column(c, &s.to_v6());
         }
     }

@@ -3,11 +3,13 @@
 //! force), prescribed joint motion (hybrid dynamics) and a sampled controller with zero-order hold.
 
 mod base_poses;
+mod batch;
 mod inputs;
 pub(crate) mod tableau;
 mod trajectory;
 
 pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
+pub use batch::{batch_size, simulate_many, BatchSpec, Stacked};
 pub use inputs::{Controller, Hold, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 

@@ -1,7 +1,7 @@
 //! Rotations: quaternions in the (x, y, z, w) order used by `q`, rotation matrices, the SO(3)
 //! exponential/logarithm and the inverse right Jacobian that the Lie-group integrator needs.
 
-use super::{skew, M3, V3};
+use super::{M3, V3};
 
 /// Hamilton product of two quaternions stored (x, y, z, w).
 #[inline]
@@ -81,12 +81,26 @@ pub fn quat_exp(phi: &V3) -> [f64; 4] {
     [k * phi.x, k * phi.y, k * phi.z, half.cos()]
 }
 
-/// Rotation matrix about a unit axis by `angle` (Rodrigues).
+/// Rotation matrix about a unit axis by `angle` (Rodrigues): `R = c 1 + s [a]× + (1 − c) a aᵀ`, entry by entry
+/// (the same matrix as `1 + s [a]× + (1 − c)[a]ײ` for a unit axis, without the 3×3 products of skew matrices that
+/// made it a tenth of forward kinematics).
 #[inline]
 pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
     let (s, c) = angle.sin_cos();
-    let k = skew(axis);
-    M3::identity() + k * s + k * k * (1.0 - c)
+    let t = 1.0 - c;
+    let (x, y, z) = (axis.x, axis.y, axis.z);
+    let (tx, ty, tz) = (t * x, t * y, t * z);
+    M3::new(
+        c + tx * x,
+        tx * y - s * z,
+        tx * z + s * y,
+        tx * y + s * z,
+        c + ty * y,
+        ty * z - s * x,
+        tx * z - s * y,
+        ty * z + s * x,
+        c + tz * z,
+    )
 }
 
 /// Rotation vector of a rotation matrix (inverse of the exponential), angle in [0, pi].

@@ -1,0 +1,391 @@
+#!/usr/bin/env python3
+"""Dynamics kernels (ABA, RNEA, CRBA) against Pinocchio, per call, core to core, on three robots, in one run.
+
+Robots: the built-in `seed001_dual_arm_consistent` (free base, two 3R arms, three wheels; nv = 15) and two random
+free-floating trees with nv = 12 and nv = 30 (revolute and prismatic joints, random placements, inertias and
+branching; `tests/random_trees.py`, which builds the Pinocchio model directly from the tree description, never
+from a freefloat object). Before anything is timed, ABA, RNEA and CRBA of both libraries are compared on random
+states (abort above 1e-9, relative).
+
+What is timed (wall clock and process CPU time; repeats interleaved between the libraries so machine noise hits
+both alike; median, min and max over the repeats):
+
+* ABA and RNEA: one freefloat call on a stacked batch of N states (`ff.aba(m, Q, V, T)`), divided by N, against
+  Pinocchio's batched C++ `abaInParallel` / `rneaInParallel` with one thread, writing into a preallocated output.
+* CRBA: Pinocchio has no batched CRBA, so its C++ time per call is estimated as the time of a Python loop of
+  `pin.crba` minus the same loop on a one-body free-flyer model (the binding and loop cost, measured in the same
+  run); freefloat's is a stacked batch of N = 1000 (its (N, nv, nv) output stays in cache).
+* Single calls from Python (`ff.aba` / `pin.aba`, `ff.crba` / `pin.crba`, `ff.momentum` /
+  `pin.computeCentroidalMomentum`), on the seed 001 robot.
+
+    python benches/kernels_vs_pinocchio.py               # full run (about a minute)
+    python benches/kernels_vs_pinocchio.py --quick       # smoke test
+    python benches/kernels_vs_pinocchio.py --out DIR     # write kernels_vs_pinocchio.{json,md} there
+
+Ratios are freefloat's time over Pinocchio's (< 1: freefloat is faster). Targets (issue 16): ABA <= 0.5,
+RNEA and CRBA <= 0.7, single calls from Python <= 1.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "tests"))
+
+from compare_pinocchio import _clock, environment  # noqa: E402
+
+SEED_ROBOT = "seed001_dual_arm_consistent"
+TARGETS = {"aba": 0.5, "rnea": 0.7, "crba": 0.7}
+
+
+def parse_args(argv=None):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawTextHelpFormatter)
+    p.add_argument("--quick", action="store_true", help="few repeats and small batches (smoke test, seconds)")
+    p.add_argument("--out", type=Path, default=HERE / "results", help="folder for the .json and .md results")
+    p.add_argument("--repeats", type=int, default=None, help="interleaved repeats of every measurement (default 7)")
+    p.add_argument("--batch", type=int, default=None, help="states per batched call (default 20000)")
+    p.add_argument("--calls", type=int, default=None, help="single calls per repeat (default 20000)")
+    p.add_argument("--seed", type=int, default=0, help="random seed of the states")
+    a = p.parse_args(argv)
+    a.repeats = a.repeats or (2 if a.quick else 7)
+    a.batch = a.batch or (500 if a.quick else 20000)
+    a.calls = a.calls or (500 if a.quick else 20000)
+    return a
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# robots: (freefloat model, callables of the Pinocchio side in freefloat's layout)
+# ---------------------------------------------------------------------------------------------------------------
+
+
+class PinSide:
+    """Pinocchio model plus the q/v layout maps (identity for the seed robot)."""
+
+    def __init__(self, model, q_to, v_to, v_from, cols_from):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.model = model
+        self.data = model.createData()
+        self.q_to, self.v_to, self.v_from, self.cols_from = q_to, v_to, v_from, cols_from
+
+    def aba(self, q, v, tau):
+        return self.v_from(self.pin.aba(self.model, self.data, self.q_to(q), self.v_to(v), self.v_to(tau)))
+
+    def rnea(self, q, v, a):
+        return self.v_from(self.pin.rnea(self.model, self.data, self.q_to(q), self.v_to(v), self.v_to(a)))
+
+    def crba(self, q):
+        M = self.pin.crba(self.model, self.data, self.q_to(q))
+        M = np.triu(M) + np.triu(M, 1).T
+        return self.cols_from(self.cols_from(M).T).T
+
+
+def seed_robot(tmp: Path):
+    import pinocchio as pin
+
+    import freefloat as ff
+
+    m = ff.models.load(SEED_ROBOT)
+    path = tmp / "seed.urdf"
+    m.to_urdf(path)
+    # the export writes unlimited revolute joints as `continuous` ((cos, sin) in Pinocchio); make them revolute so
+    # both libraries use the same q layout (limits play no part in the dynamics)
+    text = re.sub(
+        r'type="continuous">',
+        'type="revolute">\n    <limit lower="-1e6" upper="1e6" velocity="1e6" effort="1e6"/>',
+        path.read_text(),
+    )
+    path.write_text(text)
+    pm = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    pm.gravity = pin.Motion(np.asarray(m.gravity, float), np.zeros(3))
+    if (pm.nq, pm.nv) != (m.nq, m.nv) or list(pm.names)[1:] != list(m.joint_names):
+        raise SystemExit("ABORT: the Pinocchio model of the seed robot has a different layout")
+    ident = lambda x: np.asarray(x, float)  # noqa: E731
+    return m, PinSide(pm, ident, ident, ident, ident)
+
+
+def random_robot(nv: int, seed: int):
+    import freefloat as ff
+
+    import random_trees as rt
+
+    n_joints = nv - 6
+    desc = rt.random_tree(
+        np.random.default_rng(seed),
+        name=f"random_tree_nv{nv}",
+        n_children=n_joints,
+        base="free",
+        gravity=np.array([0.0, 0.0, -9.81]),
+        joint_types=("revolute", "prismatic"),
+        joint_p=(0.8, 0.2),
+    )
+    m = ff.Model.from_yaml_string(desc.to_yaml())
+    if m.nv != nv:
+        raise SystemExit(f"ABORT: random tree has nv = {m.nv}, wanted {nv}")
+    pt = rt.build_pinocchio(desc)
+    return m, PinSide(pt.model, pt.q_to_pin, pt.v_to_pin, pt.v_from_pin, pt.cols_from_pin)
+
+
+def check_agreement(m, ps, rng, n=5):
+    import freefloat as ff
+
+    def rel(a, b):
+        return float(np.abs(np.asarray(a) - np.asarray(b)).max() / max(1.0, np.abs(np.asarray(b)).max()))
+
+    worst = {"aba": 0.0, "rnea": 0.0, "crba": 0.0}
+    for _ in range(n):
+        q = m.random_configuration(rng)
+        v, tau, a = rng.normal(size=m.nv), 10 * rng.normal(size=m.nv), rng.normal(size=m.nv)
+        worst["aba"] = max(worst["aba"], rel(ff.aba(m, q, v, tau), ps.aba(q, v, tau)))
+        worst["rnea"] = max(worst["rnea"], rel(ff.rnea(m, q, v, a), ps.rnea(q, v, a)))
+        worst["crba"] = max(worst["crba"], rel(ff.crba(m, q), ps.crba(q)))
+    bad = {k: e for k, e in worst.items() if not e <= 1e-9}
+    if bad:
+        raise SystemExit(f"ABORT: freefloat and Pinocchio disagree on {m.name}: {bad}")
+    return worst
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# timing
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def interleaved(cases: dict, per: dict, repeats: int):
+    for f in cases.values():
+        f()
+    res = {k: {"wall": [], "cpu": []} for k in cases}
+    for _ in range(repeats):
+        for k, f in cases.items():
+            w, c, _ = _clock(f)
+            res[k]["wall"].append(w / per[k])
+            res[k]["cpu"].append(c / per[k])
+    return res
+
+
+def stats(s):
+    return {
+        "median": statistics.median(s["wall"]),
+        "min": min(s["wall"]),
+        "max": max(s["wall"]),
+        "cpu_median": statistics.median(s["cpu"]),
+    }
+
+
+def ratio_stats(a, b):
+    """Per-repeat ratio a/b (same repeat, so the same machine state): median, min, max."""
+    r = [x / y for x, y in zip(a["wall"], b["wall"])]
+    rc = [x / y for x, y in zip(a["cpu"], b["cpu"]) if y > 0]
+    return {
+        "median": statistics.median(r),
+        "min": min(r),
+        "max": max(r),
+        "cpu_median": statistics.median(rc) if rc else None,
+    }
+
+
+def one_body_freeflyer():
+    import pinocchio as pin
+
+    pm = pin.Model()
+    jid = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root")
+    pm.appendBodyToJoint(jid, pin.Inertia.FromBox(100.0, 1.0, 2.0, 3.0), pin.SE3.Identity())
+    return pm
+
+
+def bench_core(m, ps, args, rng):
+    import pinocchio as pin
+
+    import freefloat as ff
+
+    N, R = args.batch, args.repeats
+    Q = np.array([m.random_configuration(rng) for _ in range(N)])
+    V = rng.normal(size=(N, m.nv))
+    T = 10 * rng.normal(size=(N, m.nv))
+    Qp = np.asfortranarray(np.array([ps.q_to(q) for q in Q]).T)
+    Vp = np.asfortranarray(np.array([ps.v_to(x) for x in V]).T)
+    Tp = np.asfortranarray(np.array([ps.v_to(x) for x in T]).T)
+    pool = pin.ModelPool(ps.model, 1)
+    out = np.zeros((m.nv, N), order="F")
+    got = pin.abaInParallel(1, pool, Qp, Vp, Tp)
+    mine = ff.aba(m, Q, V, T)
+    err = max(float(np.abs(ps.v_from(got[:, k]) - mine[k]).max()) for k in range(min(N, 50)))
+    if not err <= 1e-9 * max(1.0, float(np.abs(got).max())):
+        raise SystemExit(f"ABORT: abaInParallel and batched ff.aba differ by {err}")
+
+    n_crba = min(N, 1000)
+    Qs = Q[:n_crba].copy()
+    qp0 = ps.q_to(Q[0])
+    pd = ps.data
+    pm1 = one_body_freeflyer()
+    pd1 = pm1.createData()
+    q1 = pin.neutral(pm1)
+
+    def pin_loop(model, data, qq, calls):
+        def run():
+            for _ in range(calls):
+                pin.crba(model, data, qq)
+
+        return run
+
+    cases = {
+        "ff aba": lambda: ff.aba(m, Q, V, T),
+        "pin abaInParallel": lambda: pin.abaInParallel(1, pool, Qp, Vp, Tp, out),
+        "ff rnea": lambda: ff.rnea(m, Q, V, T),
+        "pin rneaInParallel": lambda: pin.rneaInParallel(1, pool, Qp, Vp, Tp, out),
+        "ff crba": lambda: ff.crba(m, Qs),
+        "pin crba loop": pin_loop(ps.model, pd, qp0, n_crba),
+        "pin crba loop, 1-body model": pin_loop(pm1, pd1, q1, n_crba),
+    }
+    per = {k: N for k in cases}
+    per.update({"ff crba": n_crba, "pin crba loop": n_crba, "pin crba loop, 1-body model": n_crba})
+    res = interleaved(cases, per, R)
+    # Pinocchio's CRBA in C++ alone: the loop minus the same loop on a one-body model (binding + loop cost)
+    res["pin crba (C++ estimate)"] = {
+        k: [a - b for a, b in zip(res["pin crba loop"][k], res["pin crba loop, 1-body model"][k])]
+        for k in ("wall", "cpu")
+    }
+    rows = {
+        "aba": ratio_stats(res["ff aba"], res["pin abaInParallel"]),
+        "rnea": ratio_stats(res["ff rnea"], res["pin rneaInParallel"]),
+        "crba": ratio_stats(res["ff crba"], res["pin crba (C++ estimate)"]),
+    }
+    return {k: stats(s) for k, s in res.items()}, rows
+
+
+def bench_single(m, ps, args, rng):
+    import pinocchio as pin
+
+    import freefloat as ff
+
+    C, R = args.calls, args.repeats
+    q = m.random_configuration(rng)
+    v, tau = rng.normal(size=m.nv), 10 * rng.normal(size=m.nv)
+    qp, vp, tp = ps.q_to(q), ps.v_to(v), ps.v_to(tau)
+    pm, pd = ps.model, ps.data
+
+    def loop(f):
+        def run():
+            for _ in range(C):
+                f()
+
+        return run
+
+    cases = {
+        "ff aba": loop(lambda: ff.aba(m, q, v, tau)),
+        "pin aba": loop(lambda: pin.aba(pm, pd, qp, vp, tp)),
+        "ff crba": loop(lambda: ff.crba(m, q)),
+        "pin crba": loop(lambda: pin.crba(pm, pd, qp)),
+        "ff momentum": loop(lambda: ff.momentum(m, q, v)),
+        "pin computeCentroidalMomentum": loop(lambda: pin.computeCentroidalMomentum(pm, pd, qp, vp)),
+    }
+    res = interleaved(cases, {k: C for k in cases}, R)
+    rows = {
+        "aba": ratio_stats(res["ff aba"], res["pin aba"]),
+        "crba": ratio_stats(res["ff crba"], res["pin crba"]),
+        "momentum": ratio_stats(res["ff momentum"], res["pin computeCentroidalMomentum"]),
+    }
+    return {k: stats(s) for k, s in res.items()}, rows
+
+
+def us(x):
+    return f"{1e6 * x:.2f}"
+
+
+def report(env, args, results, single, single_rows):
+    lines = [
+        "# Dynamics kernels vs Pinocchio (benches/kernels_vs_pinocchio.py)",
+        "",
+        f"git {env['git']}, Pinocchio {env['pinocchio']}, {env['cpu']}, {env['nproc']} CPUs; load average "
+        f"{env['loadavg_start']} at the start, {env['loadavg_end']} at the end. {args.repeats} interleaved "
+        f"repeats, batch N = {args.batch}, {args.calls} single calls per repeat.",
+        "",
+        "Ratio = freefloat time / Pinocchio time per call, per repeat (wall median [min-max], and the median of "
+        "the per-repeat CPU-time ratios, on which 'met?' is judged). < 1: freefloat is faster.",
+        "",
+        "| robot | nv | kernel | freefloat [µs] | Pinocchio [µs] | ratio | CPU ratio | target | met? |",
+        "|---|---:|---|---:|---:|---:|---:|---:|---|",
+    ]
+    peer = {"aba": "pin abaInParallel", "rnea": "pin rneaInParallel", "crba": "pin crba (C++ estimate)"}
+    for name, r in results.items():
+        for k in ("aba", "rnea", "crba"):
+            row = r["rows"][k]
+            # judged on the CPU-time ratio (the machine is shared); an estimate <= 0 (noise larger than the
+            # difference it is taken from) is no measurement
+            judged = row["cpu_median"] if row["cpu_median"] is not None else row["median"]
+            ok = 0 < judged <= TARGETS[k]
+            verdict = "yes" if ok else ("**no**" if judged > 0 else "no estimate")
+            lines.append(
+                f"| {name} | {r['nv']} | {k} | {us(r['times']['ff ' + k]['median'])} | "
+                f"{us(r['times'][peer[k]]['median'])} | {row['median']:.2f} [{row['min']:.2f}-{row['max']:.2f}] | "
+                f"{row['cpu_median']:.2f} | <= {TARGETS[k]} | {verdict} |"
+            )
+    lines += [
+        "",
+        "Pinocchio's CRBA time is estimated: a Python loop of `pin.crba` minus the same loop on a one-body model.",
+        "",
+        f"## Single calls from Python ({SEED_ROBOT})",
+        "",
+        "| call | freefloat [µs] | Pinocchio [µs] | ratio | CPU ratio | target |",
+        "|---|---:|---:|---:|---:|---|",
+    ]
+    names = {"aba": "pin aba", "crba": "pin crba", "momentum": "pin computeCentroidalMomentum"}
+    for k, row in single_rows.items():
+        lines.append(
+            f"| {k} | {us(single['ff ' + k]['median'])} | {us(single[names[k]]['median'])} | "
+            f"{row['median']:.2f} [{row['min']:.2f}-{row['max']:.2f}] | {row['cpu_median']:.2f} | <= 1 |"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    env = environment()
+    rng = np.random.default_rng(args.seed)
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        robots = [(SEED_ROBOT, lambda: seed_robot(Path(tmp)))]
+        robots += [(f"random tree nv={nv}", lambda nv=nv: random_robot(nv, 1000 + nv)) for nv in (12, 30)]
+        single = single_rows = None
+        for name, build in robots:
+            m, ps = build()
+            agree = check_agreement(m, ps, rng)
+            times, rows = bench_core(m, ps, args, rng)
+            results[name] = {"nv": m.nv, "agreement_max_rel": agree, "times": times, "rows": rows}
+            if name == SEED_ROBOT:
+                single, single_rows = bench_single(m, ps, args, rng)
+            print(
+                f"{name}: "
+                + ", ".join(f"{k} {r['median']:.2f} [{r['min']:.2f}-{r['max']:.2f}]" for k, r in rows.items()),
+                flush=True,
+            )
+    env["loadavg_end"] = os.getloadavg()
+    print("single calls: " + ", ".join(f"{k} {r['median']:.2f}" for k, r in single_rows.items()))
+    args.out.mkdir(parents=True, exist_ok=True)
+    md = report(env, args, results, single, single_rows)
+    (args.out / "kernels_vs_pinocchio.md").write_text(md)
+    payload = {
+        "environment": env,
+        "args": {k: (str(v) if isinstance(v, Path) else v) for k, v in vars(args).items()},
+        "results": results,
+        "single": single,
+        "single_rows": single_rows,
+    }
+    (args.out / "kernels_vs_pinocchio.json").write_text(json.dumps(payload, indent=1))
+    print(md)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
