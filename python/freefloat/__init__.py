@@ -58,10 +58,15 @@ from .identification import (
 from .io import Telemetry, telemetry
 from .model import Model
 from .simulation import Trajectory, simulate
+from .actuators import Actuators, Tank, Thruster, Wheel
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Actuators",
+    "Wheel",
+    "Thruster",
+    "Tank",
     "Model",
     "Trajectory",
     "models",
