@@ -221,8 +221,8 @@ def test_tank_depletion_mass_equals_the_propellant_through_the_nozzle():
     np.testing.assert_allclose(tr.propellant[-1, 0], 0.5 - used, rtol=1e-12)
     np.testing.assert_allclose(tr.base_parameters[-1, 0], 2.0 - used, rtol=1e-12)
     np.testing.assert_allclose(tr.base_parameters[0, 0], 2.0, rtol=1e-15)
-    # m c_x = 0.1 × propellant left (the dry body's centre of mass is at the origin)
-    np.testing.assert_allclose(tr.base_parameters[:, 1], 0.1 * tr.propellant[:, 0], rtol=1e-12, atol=1e-15)
+    # the model's (wet) body has its centre of mass at the origin; m c_x then changes by 0.1 × propellant used
+    np.testing.assert_allclose(tr.base_parameters[:, 1], 0.1 * (tr.propellant[:, 0] - 0.5), rtol=1e-12, atol=1e-15)
     # rocket: the body's velocity grows as ∫ F / m(t) dt: Δv = Isp g0 ln(m0 / m1) (Tsiolkovsky)
     m0, m1 = 2.0, 2.0 - used
     np.testing.assert_allclose(tr.v[-1, 0], 200.0 * G0 * np.log(m0 / m1), rtol=1e-10)

@@ -212,7 +212,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
         }
         self.tau.copy_from_slice(&self.cmd);
         // Actuator forces at this stage: wheel friction, external wrenches, propellant flow.
-        self.act.forces(t, &qs, &vs, &self.mps, &mut self.tau, &mut self.fext, &mut self.kmp[s]);
+        self.act.forces(t, s > 0, &qs, &vs, &self.mps, &mut self.tau, &mut self.fext, &mut self.kmp[s]);
         if let Some(vm) = self.var_model.as_mut() {
             self.act.deplete(vm, &self.mps);
         }

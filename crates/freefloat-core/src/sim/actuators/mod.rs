@@ -116,8 +116,19 @@ impl ActuatorRt {
 
     /// The forces at a stage: wheel friction subtracted from `tau`, external wrenches into `fext`,
     /// and the propellant flow of each tank into `mdot` (kg/s, negative), with the propellant
-    /// left `mp` at this stage.
-    pub fn forces(&self, t: f64, q: &[f64], v: &[f64], mp: &[f64], tau: &mut [f64], fext: &mut [f64], mdot: &mut [f64]) {
+    /// left `mp` at this stage. `left`: the stage is not a step's first (see `Thruster::factor`).
+    #[allow(clippy::too_many_arguments)]
+    pub fn forces(
+        &self,
+        t: f64,
+        left: bool,
+        q: &[f64],
+        v: &[f64],
+        mp: &[f64],
+        tau: &mut [f64],
+        fext: &mut [f64],
+        mdot: &mut [f64],
+    ) {
         for w in &self.wheels {
             tau[w.kv] -= w.friction(v[w.kv]);
         }
@@ -130,7 +141,7 @@ impl ActuatorRt {
             w.jitter(q, v, fext);
         }
         for th in &self.thrusters {
-            let phi = th.factor(t);
+            let phi = th.factor(t, left);
             if phi <= 0.0 {
                 continue;
             }

@@ -144,18 +144,25 @@ impl Thruster {
         Ok(())
     }
 
-    /// Thrust factor φ(t) in [0, 1].
+    /// Thrust factor φ(t) in [0, 1]. `left`: the limit from the left at a firing edge (a stage at the
+    /// end of a step belongs to that step, so a firing that starts at the step's end must not act in it,
+    /// and one that ends there must: piecewise-smooth φ is then integrated exactly when its edges fall on
+    /// step boundaries).
     #[inline]
-    pub(crate) fn factor(&self, t: f64) -> f64 {
+    pub(crate) fn factor(&self, t: f64, left: bool) -> f64 {
         // Firings are few: a linear scan over those that may still act at t.
         let mut phi: f64 = 0.0;
+        // Stage times t0 + c h carry round-off: an edge within eps of t counts as at t.
+        let eps = 1e-12 * t.abs().max(1.0);
         for &(s, d) in &self.firings {
-            if t < s {
+            let started = if left { t > s + eps } else { t >= s - eps };
+            if !started {
                 break;
             }
             let e = s + d;
-            let rise = |x: f64| if self.ramp_on > 0.0 { (x / self.ramp_on).min(1.0) } else { 1.0 };
-            let p = if t < e {
+            let rise = |x: f64| if self.ramp_on > 0.0 { (x / self.ramp_on).clamp(0.0, 1.0) } else { 1.0 };
+            let on = if left { t <= e + eps } else { t < e - eps };
+            let p = if on {
                 rise(t - s)
             } else {
                 let top = rise(d);
