@@ -14,7 +14,8 @@ M_W, JS, JT = 1.0, 0.1, 0.06  # rotor mass, spin and transverse inertia
 AXES = np.eye(3)
 WHEEL_RPM0 = np.array([100.0, 200.0, -150.0])
 CMD = np.array([0.3, 0.1, -0.5])  # N m, constant
-U_MAX, OMEGA_MAX_RPM, P_MAX = 0.2, 400.0, 1.5
+U_MAX, OMEGA_MAX_RPM = 0.2, 400.0
+P_MAX = [None, 1.5, None]  # W: only the second wheel is power-limited
 F_COULOMB, C_VISCOUS = 0.005, 1e-4
 
 
@@ -22,18 +23,19 @@ def freefloat_model():
     import freefloat as ff
 
     i_rot = sum(JS * np.outer(a, a) + JT * (np.eye(3) - np.outer(a, a)) for a in AXES)
-    ih = I_HUB - i_rot
+    ih = (I_HUB - i_rot).tolist()
     lines = [
         "name: bsk_hub_three_wheels",
         "base: free",
         "gravity: [0, 0, 0]",
         "bodies:",
         "  - name: hub",
-        f"    inertial: {{mass: {M_HUB - 3 * M_W!r}, com: [0, 0, 0], inertia: {{xx: {ih[0, 0]!r}, yy: {ih[1, 1]!r}, "
-        f"zz: {ih[2, 2]!r}, xy: 0, yz: 0, xz: 0}}}}",
+        f"    inertial: {{mass: {M_HUB - 3 * M_W!r}, com: [0, 0, 0], inertia: {{xx: {ih[0][0]!r}, yy: {ih[1][1]!r}, "
+        f"zz: {ih[2][2]!r}, xy: 0, yz: 0, xz: 0}}}}",
     ]
     for k, a in enumerate(AXES):
-        d = JT * np.ones(3) + (JS - JT) * a
+        d = (JT * np.ones(3) + (JS - JT) * a).tolist()
+        a = a.tolist()
         lines += [
             f"  - name: rotor{k + 1}",
             "    parent: hub",
@@ -52,7 +54,7 @@ def freefloat_actuators(friction=True, limits=True):
             f"rw{k + 1}",
             max_torque=U_MAX if limits else None,
             max_speed=OMEGA_MAX_RPM * RPM if limits else None,
-            max_power=P_MAX if limits else None,
+            max_power=P_MAX[k] if limits else None,
             coulomb=F_COULOMB if friction else 0.0,
             viscous=C_VISCOUS if friction else 0.0,
         )
@@ -108,7 +110,9 @@ def basilisk_run(t_final, dt, friction=True, limits=True):
             useMaxTorque=limits,
         )
         if limits:
-            kw.update(u_max=U_MAX, Omega_max=OMEGA_MAX_RPM, P_max=P_MAX)
+            kw.update(u_max=U_MAX, Omega_max=OMEGA_MAX_RPM)
+            if P_MAX[k] is not None:
+                kw.update(P_max=P_MAX[k])
         if friction:
             kw.update(fCoulomb=F_COULOMB, cViscous=C_VISCOUS)
         rw = fac.create("custom", [float(x) for x in a], **kw)
