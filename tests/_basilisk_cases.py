@@ -156,3 +156,104 @@ def mrp_to_dcm_nb(s):
     sx = np.array([[0, -s[2], s[1]], [s[2], 0, -s[0]], [-s[1], s[0], 0]])
     c_bn = np.eye(3) + (8 * sx @ sx - 4 * (1 - s2) * sx) / (1 + s2) ** 2
     return c_bn.T
+
+
+# -- thruster firing sequence -------------------------------------------------------------------------------------
+TH_HUB_M, TH_HUB_I = 750.0, np.diag([900.0, 800.0, 600.0])
+TH_PROP, TH_TANK_R = 40.0, 46.0 / 2.0 / 3.2808399 / 12.0  # kg, m (Basilisk's integrated thruster test tank)
+TH_POS, TH_DIR, TH_F, TH_ISP = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.9, 227.5  # MOOG Monarc-1
+TH_FIRINGS = [(1.0, 2.0), (5.0, 0.5), (8.0, 3.0)]  # (start, duration) s
+
+
+def freefloat_thruster_run(t_final, dt, delay=0.0):
+    """The hub carries the tank at its origin: the model's (wet) inertia is hub + full propellant sphere. `delay`
+    shifts every firing (Basilisk reads a command written at t at its next task update, t + dt)."""
+    import freefloat as ff
+
+    i_wet = TH_HUB_I + 0.4 * TH_PROP * TH_TANK_R**2 * np.eye(3)
+    text = "\n".join(
+        [
+            "name: bsk_hub_thruster",
+            "base: free",
+            "gravity: [0, 0, 0]",
+            "bodies:",
+            "  - name: hub",
+            f"    inertial: {{mass: {TH_HUB_M + TH_PROP!r}, com: [0, 0, 0], inertia: [{float(i_wet[0, 0])!r}, "
+            f"{float(i_wet[1, 1])!r}, {float(i_wet[2, 2])!r}]}}",
+        ]
+    )
+    m = ff.Model.from_yaml_string(text + "\n")
+    acts = ff.Actuators(
+        thrusters=[
+            ff.Thruster(
+                position=TH_POS, direction=TH_DIR, max_thrust=TH_F, isp=TH_ISP, tank="main", min_on_time=0.02,
+                firings=[(s + delay, d) for s, d in TH_FIRINGS],
+            )
+        ],
+        tanks=[ff.Tank("main", mass=TH_PROP, radius=TH_TANK_R)],
+    )
+    return ff.simulate(m, m.neutral(), np.zeros(6), t_final, dt, actuators=acts)
+
+
+def basilisk_thruster_run(t_final, dt):
+    """Basilisk 2.12: hub + ThrusterDynamicEffector (Monarc-1 preset) fed by a FuelTank (constant-volume sphere),
+    on-time commands written at each firing start. Returns (t, r_BN_N, sigma_BN, omega_BN_B, fuel mass)."""
+    from Basilisk.architecture import messaging
+    from Basilisk.simulation import fuelTank, spacecraft, thrusterDynamicEffector
+    from Basilisk.utilities import SimulationBaseClass, macros, simIncludeThruster
+
+    sim = SimulationBaseClass.SimBaseClass()
+    proc = sim.CreateNewProcess("proc")
+    proc.addTask(sim.CreateNewTask("task", macros.sec2nano(dt)))
+    sc = spacecraft.Spacecraft()
+    sc.ModelTag = "hub"
+    fac = simIncludeThruster.thrusterFactory()
+    fac.create("MOOG_Monarc_1", TH_POS, TH_DIR)
+    the = thrusterDynamicEffector.ThrusterDynamicEffector()
+    fac.addToSpacecraft("thr", the, sc)
+    tank = fuelTank.FuelTank()
+    model = fuelTank.FuelTankModelConstantVolume()
+    tank.setTankModel(model)
+    model.propMassInit = TH_PROP
+    model.r_TcT_TInit = [[0.0], [0.0], [0.0]]
+    model.radiusTankInit = TH_TANK_R
+    tank.setR_TB_B([[0.0], [0.0], [0.0]])
+    tank.addThrusterSet(the)
+    sc.addStateEffector(tank)
+    fuel = tank.fuelTankOutMsg.recorder()
+    cmd = messaging.THRArrayOnTimeCmdMsgPayload()
+    cmd.OnTimeRequest = [0.0]
+    msg = messaging.THRArrayOnTimeCmdMsg().write(cmd)
+    the.cmdsInMsg.subscribeTo(msg)
+    sim.AddModelToTask("task", tank)
+    sim.AddModelToTask("task", the)
+    sim.AddModelToTask("task", sc)
+    sc.hub.mHub = TH_HUB_M
+    sc.hub.r_BcB_B = [[0.0], [0.0], [0.0]]
+    sc.hub.IHubPntBc_B = TH_HUB_I.tolist()
+    sc.hub.omega_BN_BInit = [[0.0], [0.0], [0.0]]
+    sc.hub.sigma_BNInit = [[0.0], [0.0], [0.0]]
+    sc.hub.r_CN_NInit = [[0.0], [0.0], [0.0]]
+    sc.hub.v_CN_NInit = [[0.0], [0.0], [0.0]]
+    log = sc.scStateOutMsg.recorder()
+    thr = the.thrusterOutMsgs[0].recorder()
+    for r in (log, fuel, thr):
+        sim.AddModelToTask("task", r)
+    sim.InitializeSimulation()
+    for start, dur in TH_FIRINGS:
+        sim.ConfigureStopTime(macros.sec2nano(start))
+        sim.ExecuteSimulation()
+        cmd.OnTimeRequest = [float(dur)]
+        msg.write(cmd, macros.sec2nano(start))
+    sim.ConfigureStopTime(macros.sec2nano(t_final))
+    sim.ExecuteSimulation()
+    t = log.times() * 1e-9
+    return (
+        t,
+        np.array(log.r_BN_N),
+        np.array(log.sigma_BN),
+        np.array(log.omega_BN_B),
+        np.array(fuel.fuelMass),
+        thr.times() * 1e-9,
+        np.array(thr.thrustForce),
+    )
