@@ -27,8 +27,9 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "tests"))
 
-import freefloat as ff  # noqa: E402
 from _basilisk_cases import basilisk_run, freefloat_run  # noqa: E402
+
+import freefloat as ff  # noqa: E402
 
 
 def med_spread(xs):
@@ -67,7 +68,9 @@ def seed_actuators(m):
     wheels = [j for j in m.joint_names if j.lower().startswith(("w", "rw"))]
     wheels = [j for j in wheels if j in ("Wx", "Wy", "Wz") or j.startswith("rw")]
     acts = ff.Actuators(
-        wheels=[ff.Wheel(j, max_torque=5.0, max_speed=600.0, max_power=500.0, coulomb=1e-3, viscous=1e-5) for j in wheels],
+        wheels=[
+            ff.Wheel(j, max_torque=5.0, max_speed=600.0, max_power=500.0, coulomb=1e-3, viscous=1e-5) for j in wheels
+        ],
         thrusters=[
             ff.Thruster(direction=(1, 0, 0), position=(0, 1, 0), max_thrust=1.0, firings=[(1.0, 0.5), (5.0, 0.2)]),
             ff.Thruster(direction=(-1, 0, 0), position=(0, -1, 0), max_thrust=1.0, firings=[(1.0, 0.5), (5.0, 0.2)]),
@@ -124,7 +127,8 @@ def main():
         f"{p1['basilisk_s'][0]:.4f} ({p1['basilisk_s'][1]:.4f}..{p1['basilisk_s'][2]:.4f}) | "
         f"{p1['speedup_median']:.1f}x |",
         "",
-        f"Agreement: body rates {p1['agreement_body_rate']:.2g} rad/s, wheel rates {p1['agreement_wheel_rate']:.2g} rad/s.",
+        f"Agreement: body rates {p1['agreement_body_rate']:.2g} rad/s, "
+        f"wheel rates {p1['agreement_wheel_rate']:.2g} rad/s.",
         "",
         "## Seed robots with and without actuators",
         "",

@@ -144,8 +144,12 @@ def basilisk_run(t_final, dt, friction=True, limits=True):
     sim.ConfigureStopTime(macros.sec2nano(t_final))
     sim.ExecuteSimulation()
     t = log.times() * 1e-9
-    return t, np.array(log.sigma_BN), np.array(log.omega_BN_B), np.array(speeds.wheelSpeeds)[:, :3], np.array(
-        hlog.totRotAngMomPntC_N
+    return (
+        t,
+        np.array(log.sigma_BN),
+        np.array(log.omega_BN_B),
+        np.array(speeds.wheelSpeeds)[:, :3],
+        np.array(hlog.totRotAngMomPntC_N),
     )
 
 
@@ -186,7 +190,12 @@ def freefloat_thruster_run(t_final, dt, delay=0.0):
     acts = ff.Actuators(
         thrusters=[
             ff.Thruster(
-                position=TH_POS, direction=TH_DIR, max_thrust=TH_F, isp=TH_ISP, tank="main", min_on_time=0.02,
+                position=TH_POS,
+                direction=TH_DIR,
+                max_thrust=TH_F,
+                isp=TH_ISP,
+                tank="main",
+                min_on_time=0.02,
                 firings=[(s + delay, d) for s, d in TH_FIRINGS],
             )
         ],

@@ -15,14 +15,17 @@ G0 = 9.80665
 def hub_wheel_yaml(effort=None, velocity=None, hub_mass=10.0, hub_i=2.0, js=0.1, jt=0.06):
     lim = ""
     if effort is not None or velocity is not None:
-        parts = [f"effort: {effort}" if effort is not None else "", f"velocity: {velocity}" if velocity is not None else ""]
+        parts = [
+            f"effort: {effort}" if effort is not None else "",
+            f"velocity: {velocity}" if velocity is not None else "",
+        ]
         lim = ", limits: {" + ", ".join(p for p in parts if p) + "}"
     return f"""name: hub_wheel
 base: free
 gravity: [0, 0, 0]
 bodies:
   - name: hub
-    inertial: {{mass: {hub_mass}, com: [0, 0, 0], inertia: {{xx: {hub_i}, yy: {hub_i}, zz: {hub_i}, xy: 0, yz: 0, xz: 0}}}}
+    inertial: {{mass: {hub_mass}, com: [0, 0, 0], inertia: [{hub_i}, {hub_i}, {hub_i}]}}
   - name: rotor
     parent: hub
     joint: {{name: rw, type: revolute, axis: [0, 0, 1]{lim}}}
@@ -232,11 +235,23 @@ def test_tank_depletion_mass_equals_the_propellant_through_the_nozzle():
 def test_actuator_bad_input_names_the_key():
     m = point_body()
     with pytest.raises(InputError, match=r"thrusters\[0\].direction"):
-        ff.simulate(m, m.neutral(), np.zeros(6), 1.0, 0.01,
-                    actuators=ff.Actuators(thrusters=[ff.Thruster(direction=(0, 0, 0), max_thrust=1.0)]))
+        ff.simulate(
+            m,
+            m.neutral(),
+            np.zeros(6),
+            1.0,
+            0.01,
+            actuators=ff.Actuators(thrusters=[ff.Thruster(direction=(0, 0, 0), max_thrust=1.0)]),
+        )
     with pytest.raises(InputError, match=r"thrusters\[0\].isp"):
-        ff.simulate(m, m.neutral(), np.zeros(6), 1.0, 0.01,
-                    actuators=ff.Actuators(thrusters=[ff.Thruster(direction=(1, 0, 0), max_thrust=1.0, isp=0.0)]))
+        ff.simulate(
+            m,
+            m.neutral(),
+            np.zeros(6),
+            1.0,
+            0.01,
+            actuators=ff.Actuators(thrusters=[ff.Thruster(direction=(1, 0, 0), max_thrust=1.0, isp=0.0)]),
+        )
     with pytest.raises(InputError, match=r"tanks\[0\].mass"):
         ff.simulate(m, m.neutral(), np.zeros(6), 1.0, 0.01, actuators=ff.Actuators(tanks=[ff.Tank("t", mass=3.0)]))
     with pytest.raises(InputError, match="unknown key"):
@@ -245,8 +260,14 @@ def test_actuator_bad_input_names_the_key():
     with pytest.raises(InputError, match=r"wheels\[0\].joint"):
         ff.simulate(mw, mw.neutral(), np.zeros(mw.nv), 1.0, 0.01, actuators=ff.Actuators(wheels=[ff.Wheel("nope")]))
     with pytest.raises(InputError, match=r"wheels\[0\].max_torque"):
-        ff.simulate(mw, mw.neutral(), np.zeros(mw.nv), 1.0, 0.01,
-                    actuators=ff.Actuators(wheels=[ff.Wheel("rw", max_torque=-1.0)]))
+        ff.simulate(
+            mw,
+            mw.neutral(),
+            np.zeros(mw.nv),
+            1.0,
+            0.01,
+            actuators=ff.Actuators(wheels=[ff.Wheel("rw", max_torque=-1.0)]),
+        )
 
 
 def test_actuators_from_a_yaml_block():

@@ -9,9 +9,9 @@ import pytest
 
 bsk = pytest.importorskip("Basilisk", reason="Basilisk (PyPI `bsk`) is not installed: pip install bsk")
 
-import freefloat as ff  # noqa: E402
-
 from _basilisk_cases import RPM, basilisk_run, freefloat_model, freefloat_run  # noqa: E402
+
+import freefloat as ff  # noqa: E402
 
 
 def _quat_to_dcm(q):
@@ -79,9 +79,8 @@ def test_thruster_firing_sequence_with_propellant_matches_basilisk():
     relative on body rate and position and 1e-3 on the attitude matrix. The other modelling difference (Basilisk
     keeps d(I ω)/dt = τ for the hub + propellant, freefloat lets the propellant leave with the hub's motion,
     docs/actuators.md) is ~1e-8 here: the spherical tank at the centre carries 0.4 kg m² of 600."""
-    from Basilisk.utilities import RigidBodyKinematics as rbk
-
     from _basilisk_cases import TH_F, TH_FIRINGS, TH_ISP, TH_PROP, basilisk_thruster_run, freefloat_thruster_run
+    from Basilisk.utilities import RigidBodyKinematics as rbk
 
     dt, tf = 0.01, 15.0
     tr = freefloat_thruster_run(tf, dt)
@@ -99,9 +98,7 @@ def test_thruster_firing_sequence_with_propellant_matches_basilisk():
     d_w = np.abs(w_ff - omega[:n]).max() / np.abs(omega[:n]).max()
     pos = tr.q[:n, :3]
     d_r = np.abs(pos - r[:n]).max() / np.abs(r[:n]).max()
-    d_att = max(
-        np.linalg.norm(_quat_to_dcm(tr.q[k, 3:7]) - np.asarray(rbk.MRP2C(sigma[k])).T) for k in range(0, n, 50)
-    )
+    d_att = max(np.linalg.norm(_quat_to_dcm(tr.q[k, 3:7]) - np.asarray(rbk.MRP2C(sigma[k])).T) for k in range(0, n, 50))
     print(f"body rate rel {d_w:.3g}, position rel {d_r:.3g}, attitude {d_att:.3g}")
     assert d_w < 1.5e-3
     assert d_r < 1.5e-3

@@ -18,6 +18,7 @@ _cpu.check()  # before anything loads the engine: a clear ImportError on too old
 
 from . import constants, control, derivatives, dq, identification, io, models, trajectories, viz
 from ._core import InputError, ModelError, NumericalError
+from .actuators import Actuators, Tank, Thruster, Wheel
 from .algorithms import (
     aba,
     base_twist_for_momentum,
@@ -58,7 +59,6 @@ from .identification import (
 from .io import Telemetry, telemetry
 from .model import Model
 from .simulation import Trajectory, simulate
-from .actuators import Actuators, Tank, Thruster, Wheel
 
 __version__ = "0.1.0"
 

@@ -99,7 +99,9 @@ class Actuators:
                     d["firings"] = [tuple(map(float, f)) for f in d["firings"]] if "firings" in d else None
                     items.append({k: v for k, v in d.items() if v is not None})
                 else:
-                    raise InputError(f"actuators.{key}[{j}]: expected a freefloat.{kind.__name__}, got {type(a).__name__}")
+                    raise InputError(
+                        f"actuators.{key}[{j}]: expected a freefloat.{kind.__name__}, got {type(a).__name__}"
+                    )
             out[key] = items
         return out
 
@@ -162,8 +164,12 @@ def add_wheels(model_yaml: dict, n: int = 3, *, axes=None, inertia=(0.1, 0.05), 
                     "mass": mass,
                     "com": [0, 0, 0],
                     "inertia": {
-                        "xx": inert[0, 0], "yy": inert[1, 1], "zz": inert[2, 2],
-                        "xy": inert[0, 1], "yz": inert[1, 2], "xz": inert[0, 2],
+                        "xx": inert[0, 0],
+                        "yy": inert[1, 1],
+                        "zz": inert[2, 2],
+                        "xy": inert[0, 1],
+                        "yz": inert[1, 2],
+                        "xz": inert[0, 2],
                     },
                 },
                 "tags": ["wheel"],

@@ -300,8 +300,17 @@ fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actuators> {
         check_keys(
             w,
             &[
-                "joint", "max_torque", "max_speed", "max_power", "coulomb", "static_friction", "stribeck_speed",
-                "viscous", "limit_cycle_speed", "static_imbalance", "dynamic_imbalance",
+                "joint",
+                "max_torque",
+                "max_speed",
+                "max_power",
+                "coulomb",
+                "static_friction",
+                "stribeck_speed",
+                "viscous",
+                "limit_cycle_speed",
+                "static_imbalance",
+                "dynamic_imbalance",
             ],
             &at,
         )?;
@@ -358,8 +367,17 @@ fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actuators> {
         check_keys(
             t,
             &[
-                "name", "body", "position", "direction", "max_thrust", "min_on_time", "ramp_on", "ramp_off", "isp",
-                "tank", "firings",
+                "name",
+                "body",
+                "position",
+                "direction",
+                "max_thrust",
+                "min_on_time",
+                "ramp_on",
+                "ramp_off",
+                "isp",
+                "tank",
+                "firings",
             ],
             &at,
         )?;

@@ -8,8 +8,8 @@ mod inputs;
 pub(crate) mod tableau;
 mod trajectory;
 
-pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use actuators::{Actuators, Tank, Thruster, Wheel};
+pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 
@@ -296,7 +296,8 @@ impl<'m, 'i> Stepper<'m, 'i> {
                 self.vs[k] = v0[k] + self.dv[k];
             }
             for k in 0..self.mp.len() {
-                self.mps[k] = self.mp[k] + h * tab.a[s].iter().enumerate().map(|(j, a)| a * self.kmp[j][k]).sum::<f64>();
+                self.mps[k] =
+                    self.mp[k] + h * tab.a[s].iter().enumerate().map(|(j, a)| a * self.kmp[j][k]).sum::<f64>();
             }
             self.eval(t + tab.c[s] * h, s)?;
             dexpinv(m, &self.dq, &mut self.kq[s]);

@@ -58,10 +58,16 @@ impl ActuatorRt {
             let at = format!("actuators.wheels[{j}]");
             w.check(m, &at)?;
             if seen[w.joint] {
-                return Err(FfError::arg(&format!("{at}.joint"), format!("joint '{}' has two wheel models", m.joint_names[w.joint])));
+                return Err(FfError::arg(
+                    &format!("{at}.joint"),
+                    format!("joint '{}' has two wheel models", m.joint_names[w.joint]),
+                ));
             }
             if prescribed[w.joint] {
-                return Err(FfError::arg(&format!("{at}.joint"), format!("joint '{}' is prescribed", m.joint_names[w.joint])));
+                return Err(FfError::arg(
+                    &format!("{at}.joint"),
+                    format!("joint '{}' is prescribed", m.joint_names[w.joint]),
+                ));
             }
             seen[w.joint] = true;
             wheels.push(WheelRt::new(m, w));
@@ -75,7 +81,10 @@ impl ActuatorRt {
             if total > 0.0 && total >= m.inertias[b].mass {
                 return Err(FfError::arg(
                     "actuators.tanks",
-                    format!("the tanks on body '{}' hold {total} kg, not less than the body's {} kg", m.body_names[b], m.inertias[b].mass),
+                    format!(
+                        "the tanks on body '{}' hold {total} kg, not less than the body's {} kg",
+                        m.body_names[b], m.inertias[b].mass
+                    ),
                 ));
             }
         }

@@ -22,9 +22,9 @@
 //! turns with the wheel angle θ about the spin axis `ĝ`: `ŵ₂ = cos θ ŵ₂₀ + sin θ (ĝ × ŵ₂₀)`,
 //! `ŵ₂₀ = ĝ × x̂` normalised (`ĝ × ŷ` when ĝ is nearly along x̂), Basilisk's wheel frame.
 
+use crate::error::{FfError, Result};
 use crate::model::{JointType, Model};
 use crate::spatial::V3;
-use crate::error::{FfError, Result};
 
 /// A reaction wheel: the model's revolute joint `joint` (body index of the rotor) with its drive.
 /// Every limit is optional (`None`: none); friction coefficients default to zero.
