@@ -285,3 +285,64 @@ actuators:
     v0[6] = 10.0
     tr = ff.simulate(m, m.neutral(), v0, 1.0, 1e-3, actuators=d["actuators"])
     np.testing.assert_allclose(tr.v[-1, 6], 10.0 * np.exp(-0.01 * (1 / 0.1 + 1 / 2.0)), rtol=1e-10)
+
+
+def test_add_wheels_appends_rotor_bodies_to_the_base():
+    import yaml
+
+    from freefloat.actuators import add_wheels
+
+    doc = yaml.safe_load(hub_wheel_yaml())
+    doc["bodies"] = doc["bodies"][:1]
+    m = ff.Model.from_yaml_string(yaml.safe_dump(add_wheels(doc, 3, inertia=(0.1, 0.06), mass=1.0)))
+    assert m.nv == 9 and [j for j in m.joint_names if j.startswith("rw")] == ["rw1", "rw2", "rw3"]
+    # locked inertia about the base origin: hub 2 + per axis one spin (0.1) and two transverse (0.06 + m r² 0.04)
+    mb = ff.crba(m, m.neutral())[3:6, 3:6]
+    np.testing.assert_allclose(np.diag(mb), 2.0 + 0.1 + 2 * (0.06 + 0.04), rtol=1e-12)
+
+
+@pytest.mark.slow
+def test_cli_simulate_reads_an_actuators_file(tmp_path):
+    """`freefloat simulate MODEL --actuators FILE` reads the `actuators:` block; a bad key is a clear error."""
+    import json
+    import subprocess
+    import sys
+
+    model = tmp_path / "hub_wheel.yaml"
+    model.write_text(hub_wheel_yaml())
+    acts = tmp_path / "acts.yaml"
+    acts.write_text("actuators:\n  wheels:\n    - {joint: rw, viscous: 0.01, max_torque: 0.1}\n")
+    out = tmp_path / "run"
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "freefloat.cli",
+            "simulate",
+            str(model),
+            "--actuators",
+            str(acts),
+            "--t-final",
+            "1",
+            "--torques",
+            "zero",
+            "--v0",
+            "0,0,0,0,0,0,10",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    res = json.loads((out / "results.json").read_text())
+    assert res["model"] == "hub_wheel"
+    acts.write_text("actuators:\n  wheels:\n    - {joint: rw, frition: 0.01}\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "freefloat.cli", "simulate", str(model), "--actuators", str(acts), "--t-final", "1"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode != 0 and "frition" in r.stderr and "Traceback" not in r.stderr
