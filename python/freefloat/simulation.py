@@ -100,8 +100,13 @@ class Trajectory:
         return cols
 
     def to_numpy(self) -> dict:
-        """All recorded arrays by name."""
-        return {k: getattr(self, k) for k in ("t", "q", "v", "ddq", "tau", "momentum", "kinetic_energy", "work")}
+        """All recorded arrays by name (with tanks also `propellant` and `base_parameters`)."""
+        out = {k: getattr(self, k) for k in ("t", "q", "v", "ddq", "tau", "momentum", "kinetic_energy", "work")}
+        for k in ("propellant", "base_parameters"):
+            x = getattr(self, k)
+            if x is not None and x.size:
+                out[k] = x
+        return out
 
     # -- conservation summaries -------------------------------------------------------------------------
     def momentum_drift(self) -> dict:
