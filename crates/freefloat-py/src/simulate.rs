@@ -251,7 +251,7 @@ pub fn simulate<'py>(
     d.set_item("momentum", PyArray1::from_slice(py, &tr.momentum).reshape([n, 6])?)?;
     d.set_item("kinetic_energy", PyArray1::from_slice(py, &tr.kinetic_energy))?;
     d.set_item("work", PyArray1::from_slice(py, &tr.work))?;
-    let nt = if n > 0 { tr.propellant.len() / n } else { 0 };
+    let nt = tr.propellant.len().checked_div(n).unwrap_or(0);
     d.set_item("propellant", PyArray1::from_slice(py, &tr.propellant).reshape([n, nt])?)?;
     let nb = if tr.base_parameters.is_empty() { 0 } else { 10 };
     d.set_item("base_parameters", PyArray1::from_slice(py, &tr.base_parameters).reshape([n, nb])?)?;
