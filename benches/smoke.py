@@ -149,6 +149,16 @@ def _check_sim_vs_mujoco(out: Path) -> list[str]:
     return bad
 
 
+def _check_basilisk_wheels(out: Path) -> list[str]:
+    res = json.loads((out / "basilisk_wheels.json").read_text())
+    p1, bad = res["hub_three_wheels"], []
+    if not p1["agreement_body_rate"] < 1e-9:
+        bad.append(f"agreement_body_rate = {p1['agreement_body_rate']:.3g} >= 1e-9")
+    if not res["seed_robots"]:
+        bad.append("no seed robot was timed")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -163,6 +173,7 @@ BENCHES = {
     "sensors": ("sensors_bench.py", [], ("scipy",), _check_sensors),
     "kernels": ("kernels_vs_pinocchio.py", [], ("pinocchio",), _check_kernels),
     "mujoco": ("sim_vs_mujoco.py", [], ("mujoco",), _check_sim_vs_mujoco),
+    "basilisk_wheels": ("basilisk_wheels.py", [], ("Basilisk",), _check_basilisk_wheels),
 }
 
 

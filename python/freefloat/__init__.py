@@ -18,6 +18,7 @@ _cpu.check()  # before anything loads the engine: a clear ImportError on too old
 
 from . import constants, control, derivatives, dq, identification, io, models, trajectories, viz
 from ._core import InputError, ModelError, NumericalError
+from .actuators import Actuators, Tank, Thruster, Wheel
 from .algorithms import (
     aba,
     base_twist_for_momentum,
@@ -63,6 +64,10 @@ from .simulation import Trajectory, simulate
 __version__ = "0.1.0"
 
 __all__ = [
+    "Actuators",
+    "Wheel",
+    "Thruster",
+    "Tank",
     "Model",
     "Trajectory",
     "models",

@@ -25,8 +25,10 @@ class Trajectory:
     """A recorded motion. Arrays have a leading time axis: q (T, nq), v/ddq/tau (T, nv),
     momentum (T, 6) = [p; L about the inertial origin] in the inertial frame, kinetic_energy and
     work (T,). `tau` holds the generalized forces that acted (for prescribed joints: those they
-    needed); `work` is the integral of tau·v since t = 0, so kinetic_energy - kinetic_energy[0]
-    should equal it."""
+    needed; for wheels: motor torque minus friction); `work` is the integral of tau·v (plus the power of
+    thrusters and wheel jitter) since t = 0, so kinetic_energy - kinetic_energy[0] should equal it.
+    With propellant tanks, `propellant` (T, number of tanks) is the mass left in each and `base_parameters`
+    (T, 10) the base's standard inertial parameters over time; otherwise both are empty (T, 0)."""
 
     t: np.ndarray
     q: np.ndarray
@@ -37,6 +39,8 @@ class Trajectory:
     kinetic_energy: np.ndarray
     work: np.ndarray
     model_name: str = ""
+    propellant: np.ndarray | None = None
+    base_parameters: np.ndarray | None = None
     q_labels: list = field(default_factory=list)
     v_labels: list = field(default_factory=list)
     stats: dict = field(default_factory=dict)
@@ -96,23 +100,31 @@ class Trajectory:
         return cols
 
     def to_numpy(self) -> dict:
-        """All recorded arrays by name."""
-        return {k: getattr(self, k) for k in ("t", "q", "v", "ddq", "tau", "momentum", "kinetic_energy", "work")}
+        """All recorded arrays by name (with tanks also `propellant` and `base_parameters`)."""
+        out = {k: getattr(self, k) for k in ("t", "q", "v", "ddq", "tau", "momentum", "kinetic_energy", "work")}
+        for k in ("propellant", "base_parameters"):
+            x = getattr(self, k)
+            if x is not None and x.size:
+                out[k] = x
+        return out
 
     # -- conservation summaries -------------------------------------------------------------------------
     def momentum_drift(self) -> dict:
         """Largest deviation of linear and angular momentum from their initial values, absolute and
         relative to a momentum scale: the largest |p| (|L|) reached, or, if larger, the momentum the
         motion's kinetic energy represents (sqrt(2 M E) and sqrt(2 J E), with M the total mass and
-        J = M R², R the largest distance of a body from the centre of mass at t = 0, both recorded
-        by `simulate` in stats). The second scale keeps the figure meaningful when the momentum
-        itself is zero, as in a robot starting at rest."""
+        J the larger of M R² (R the largest distance of a body from the centre of mass at t = 0) and the
+        largest principal moment of the whole system's inertia about its centre of mass at t = 0, both
+        recorded by `simulate` in stats). The second scale keeps the figure meaningful when the momentum
+        itself is zero, as in a robot starting at rest; the principal moment keeps it meaningful when
+        every body sits at the centre of mass (R = 0, a hub with balanced wheels)."""
         dp = np.linalg.norm(self.momentum[:, :3] - self.momentum[0, :3], axis=1).max()
         dl = np.linalg.norm(self.momentum[:, 3:] - self.momentum[0, 3:], axis=1).max()
         e = np.abs(self.kinetic_energy).max()
         mass, radius = self.stats.get("total_mass", 0.0), self.stats.get("radius", 0.0)
         sp = max(np.linalg.norm(self.momentum[:, :3], axis=1).max(), np.sqrt(2 * mass * e), 1e-300)
-        sl = max(np.linalg.norm(self.momentum[:, 3:], axis=1).max(), np.sqrt(2 * mass * radius**2 * e), 1e-300)
+        j = max(mass * radius**2, self.stats.get("rotational_inertia", 0.0))
+        sl = max(np.linalg.norm(self.momentum[:, 3:], axis=1).max(), np.sqrt(2 * j * e), 1e-300)
         return {
             "linear_abs": float(dp),
             "angular_abs": float(dl),
@@ -210,6 +222,8 @@ def simulate(
     progress=False,
     max_steps: int = 50_000_000,
     formulation: str = "aba",
+    actuators=None,
+    input_timing: str = "step",
 ) -> Trajectory:
     """Simulate the model from (q0, v0) for t_final seconds.
 
@@ -229,7 +243,17 @@ def simulate(
     formulation: "aba" (the engine's articulated-body algorithm) or "dq" (the dual-quaternion Newton-Euler
       system of Valverde 2018 ch. 6, `dq_dynamics`: same motion to round-off, slower; free or fixed base with
       revolute, prismatic, spherical, cylindrical, universal and fixed joints). With "dq" the recorded momentum
-      and kinetic energy are the formulation's own (2.53)/(2.54)."""
+      and kinetic energy are the formulation's own (2.53)/(2.54).
+    actuators: a `freefloat.Actuators` (reaction wheels on revolute joints, thrusters, propellant tanks) or the
+      equivalent mapping (a YAML `actuators:` block), evaluated in the engine at every step (docs/actuators.md).
+      The model's joint limits (effort, velocity) apply in every run: the commanded force is clipped to
+      ±effort and a command that would drive a joint further past its velocity limit becomes zero.
+    input_timing: "step" (default): the torque table or function, the controller-free command, the joint
+      limits and the wheel saturation are read once per step at its start and held through its stages, so a
+      zero-order-hold switch on a step boundary acts from exactly there (rk45 lands on every table time);
+      "stage": read at every Runge-Kutta stage time (keeps RK4's order for a smooth torque function of the
+      state; a held switch on a step boundary then leaks 1/6 of a step into the step before). A table with
+      hold="linear" is read at every stage in both cases."""
     if not isinstance(model, Model):
         raise TypeError(f"expected a freefloat.Model, got {type(model).__name__}")
     if isinstance(prescribed, str):
@@ -250,6 +274,17 @@ def simulate(
     tt = None if torque_times is None else as_f64(torque_times, "torque_times")
     if torques is not None and not callable(torques):
         torques = as_f64(torques, "torques")
+    acts = None
+    if actuators is not None:
+        from .actuators import Actuators
+
+        if isinstance(actuators, dict):
+            actuators = Actuators.from_dict(actuators)
+        if not isinstance(actuators, Actuators):
+            raise InputError(
+                f"argument `actuators`: expected a freefloat.Actuators or a mapping, got {type(actuators).__name__}"
+            )
+        acts = actuators.to_dict()
     try:
         out = _core.simulate(
             model._core,
@@ -272,6 +307,8 @@ def simulate(
             int(max_steps),
             cb,
             formulation,
+            acts,
+            input_timing,
         )
         if bar is not None:  # a finished run fills its bar (however fast it was: tqdm redraws at most every 0.1 s)
             bar.update(bar.total - bar.n)
@@ -287,6 +324,8 @@ def simulate(
         t_final=t_final,
         total_mass=model.total_mass,
         radius=_radius(model, q0),
+        rotational_inertia=_rotational_inertia(model, q0),
+        input_timing=input_timing,
     )
     return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
 
@@ -346,3 +385,21 @@ def _radius(model: Model, q) -> float:
     massive = P[:, 0] > 0
     coms = fk[massive, :3] + np.einsum("bij,bj->bi", quat_to_matrix(fk[massive, 3:7]), P[massive, 1:4] / P[massive, :1])
     return float(np.linalg.norm(coms - center_of_mass(model, q), axis=1).max())
+
+
+def _rotational_inertia(model: Model, q) -> float:
+    """Largest principal moment (kg m²) of the whole system's inertia about its centre of mass at q, the bodies
+    locked (from the engine's composite inertia: the base block of the joint-space inertia matrix); 0 for a
+    base that is not free."""
+    from .algorithms import crba
+
+    if model.nvs[0] != 6:
+        return 0.0
+    mb = crba(model, q)[:6, :6]  # [lin; ang] base block, base frame about the base origin
+    mass = mb[0, 0]
+    if not mass > 0:
+        return 0.0
+    cx = mb[3:, :3] / mass  # M [c]x
+    c = np.array([cx[2, 1], cx[0, 2], cx[1, 0]])
+    i_c = mb[3:, 3:] - mass * (c @ c * np.eye(3) - np.outer(c, c))
+    return float(np.linalg.eigvalsh(0.5 * (i_c + i_c.T)).max())

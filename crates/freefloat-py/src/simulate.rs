@@ -5,7 +5,12 @@
 use crate::algorithms::prescribed_bodies;
 use crate::errors::{guard, input_err};
 use crate::model::PyModel;
-use freefloat_core::sim::{self, Controller, Hold, Inputs, Method, Prescription, SimOptions, TorqueSource};
+use freefloat_core::model::Model;
+use freefloat_core::sim::{
+    self, Actuators, Controller, Hold, InputTiming, Inputs, Method, Prescription, SimOptions, Tank, Thruster,
+    TorqueSource, Wheel,
+};
+use freefloat_core::spatial::V3;
 use freefloat_core::FfError;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -50,7 +55,8 @@ fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'st
 #[pyo3(signature = (
     model, q0, v0, t_final, dt, method = "rk4", rtol = 1e-9, atol = 1e-12, max_step = None, record_every = 1,
     torques = None, torque_times = None, hold = "zoh", controller = None, controller_period = None,
-    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba"
+    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba",
+    actuators = None, input_timing = "step"
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -75,8 +81,20 @@ pub fn simulate<'py>(
     max_steps: usize,
     progress: Option<Bound<'py, PyAny>>,
     formulation: &str,
+    actuators: Option<Bound<'py, PyAny>>,
+    input_timing: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model.inner.clone();
+    let timing = match input_timing {
+        "step" => InputTiming::PerStep,
+        "stage" => InputTiming::Stage,
+        other => return Err(input_err(format!("argument `input_timing`: must be 'step' or 'stage', got '{other}'"))),
+    };
+    let acts = match &actuators {
+        None => None,
+        Some(a) if a.is_none() => None,
+        Some(a) => Some(parse_actuators(&m, a)?),
+    };
     let formulation = match formulation {
         "aba" => sim::Formulation::Aba,
         "dq" => sim::Formulation::DualQuaternion,
@@ -186,7 +204,7 @@ pub fn simulate<'py>(
             TorqueSpec::Table(times, values) => guard(|| TorqueSource::table(times, values, nv, hold))?,
             TorqueSpec::Callable(f) => TorqueSource::Function(state_fn(py, f, stash.clone(), "the torque function")),
         };
-        let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc };
+        let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc, actuators: acts, timing };
         let st = stash.clone();
         let mut prog = progress.map(|p| {
             move |frac: f64| -> bool {
@@ -214,7 +232,7 @@ pub fn simulate<'py>(
                     Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
                     None => TorqueSource::Zero,
                 };
-                let inputs = Inputs { torques, ..Default::default() };
+                let inputs = Inputs { torques, actuators: acts, timing, ..Default::default() };
                 sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, None)
             })
         })
@@ -233,6 +251,10 @@ pub fn simulate<'py>(
     d.set_item("momentum", PyArray1::from_slice(py, &tr.momentum).reshape([n, 6])?)?;
     d.set_item("kinetic_energy", PyArray1::from_slice(py, &tr.kinetic_energy))?;
     d.set_item("work", PyArray1::from_slice(py, &tr.work))?;
+    let nt = tr.propellant.len().checked_div(n).unwrap_or(0);
+    d.set_item("propellant", PyArray1::from_slice(py, &tr.propellant).reshape([n, nt])?)?;
+    let nb = if tr.base_parameters.is_empty() { 0 } else { 10 };
+    d.set_item("base_parameters", PyArray1::from_slice(py, &tr.base_parameters).reshape([n, nb])?)?;
     d.set_item("steps", tr.steps)?;
     d.set_item("rejected", tr.rejected)?;
     d.set_item("evaluations", tr.evaluations)?;
@@ -244,4 +266,203 @@ enum TorqueSpec<'py> {
     Zero,
     Table(Vec<f64>, Vec<f64>),
     Callable(Bound<'py, PyAny>),
+}
+
+/// Read the `actuators` argument: a dict `{"wheels": [...], "thrusters": [...], "tanks": [...]}` of
+/// dicts (what `freefloat.Actuators.to_dict()` writes); joints and bodies by name. Every key is
+/// checked; errors name the entry (`actuators.wheels[1].max_torque`).
+fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actuators> {
+    let d = a.downcast::<PyDict>().map_err(|_| {
+        input_err("argument `actuators`: expected a freefloat.Actuators or a dict with wheels/thrusters/tanks lists")
+    })?;
+    check_keys(d, &["wheels", "thrusters", "tanks"], "actuators")?;
+    let list = |key: &str| -> PyResult<Vec<Bound<'_, PyDict>>> {
+        match d.get_item(key)? {
+            None => Ok(vec![]),
+            Some(x) if x.is_none() => Ok(vec![]),
+            Some(x) => {
+                let items: Vec<Bound<PyAny>> =
+                    x.extract().map_err(|_| input_err(format!("actuators.{key}: expected a list")))?;
+                items
+                    .into_iter()
+                    .enumerate()
+                    .map(|(j, it)| {
+                        it.downcast_into::<PyDict>()
+                            .map_err(|_| input_err(format!("actuators.{key}[{j}]: expected a mapping of settings")))
+                    })
+                    .collect()
+            }
+        }
+    };
+    let mut out = Actuators::default();
+    for (j, w) in list("wheels")?.iter().enumerate() {
+        let at = format!("actuators.wheels[{j}]");
+        check_keys(
+            w,
+            &[
+                "joint",
+                "max_torque",
+                "max_speed",
+                "max_power",
+                "coulomb",
+                "static_friction",
+                "stribeck_speed",
+                "viscous",
+                "limit_cycle_speed",
+                "static_imbalance",
+                "dynamic_imbalance",
+            ],
+            &at,
+        )?;
+        let name = get_str(w, "joint", &at)?;
+        let joint = m
+            .joint_names
+            .iter()
+            .position(|n| *n == name)
+            .ok_or_else(|| input_err(format!("{at}.joint: the model has no joint '{name}'")))?;
+        let mut wh = Wheel::new(joint);
+        wh.max_torque = get_f(w, "max_torque", &at)?;
+        wh.max_speed = get_f(w, "max_speed", &at)?;
+        wh.max_power = get_f(w, "max_power", &at)?;
+        wh.coulomb = get_f(w, "coulomb", &at)?.unwrap_or(0.0);
+        wh.static_friction = get_f(w, "static_friction", &at)?.unwrap_or(0.0);
+        wh.stribeck_speed = get_f(w, "stribeck_speed", &at)?;
+        wh.viscous = get_f(w, "viscous", &at)?.unwrap_or(0.0);
+        wh.limit_cycle_speed = get_f(w, "limit_cycle_speed", &at)?.unwrap_or(1e-4);
+        wh.static_imbalance = get_f(w, "static_imbalance", &at)?.unwrap_or(0.0);
+        wh.dynamic_imbalance = get_f(w, "dynamic_imbalance", &at)?.unwrap_or(0.0);
+        out.wheels.push(wh);
+    }
+    let body = |d: &Bound<PyDict>, at: &str| -> PyResult<usize> {
+        match d.get_item("body")? {
+            None => Ok(0),
+            Some(x) if x.is_none() => Ok(0),
+            Some(_) => {
+                let name = get_str(d, "body", at)?;
+                m.body_names
+                    .iter()
+                    .position(|n| *n == name)
+                    .ok_or_else(|| input_err(format!("{at}.body: the model has no body '{name}'")))
+            }
+        }
+    };
+    let tanks = list("tanks")?;
+    let mut tank_names = Vec::new();
+    for (j, t) in tanks.iter().enumerate() {
+        let at = format!("actuators.tanks[{j}]");
+        check_keys(t, &["name", "body", "position", "mass", "radius"], &at)?;
+        tank_names.push(match t.get_item("name")? {
+            Some(x) if !x.is_none() => get_str(t, "name", &at)?,
+            _ => format!("tank{j}"),
+        });
+        out.tanks.push(Tank {
+            body: body(t, &at)?,
+            position: get_v3(t, "position", &at)?.unwrap_or_else(V3::zeros),
+            mass: get_f(t, "mass", &at)?.ok_or_else(|| input_err(format!("{at}.mass: required (kg of propellant)")))?,
+            radius: get_f(t, "radius", &at)?.unwrap_or(0.0),
+        });
+    }
+    for (j, t) in list("thrusters")?.iter().enumerate() {
+        let at = format!("actuators.thrusters[{j}]");
+        check_keys(
+            t,
+            &[
+                "name",
+                "body",
+                "position",
+                "direction",
+                "max_thrust",
+                "min_on_time",
+                "ramp_on",
+                "ramp_off",
+                "isp",
+                "tank",
+                "firings",
+            ],
+            &at,
+        )?;
+        let tank = match t.get_item("tank")? {
+            None => None,
+            Some(x) if x.is_none() => None,
+            Some(x) => {
+                if let Ok(k) = x.extract::<usize>() {
+                    Some(k)
+                } else {
+                    let name: String =
+                        x.extract().map_err(|_| input_err(format!("{at}.tank: expected a tank name or index")))?;
+                    Some(tank_names.iter().position(|n| *n == name).ok_or_else(|| {
+                        input_err(format!("{at}.tank: no tank named '{name}' (tanks: {tank_names:?})"))
+                    })?)
+                }
+            }
+        };
+        let firings: Vec<(f64, f64)> = match t.get_item("firings")? {
+            None => vec![],
+            Some(x) if x.is_none() => vec![],
+            Some(x) => x.extract().map_err(|_| {
+                input_err(format!("{at}.firings: expected a list of (start, duration) pairs in seconds"))
+            })?,
+        };
+        out.thrusters.push(Thruster {
+            body: body(t, &at)?,
+            position: get_v3(t, "position", &at)?.unwrap_or_else(V3::zeros),
+            direction: get_v3(t, "direction", &at)?
+                .ok_or_else(|| input_err(format!("{at}.direction: required (unit vector, body frame)")))?,
+            max_thrust: get_f(t, "max_thrust", &at)?
+                .ok_or_else(|| input_err(format!("{at}.max_thrust: required (N)")))?,
+            min_on_time: get_f(t, "min_on_time", &at)?.unwrap_or(0.0),
+            ramp_on: get_f(t, "ramp_on", &at)?.unwrap_or(0.0),
+            ramp_off: get_f(t, "ramp_off", &at)?.unwrap_or(0.0),
+            isp: get_f(t, "isp", &at)?,
+            tank,
+            firings,
+        });
+    }
+    // The engine checks every value against the model (ranges, Isp, tank masses) and names the entry.
+    Ok(out)
+}
+
+fn check_keys(d: &Bound<'_, PyDict>, allowed: &[&str], at: &str) -> PyResult<()> {
+    for k in d.keys() {
+        let k: String = k.extract().map_err(|_| input_err(format!("{at}: keys must be strings")))?;
+        if !allowed.contains(&k.as_str()) {
+            return Err(input_err(format!("{at}: unknown key '{k}' (allowed: {})", allowed.join(", "))));
+        }
+    }
+    Ok(())
+}
+
+fn get_f(d: &Bound<'_, PyDict>, key: &str, at: &str) -> PyResult<Option<f64>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(x) if x.is_none() => Ok(None),
+        Some(x) => {
+            let v: f64 = x.extract().map_err(|_| input_err(format!("{at}.{key}: expected a number")))?;
+            if !v.is_finite() {
+                return Err(input_err(format!("{at}.{key}: must be finite, got {v}")));
+            }
+            Ok(Some(v))
+        }
+    }
+}
+
+fn get_str(d: &Bound<'_, PyDict>, key: &str, at: &str) -> PyResult<String> {
+    d.get_item(key)?
+        .ok_or_else(|| input_err(format!("{at}.{key}: required")))?
+        .extract()
+        .map_err(|_| input_err(format!("{at}.{key}: expected a name (string)")))
+}
+
+fn get_v3(d: &Bound<'_, PyDict>, key: &str, at: &str) -> PyResult<Option<V3>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(x) if x.is_none() => Ok(None),
+        Some(x) => {
+            let v: [f64; 3] = x.extract().map_err(|_| input_err(format!("{at}.{key}: expected three numbers")))?;
+            if !v.iter().all(|x| x.is_finite()) {
+                return Err(input_err(format!("{at}.{key}: must be finite")));
+            }
+            Ok(Some(V3::new(v[0], v[1], v[2])))
+        }
+    }
 }

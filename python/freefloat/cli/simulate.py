@@ -49,12 +49,41 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
     help="Dynamics: the engine's ABA, or the dual-quaternion Newton-Euler system (Valverde 2018 ch. 6).",
 )
 @click.option(
+    "--actuators",
+    "actuators_file",
+    type=click.Path(dir_okay=False),
+    help="YAML file with an `actuators:` block (wheels on revolute joints, thrusters, propellant tanks; see "
+    "docs/actuators.md). The model's joint limits (effort, velocity) apply with or without it.",
+)
+@click.option(
+    "--input-timing",
+    type=click.Choice(["step", "stage"]),
+    default="step",
+    show_default=True,
+    help="Read --torques once per step and hold it (step), or at every Runge-Kutta stage (stage).",
+)
+@click.option(
     "--out",
     help="FILE.parquet or FILE.csv (plus FILE.results.json and FILE.png beside it), or a directory (gets "
     "trajectory.parquet, results.json, trajectory.png). Every file written is listed.",
 )
 def simulate_cmd(
-    model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out
+    model,
+    base,
+    t_final,
+    dt,
+    method,
+    rtol,
+    atol,
+    torques,
+    amplitude,
+    q0,
+    v0,
+    record_every,
+    formulation,
+    actuators_file,
+    input_timing,
+    out,
 ):
     """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.
 
@@ -65,6 +94,8 @@ def simulate_cmd(
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
     kw = torque_options(m, torques, amplitude)
+    if actuators_file:
+        kw["actuators"] = read_actuators(actuators_file)
     t0 = time.perf_counter()
     traj = simulate(
         m,
@@ -78,6 +109,7 @@ def simulate_cmd(
         record_every=record_every,
         progress=True,
         formulation=formulation,
+        input_timing=input_timing,
         **kw,
     )
     s = summarize(traj, time.perf_counter() - t0)
@@ -88,3 +120,24 @@ def simulate_cmd(
         click.echo(f"warning: {warn}", err=True)
         s["integration_warning"] = warn
     write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation")
+
+
+def read_actuators(path):
+    """The `actuators:` block of a YAML file (or the whole file if it is the block itself) as an Actuators."""
+    from pathlib import Path
+
+    import yaml
+
+    from .._core import InputError
+    from ..actuators import Actuators
+
+    p = Path(path)
+    if not p.exists():
+        raise InputError(f"--actuators: file not found: {p}")
+    try:
+        d = yaml.safe_load(p.read_text())
+    except yaml.YAMLError as e:
+        raise InputError(f"{p}: not valid YAML: {e}") from None
+    if isinstance(d, dict) and "actuators" in d:
+        d = d["actuators"]
+    return Actuators.from_dict(d, where=f"{p}: actuators")

@@ -199,6 +199,27 @@ impl ModelBuilder {
                 b.joint_type.name()
             )));
         }
+        // Effort and velocity limits are magnitudes (the simulator enforces |tau| <= effort and stops
+        // driving past |v| = velocity); a negative or non-finite one is a mistake in the file, and so
+        // is a lower position limit above the upper one.
+        for (key, x) in [("effort", b.limits.effort), ("velocity", b.limits.velocity)] {
+            if let Some(x) = x {
+                if !(x >= 0.0) || !x.is_finite() {
+                    return Err(FfError::Model(format!(
+                        "joint '{}': limits.{key} must be a finite number >= 0, got {x}",
+                        b.joint_name
+                    )));
+                }
+            }
+        }
+        if let (Some(lo), Some(hi)) = (b.limits.lower, b.limits.upper) {
+            if lo > hi {
+                return Err(FfError::Model(format!(
+                    "joint '{}': limits.lower {lo} is above limits.upper {hi} (inverted limits)",
+                    b.joint_name
+                )));
+            }
+        }
         let mut axis = b.axis;
         if b.joint_type.has_axis() {
             let n = axis.norm();

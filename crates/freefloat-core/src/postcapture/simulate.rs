@@ -3,7 +3,7 @@
 use super::control::{Controller, PostcaptureControl};
 use crate::error::Result;
 use crate::model::Model;
-use crate::sim::{simulate, Inputs, Method, Progress, SimOptions, TorqueSource, Trajectory};
+use crate::sim::{simulate, InputTiming, Inputs, Method, Progress, SimOptions, TorqueSource, Trajectory};
 
 /// Simulate from (q0, v0) for `t_final` seconds with RK4 step `dt`, recording every step (the
 /// identification integrates the thrust at the step rate). The controller (eqs. 39-40) is
@@ -21,7 +21,8 @@ pub fn simulate_postcapture(
 ) -> Result<Trajectory> {
     let mut ctl = Controller::new(m, control)?;
     let torques = TorqueSource::Function(Box::new(move |t, q, v, out| ctl.generalized_forces(m, t, q, v, out)));
-    let inputs = Inputs { torques, controller: None, prescription: None };
+    // The paper's control law is continuous in time: read it at every stage (not held per step).
+    let inputs = Inputs { torques, timing: InputTiming::Stage, ..Default::default() };
     let opts = SimOptions { t_final, dt, method: Method::Rk4, record_every, max_steps: usize::MAX };
     simulate(m, q0, v0, &opts, inputs, progress)
 }

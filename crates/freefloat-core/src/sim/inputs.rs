@@ -11,6 +11,22 @@ pub enum Hold {
     Linear,
 }
 
+/// When the torque source is read during an integration step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum InputTiming {
+    /// Read once per step, at the step's start, and held through its stages (the default): a
+    /// zero-order-hold table switching on a step boundary acts from exactly that boundary, and a
+    /// torque function is sampled like a digital controller running at the step rate. The actuator
+    /// command shaping (joint limits, wheel saturation) happens at the same instant. A linearly
+    /// interpolated table is still read at every stage (it is continuous in time).
+    #[default]
+    PerStep,
+    /// Read at every Runge-Kutta stage time (t + c_s h): for a smooth function of (t, q, v) this
+    /// keeps the integrator's order; a zero-order-hold switch on a step boundary then gets the last
+    /// stage's weight (1/6 with RK4) of the new value in the step before it.
+    Stage,
+}
+
 /// `f(t, q, v, out)`: generalized forces (nv) at time t and state (q, v).
 pub type TorqueFn<'a> = Box<dyn FnMut(f64, &[f64], &[f64], &mut [f64]) -> Result<()> + 'a>;
 
@@ -51,6 +67,23 @@ impl TorqueSource<'_> {
             return Err(FfError::arg("torques", format!("entry {k} is not finite")));
         }
         Ok(TorqueSource::Table { times, values, hold })
+    }
+
+    /// Whether this source is read at every stage regardless of the timing (a linear table).
+    pub(crate) fn continuous(&self) -> bool {
+        matches!(self, TorqueSource::Table { hold: Hold::Linear, .. })
+    }
+
+    /// The first table sample time strictly after `t` (infinity for other sources): the adaptive
+    /// stepper lands there so that a held switch acts from its exact time.
+    pub(crate) fn next_switch(&self, t: f64) -> f64 {
+        match self {
+            TorqueSource::Table { times, hold: Hold::Zoh, .. } => {
+                let k = times.partition_point(|&x| x <= t + 1e-12 * t.abs().max(1.0));
+                times.get(k).copied().unwrap_or(f64::INFINITY)
+            }
+            _ => f64::INFINITY,
+        }
     }
 
     /// Forces at time `t` and state (q, v) into `out` (nv; a table's row length is checked).

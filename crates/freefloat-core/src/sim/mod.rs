@@ -2,15 +2,17 @@
 //! Dormand-Prince 5(4), with joint torques, base thrusters (the base entries of the generalized
 //! force), prescribed joint motion (hybrid dynamics) and a sampled controller with zero-order hold.
 
+pub mod actuators;
 mod base_poses;
 mod batch;
 mod inputs;
 pub(crate) mod tableau;
 mod trajectory;
 
+pub use actuators::{Actuators, Tank, Thruster, Wheel};
 pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use batch::{batch_size, simulate_many, BatchSpec, Stacked};
-pub use inputs::{Controller, Hold, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
+pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 
 use crate::config::{
@@ -73,11 +75,21 @@ pub struct Inputs<'a> {
     pub controller: Option<Controller<'a>>,
     /// Joints that follow a prescribed motion (hybrid dynamics).
     pub prescription: Option<Prescription<'a>>,
+    /// Wheels, thrusters and tanks (the joint limits of the model always apply).
+    pub actuators: Option<Actuators>,
+    /// When the torque source is read within a step (default: once per step, held).
+    pub timing: InputTiming,
 }
 
 impl Default for Inputs<'_> {
     fn default() -> Self {
-        Inputs { torques: TorqueSource::Zero, controller: None, prescription: None }
+        Inputs {
+            torques: TorqueSource::Zero,
+            controller: None,
+            prescription: None,
+            actuators: None,
+            timing: InputTiming::PerStep,
+        }
     }
 }
 
@@ -92,6 +104,21 @@ struct Stepper<'m, 'i> {
     inputs: Inputs<'i>,
     held: Vec<f64>,
     tau: Vec<f64>,
+    /// The shaped command (torque source + controller, after limits and wheel saturation), read at
+    /// a step's start and held through its stages (per-step timing).
+    cmd: Vec<f64>,
+    act: actuators::ActuatorRt,
+    /// Per-body external wrenches (nbodies × 6, body frame, about the body origin) that actuators
+    /// (and, later, the environment) accumulate into; passed to ABA as `fext`.
+    fext: Vec<f64>,
+    /// Propellant left in each tank: at the step's start, at the current stage, at the step's end;
+    /// its rate at every stage.
+    mp: Vec<f64>,
+    mps: Vec<f64>,
+    mp1: Vec<f64>,
+    kmp: Vec<Vec<f64>>,
+    /// A copy of the model whose tank bodies' inertias follow the propellant (tanks only).
+    var_model: Option<Model>,
     presc_mask: Vec<bool>,
     presc_q: Vec<f64>,
     presc_v: Vec<f64>,
@@ -111,7 +138,7 @@ struct Stepper<'m, 'i> {
 
 /// Result of one derivative evaluation at a stage.
 impl<'m, 'i> Stepper<'m, 'i> {
-    fn new(m: &'m Model, inputs: Inputs<'i>, stages: usize) -> Result<Self> {
+    fn new(m: &'m Model, mut inputs: Inputs<'i>, stages: usize) -> Result<Self> {
         let mut presc_mask = vec![false; m.nbodies()];
         if let Some(p) = &inputs.prescription {
             for &b in &p.bodies {
@@ -121,6 +148,11 @@ impl<'m, 'i> Stepper<'m, 'i> {
                 presc_mask[b] = true;
             }
         }
+        let act = actuators::ActuatorRt::new(m, inputs.actuators.take(), &presc_mask)?;
+        let nt = act.ntanks();
+        let mut mp = vec![0.0; nt];
+        act.initial_propellant(&mut mp);
+        let var_model = if act.depletes() { Some(m.clone()) } else { None };
         Ok(Stepper {
             m,
             formulation: Formulation::Aba,
@@ -128,6 +160,14 @@ impl<'m, 'i> Stepper<'m, 'i> {
             inputs,
             held: vec![0.0; m.nv],
             tau: vec![0.0; m.nv],
+            cmd: vec![0.0; m.nv],
+            act,
+            fext: vec![0.0; 6 * m.nbodies()],
+            mps: mp.clone(),
+            mp1: mp.clone(),
+            mp,
+            kmp: vec![vec![0.0; nt]; stages],
+            var_model,
             presc_mask,
             presc_q: vec![0.0; m.nq],
             presc_v: vec![0.0; m.nv],
@@ -164,21 +204,33 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let m = self.m;
         let (mut qs, mut vs) = (std::mem::take(&mut self.qs), std::mem::take(&mut self.vs));
         self.impose(t, &mut qs, &mut vs)?;
-        self.inputs.torques.eval(t, &qs, &vs, &mut self.tau)?;
-        for (x, h) in self.tau.iter_mut().zip(&self.held) {
-            *x += h;
+        // The command: read at the step's start (stage 0) and held, or at every stage (see InputTiming).
+        if s == 0 || self.inputs.timing == InputTiming::Stage || self.inputs.torques.continuous() {
+            self.inputs.torques.eval(t, &qs, &vs, &mut self.cmd)?;
+            for (x, h) in self.cmd.iter_mut().zip(&self.held) {
+                *x += h;
+            }
+            self.act.command(&vs, &mut self.cmd);
         }
+        self.tau.copy_from_slice(&self.cmd);
+        // Actuator forces at this stage: wheel friction, external wrenches, propellant flow.
+        self.act.forces(t, s > 0, &qs, &vs, &self.mps, &mut self.tau, &mut self.fext, &mut self.kmp[s]);
+        if let Some(vm) = self.var_model.as_mut() {
+            self.act.deplete(vm, &self.mps);
+        }
+        let fext = if self.act.uses_fext { Some(&self.fext[..]) } else { None };
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
+        let ma: &Model = self.var_model.as_ref().unwrap_or(m);
         match self.formulation {
-            Formulation::Aba => hybrid_aba_unchecked(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?,
+            Formulation::Aba => hybrid_aba_unchecked(ma, &mut self.d, &qs, &vs, &self.tau, fext, presc)?,
             Formulation::DualQuaternion => {
                 // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
                 let (mask, ddq) = match presc {
                     Some(p) => (Some(p.mask), Some(p.ddq)),
                     None => (None, None),
                 };
-                crate::dqdynamics::solve_system_unchecked(m, &mut self.d, &qs, &vs, &self.tau, None, mask, ddq)?;
+                crate::dqdynamics::solve_system_unchecked(ma, &mut self.d, &qs, &vs, &self.tau, fext, mask, ddq)?;
                 let d = &mut self.d;
                 d.ddq.copy_from_slice(&d.dq.out.ddq);
                 d.tau.copy_from_slice(&self.tau);
@@ -199,6 +251,15 @@ impl<'m, 'i> Stepper<'m, 'i> {
         tangent_rate(m, &qs, &vs, &mut self.kq[s]);
         self.kv[s].copy_from_slice(&self.d.ddq);
         self.kw[s] = self.d.tau.iter().zip(&vs).map(|(a, b)| a * b).sum();
+        if fext.is_some() {
+            // Power of the external wrenches: each one's inertial-frame image on its body's twist
+            // (ABA leaves the placements and the twists at the inertial origin in `d`).
+            let d = &self.d;
+            for i in 0..m.nbodies() {
+                let f = crate::spatial::Force::from_slice(&self.fext[6 * i..6 * i + 6]);
+                self.kw[s] += d.ov[i].dot(&d.o_mi[i].act_force(&f));
+            }
+        }
         self.evals += 1;
         self.qs = qs;
         self.vs = vs;
@@ -236,6 +297,10 @@ impl<'m, 'i> Stepper<'m, 'i> {
             for k in 0..nv {
                 self.vs[k] = v0[k] + self.dv[k];
             }
+            for k in 0..self.mp.len() {
+                self.mps[k] =
+                    self.mp[k] + h * tab.a[s].iter().enumerate().map(|(j, a)| a * self.kmp[j][k]).sum::<f64>();
+            }
             self.eval(t + tab.c[s] * h, s)?;
             dexpinv(m, &self.dq, &mut self.kq[s]);
         }
@@ -251,6 +316,9 @@ impl<'m, 'i> Stepper<'m, 'i> {
         }
         for (j, b) in tab.b.iter().enumerate() {
             w1 += h * b * self.kw[j];
+        }
+        for k in 0..self.mp.len() {
+            self.mp1[k] = self.mp[k] + h * tab.b.iter().enumerate().map(|(j, b)| b * self.kmp[j][k]).sum::<f64>();
         }
         retract(m, q0, &self.dq, q1);
         for k in 0..nv {
@@ -329,6 +397,12 @@ pub fn simulate_with(
     };
     let mut st = Stepper::new(m, inputs, tab.stages())?;
     st.formulation = formulation;
+    if formulation == Formulation::DualQuaternion && st.act.uses_fext {
+        return Err(FfError::arg(
+            "formulation",
+            "thrusters and wheel imbalance need formulation 'aba' (the work of external wrenches is formed from ABA's twists)",
+        ));
+    }
     let expected = match opts.method {
         Method::Rk4 => (opts.t_final / opts.dt).round() as usize / opts.record_every + 2,
         Method::Rk45 { .. } => (opts.t_final / opts.dt).ceil() as usize + 2,
@@ -370,6 +444,7 @@ pub fn simulate_with(
         ctrl_update(&mut st, t, &q, &v, &mut next_sample, &mut sample_k)?;
         st.qs.copy_from_slice(&q);
         st.vs.copy_from_slice(&v);
+        st.mps.copy_from_slice(&st.mp);
         st.eval(t, 0)?;
         // Record the state together with the accelerations and forces evaluated at it.
         let record = match opts.method {
@@ -378,6 +453,11 @@ pub fn simulate_with(
         };
         if record {
             traj.push(&st.d, t, &q, &v, w);
+            if st.act.depletes() {
+                traj.propellant.extend_from_slice(&st.mp);
+                let ma = st.var_model.as_ref().unwrap_or(m);
+                traj.base_parameters.extend_from_slice(&ma.inertias[0].to_params());
+            }
             out_k += 1;
             next_out = out_k as f64 * opts.dt;
         }
@@ -395,6 +475,7 @@ pub fn simulate_with(
             Method::Rk4 => {
                 let (w1, _) = st.step(tab, t, h, &q, &v, w, &mut q1, &mut v1, None)?;
                 w = w1;
+                std::mem::swap(&mut st.mp, &mut st.mp1);
                 steps += 1;
                 t = steps as f64 * h;
             }
@@ -404,12 +485,18 @@ pub fn simulate_with(
                 if st.inputs.controller.is_some() {
                     stop = stop.min(next_sample);
                 }
+                // Held switches of a table and thruster edges: land on them too.
+                if st.inputs.timing == InputTiming::PerStep {
+                    stop = stop.min(st.inputs.torques.next_switch(t));
+                }
+                stop = stop.min(st.act.next_event(t));
                 loop {
                     let hh = h.min(stop - t).min(max_step);
                     let (w1, err) = st.step(tab, t, hh, &q, &v, w, &mut q1, &mut v1, Some((rtol, atol)))?;
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
                     if err <= 1.0 {
                         w = w1;
+                        std::mem::swap(&mut st.mp, &mut st.mp1);
                         t = if (stop - (t + hh)).abs() <= eps_t { stop } else { t + hh };
                         steps += 1;
                         if hh >= h * 0.999 || factor < 1.0 {

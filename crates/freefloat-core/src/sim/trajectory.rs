@@ -26,6 +26,11 @@ pub struct Trajectory {
     pub kinetic_energy: Vec<f64>,
     /// Work done by all generalized forces since t = 0 (integrated with the state).
     pub work: Vec<f64>,
+    /// Propellant left in each tank (T × number of tanks; empty without tanks).
+    pub propellant: Vec<f64>,
+    /// The base's standard inertial parameters over time (T × 10; recorded with tanks only, whose
+    /// propellant changes them).
+    pub base_parameters: Vec<f64>,
     /// Accepted integration steps.
     pub steps: usize,
     /// Rejected steps (adaptive method).

@@ -1,0 +1,178 @@
+"""Actuator models for `simulate`: reaction wheels, thrusters and propellant tanks.
+
+They are evaluated in the engine, inside the integrator (no Python runs during the simulation). The joint
+limits of the model (URDF ``<limit effort velocity>``, YAML ``limits: {effort, velocity}``) always apply, with or
+without these. See ``docs/actuators.md`` for every formula and choice.
+
+    import freefloat as ff
+    acts = ff.Actuators(
+        wheels=[ff.Wheel("rw1", max_torque=0.2, max_speed=600.0, coulomb=5e-4, viscous=1e-6)],
+        thrusters=[ff.Thruster(position=(0, 0, -0.5), direction=(0, 0, 1), max_thrust=1.0, isp=220.0,
+                               tank="main", firings=[(1.0, 0.5)])],
+        tanks=[ff.Tank("main", mass=5.0, position=(0, 0, 0))],
+    )
+    tr = ff.simulate(model, q0, v0, 10.0, 1e-3, actuators=acts)
+    tr.propellant[:, 0], tr.base_parameters[:, 0]   # propellant left, base mass over time
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field, fields
+
+from ._core import InputError
+
+
+@dataclass
+class Wheel:
+    """A reaction wheel: the model's revolute joint `joint` (by name) with its drive. The commanded torque is that
+    joint's entry of the torques/controller; the drive saturates it (torque, power, then speed: no torque that
+    drives |Ω| further past max_speed, Basilisk's order) once per step and subtracts friction at every stage.
+    Limits are optional (None: none). Units: N m, rad/s, W, N m s/rad, kg m, kg m²."""
+
+    joint: str
+    max_torque: float | None = None
+    max_speed: float | None = None
+    max_power: float | None = None
+    coulomb: float = 0.0
+    static_friction: float = 0.0
+    stribeck_speed: float | None = None
+    viscous: float = 0.0
+    limit_cycle_speed: float = 1e-4
+    static_imbalance: float = 0.0
+    dynamic_imbalance: float = 0.0
+
+
+@dataclass
+class Thruster:
+    """A thruster on `body` (None: the base) at `position` (body frame, m) pushing the body along `direction`
+    with max_thrust (N) while a firing is on. `firings`: (start, duration) pairs in seconds; a firing shorter
+    than min_on_time lasts min_on_time; thrust ramps linearly over ramp_on/ramp_off seconds. A thruster fed by a
+    `tank` (its name or index) needs `isp` (s) and stops when the tank is empty."""
+
+    direction: tuple
+    max_thrust: float
+    position: tuple = (0.0, 0.0, 0.0)
+    body: str | None = None
+    min_on_time: float = 0.0
+    ramp_on: float = 0.0
+    ramp_off: float = 0.0
+    isp: float | None = None
+    tank: str | int | None = None
+    firings: list = field(default_factory=list)
+    name: str | None = None
+
+
+@dataclass
+class Tank:
+    """A propellant tank on `body` (None: the base) at `position` (body frame, m): `mass` kg of propellant at t = 0,
+    already included in the body's mass in the model; a point mass (radius 0) or a uniform sphere of `radius` m.
+    The body's inertial parameters follow the propellant left."""
+
+    name: str
+    mass: float
+    position: tuple = (0.0, 0.0, 0.0)
+    body: str | None = None
+    radius: float = 0.0
+
+
+@dataclass
+class Actuators:
+    """Wheels, thrusters and tanks of one simulation (`simulate(..., actuators=...)`)."""
+
+    wheels: list = field(default_factory=list)
+    thrusters: list = field(default_factory=list)
+    tanks: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        """The plain mapping the engine reads (also the layout of a YAML `actuators:` block)."""
+        out = {}
+        for key, kind in (("wheels", Wheel), ("thrusters", Thruster), ("tanks", Tank)):
+            items = []
+            for j, a in enumerate(getattr(self, key)):
+                if isinstance(a, dict):
+                    items.append(dict(a))
+                elif isinstance(a, kind):
+                    d = asdict(a)
+                    for k in ("position", "direction"):
+                        if k in d and d[k] is not None:
+                            d[k] = [float(x) for x in d[k]]
+                    d["firings"] = [tuple(map(float, f)) for f in d["firings"]] if "firings" in d else None
+                    items.append({k: v for k, v in d.items() if v is not None})
+                else:
+                    raise InputError(
+                        f"actuators.{key}[{j}]: expected a freefloat.{kind.__name__}, got {type(a).__name__}"
+                    )
+            out[key] = items
+        return out
+
+    @classmethod
+    def from_dict(cls, d, where: str = "actuators") -> Actuators:
+        """Read an `actuators:` mapping (from a scenario or YAML file): lists `wheels`, `thrusters`, `tanks` of
+        mappings with the fields of Wheel, Thruster, Tank. Unknown keys are errors naming them."""
+        if not isinstance(d, dict):
+            raise InputError(f"{where}: expected a mapping with wheels/thrusters/tanks, got {type(d).__name__}")
+        unknown = set(d) - {"wheels", "thrusters", "tanks"}
+        if unknown:
+            raise InputError(f"{where}: unknown key(s) {sorted(unknown)} (allowed: wheels, thrusters, tanks)")
+        lists = {}
+        for key, kind in (("wheels", Wheel), ("thrusters", Thruster), ("tanks", Tank)):
+            items = d.get(key) or []
+            if not isinstance(items, list):
+                raise InputError(f"{where}.{key}: expected a list")
+            names = {f.name for f in fields(kind)}
+            out = []
+            for j, it in enumerate(items):
+                if not isinstance(it, dict):
+                    raise InputError(f"{where}.{key}[{j}]: expected a mapping of settings")
+                bad = set(it) - names
+                if bad:
+                    raise InputError(f"{where}.{key}[{j}]: unknown key(s) {sorted(bad)} (allowed: {sorted(names)})")
+                try:
+                    out.append(kind(**it))
+                except TypeError as e:  # a required field is missing
+                    raise InputError(f"{where}.{key}[{j}]: {e}") from None
+            lists[key] = out
+        return cls(**lists)
+
+
+def add_wheels(model_yaml: dict, n: int = 3, *, axes=None, inertia=(0.1, 0.05), mass: float = 1.0, radius=0.2):
+    """A convenience for YAML model descriptions: append `n` reaction-wheel bodies (revolute joints named
+    rw1..rwn) to the base of the model mapping `model_yaml` (the layout `Model.from_yaml` reads) and return it.
+    `axes`: n spin axes in the base frame (default x, y, z, then repeated); `inertia`: (spin, transverse)
+    moments of each rotor (kg m²); `radius`: distance of each wheel from the base origin along its axis."""
+    import numpy as np
+
+    axes = axes or [np.eye(3)[k % 3] for k in range(n)]
+    if len(axes) != n:
+        raise InputError(f"argument `axes`: {len(axes)} axes for {n} wheels")
+    base = model_yaml["bodies"][0]["name"]
+    js, jt = inertia
+    for k, a in enumerate(axes):
+        a = np.asarray(a, float)
+        if not np.linalg.norm(a) > 0:
+            raise InputError(f"argument `axes`: wheel {k + 1} has a zero-length axis")
+        a = a / np.linalg.norm(a)
+        # rotor inertia about its centre, joint-frame axes: Js along the spin axis, Jt across it
+        inert = jt * np.eye(3) + (js - jt) * np.outer(a, a)
+        model_yaml["bodies"].append(
+            {
+                "name": f"rw{k + 1}",
+                "parent": base,
+                "joint": {"type": "revolute", "name": f"rw{k + 1}", "axis": a.tolist()},
+                "origin": {"xyz": (radius * a).tolist(), "rpy": [0, 0, 0]},
+                "inertial": {
+                    "mass": float(mass),
+                    "com": [0, 0, 0],
+                    "inertia": {
+                        "xx": float(inert[0, 0]),
+                        "yy": float(inert[1, 1]),
+                        "zz": float(inert[2, 2]),
+                        "xy": float(inert[0, 1]),
+                        "yz": float(inert[1, 2]),
+                        "xz": float(inert[0, 2]),
+                    },
+                },
+                "tags": ["wheel"],
+            }
+        )
+    return model_yaml
