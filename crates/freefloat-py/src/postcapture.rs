@@ -2,7 +2,7 @@
 //! estimators (ordinary RLS with forgetting; the paper's modified RLS, eqs. 34-38) as Python objects
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
-use crate::errors::{guard, input_err};
+use crate::errors::{guard, input_err, reraise_foreign, signal_hook};
 use crate::model::PyModel;
 use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
 use freefloat_core::postcapture::{simulate_postcapture, PostcaptureControl};
@@ -75,7 +75,17 @@ pub fn postcapture_simulate<'py>(
         phase,
     };
     let (q0, v0) = (q0.as_array().to_vec(), v0.as_array().to_vec());
-    let tr = py.detach(move || guard(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, None)))?;
+    // Ctrl-C: the engine polls the hook (GIL re-taken for the signal check only) and stops with `Interrupted`
+    let mut raised: Option<PyErr> = None;
+    let r = {
+        let raised = &mut raised;
+        py.detach(move || {
+            let mut hook = signal_hook(raised);
+            guard(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, Some(&mut hook)))
+        })
+    };
+    reraise_foreign(py, raised)?;
+    let tr = r?;
     let d = PyDict::new(py);
     let n = tr.len();
     d.set_item("t", PyArray1::from_slice(py, &tr.t))?;

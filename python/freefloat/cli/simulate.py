@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import sys
 import time
+from pathlib import Path
 
 import click
 import numpy as np
 
+from .._core import Interrupted
 from ..simulation import simulate
 from ._common import load_model, parse_vector, print_summary, summarize, torque_options, write_outputs
 
@@ -18,7 +21,7 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
     type=click.Choice(["free", "planar", "fixed"]),
     default="free",
     show_default=True,
-    help="Base joint for a URDF model.",
+    help="Base joint for a URDF model (built-in robots and YAML/MJCF files declare their own base joint).",
 )
 @click.option("--t-final", type=float, default=10.0, show_default=True, help="Simulated time [s].")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="RK4 step, or RK45 output interval [s].")
@@ -51,35 +54,54 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
 @click.option(
     "--out",
     help="FILE.parquet or FILE.csv (plus FILE.results.json and FILE.png beside it), or a directory (gets "
-    "trajectory.parquet, results.json, trajectory.png). Every file written is listed.",
+    "trajectory.parquet, results.json, trajectory.png). Every file written is listed. After Ctrl-C the part "
+    "simulated so far is written there.",
+)
+@click.option(
+    "--max-memory",
+    type=float,
+    default=None,
+    help="Largest recording to hold in memory [GB] (default: half the memory available). Longer runs are refused "
+    "before they start; record fewer samples with --record-every.",
 )
 def simulate_cmd(
-    model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out
+    model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out, max_memory
 ):
     """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.
 
     The robot floats freely; joints are driven by --torques. The summary gives the drift of total
     linear and angular momentum (conserved with internal torques only) and the difference between
-    the change of kinetic energy and the work done, both of which measure integration error."""
+    the change of kinetic energy and the work done, both of which measure integration error.
+
+    Ctrl-C stops the run within a fraction of a second; with --out the part simulated so far is written
+    (and results.json says the run was interrupted)."""
     m = load_model(model, base)
+    _check_base(click.get_current_context(), model, base, m)
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
     kw = torque_options(m, torques, amplitude)
     t0 = time.perf_counter()
-    traj = simulate(
-        m,
-        q,
-        v,
-        t_final,
-        dt,
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        record_every=record_every,
-        progress=True,
-        formulation=formulation,
-        **kw,
-    )
+    try:
+        traj = simulate(
+            m,
+            q,
+            v,
+            t_final,
+            dt,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            record_every=record_every,
+            progress=True,
+            formulation=formulation,
+            # interactive runs stop on Ctrl-C: no step limit, only the memory check
+            max_steps=2**62,
+            max_memory=None if max_memory is None else max_memory * 1e9,
+            **kw,
+        )
+    except Interrupted as e:
+        _save_partial(e, m, out, time.perf_counter() - t0)
+        sys.exit(130)
     s = summarize(traj, time.perf_counter() - t0)
     s["model"] = m.name
     print_summary(f"{m.name}: {t_final} s, {method}, {formulation}", s)
@@ -88,3 +110,40 @@ def simulate_cmd(
         click.echo(f"warning: {warn}", err=True)
         s["integration_warning"] = warn
     write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation")
+
+
+def _check_base(ctx, spec: str, base: str, m) -> None:
+    """--base chooses the base joint of a URDF file only; given for another model it is an error, not ignored."""
+    explicit = ctx.get_parameter_source("base") not in (None, click.core.ParameterSource.DEFAULT)
+    if not explicit or Path(spec).suffix.lower() == ".urdf":
+        return
+    own = m.joint_types[0]
+    if base == own:
+        return
+    raise click.BadParameter(
+        f"'{spec}' declares its own base joint ('{own}'); --base {base} applies to URDF files only. To simulate it "
+        f"with a {base} base, save its description (`freefloat models --show {spec} > robot.yaml` for a built-in "
+        f"robot), change the root body's joint to {base}, and simulate that file",
+        param_hint="--base",
+    )
+
+
+def _save_partial(e: Interrupted, m, out, elapsed: float) -> None:
+    """After Ctrl-C: say where the run stopped and write the part simulated so far when --out was given."""
+    traj = getattr(e, "partial", None)
+    if traj is None or len(traj) == 0:
+        click.echo(f"interrupted: {e}; nothing was recorded", err=True)
+        return
+    click.echo(
+        f"interrupted: {e}; {len(traj)} samples recorded, t = {traj.t[0]:g} .. {traj.t[-1]:g} s",
+        err=True,
+    )
+    if not out:
+        click.echo("  (give --out to keep the part simulated so far)", err=True)
+        return
+    s = summarize(traj, elapsed)
+    s["model"] = m.name
+    s["interrupted"] = str(e)
+    s["t_end"] = float(traj.t[-1])
+    write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation (interrupted at t = {traj.t[-1]:g} s)")
+    click.echo("  the files hold the part simulated before the interrupt", err=True)
