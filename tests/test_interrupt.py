@@ -90,8 +90,9 @@ def test_ctrl_c_stops_simulate_with_a_python_torque_function(robot):
         return out
 
     exc, dt_stop = _run_interrupted(
-        lambda: ff.simulate(m, m.neutral(), np.zeros(m.nv), 1e5, 1e-3, record_every=100, torques=torques,
-                            max_steps=10**9)
+        lambda: ff.simulate(
+            m, m.neutral(), np.zeros(m.nv), 1e5, 1e-3, record_every=100, torques=torques, max_steps=10**9
+        )
     )
     assert dt_stop < STOP_WITHIN, f"stopped {dt_stop:.2f} s after the signal"
     _check_partial(exc, m, 1e5)
@@ -100,8 +101,9 @@ def test_ctrl_c_stops_simulate_with_a_python_torque_function(robot):
 def test_ctrl_c_with_a_progress_bar(robot):
     m = robot
     exc, dt_stop = _run_interrupted(
-        lambda: ff.simulate(m, m.neutral(), np.full(m.nv, 0.01), 1e5, 1e-3, record_every=1000, progress=True,
-                            max_steps=10**9)
+        lambda: ff.simulate(
+            m, m.neutral(), np.full(m.nv, 0.01), 1e5, 1e-3, record_every=1000, progress=True, max_steps=10**9
+        )
     )
     assert dt_stop < STOP_WITHIN
     _check_partial(exc, m, 1e5)
@@ -110,8 +112,7 @@ def test_ctrl_c_with_a_progress_bar(robot):
 def test_ctrl_c_stops_rk45(robot):
     m = robot
     exc, dt_stop = _run_interrupted(
-        lambda: ff.simulate(m, m.neutral(), np.full(m.nv, 0.05), 1e5, 1.0, method="rk45", rtol=1e-12,
-                            max_steps=10**9)
+        lambda: ff.simulate(m, m.neutral(), np.full(m.nv, 0.05), 1e5, 1.0, method="rk45", rtol=1e-12, max_steps=10**9)
     )
     assert dt_stop < STOP_WITHIN
     _check_partial(exc, m, 1e5)

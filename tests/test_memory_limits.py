@@ -103,8 +103,17 @@ def test_cli_refuses_a_run_too_large_for_memory():
 
 def test_cli_max_memory_option():
     r = subprocess.run(
-        [sys.executable, "-m", "freefloat.cli", "simulate", "naveen_dual_arm", "--t-final", "1", "--max-memory",
-         "1e-6"],
+        [
+            sys.executable,
+            "-m",
+            "freefloat.cli",
+            "simulate",
+            "naveen_dual_arm",
+            "--t-final",
+            "1",
+            "--max-memory",
+            "1e-6",
+        ],
         capture_output=True,
         text=True,
         timeout=300,

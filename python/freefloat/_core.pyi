@@ -146,6 +146,9 @@ class DualQuaternion:
 class InputError(ValueError):
     """An argument has the wrong shape, non-finite entries or an invalid value."""
 
+class Interrupted(KeyboardInterrupt):
+    """A long run was stopped (Ctrl-C, or a progress callback returning False); `partial` holds what was finished (a Trajectory for a simulation), or None."""
+
 class Model:
     ...
     @property
@@ -596,7 +599,7 @@ def rnea_derivatives(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fex
 (nv, nv); q along its local tangent (see aba_derivatives).
     """
 
-def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba') -> Any:
+def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba', max_memory: ArrayLike | None = None) -> Any:
     ...
 
 def skew(v: ArrayLike) -> Any:

@@ -173,6 +173,14 @@ pub fn simulate<'py>(
         (None, None) => None,
         (Some(names), Some(f)) if f.is_callable() => {
             let bodies = prescribed_bodies(&m, &names)?;
+            // the entries the prescription drives: a NaN or an infinity there is named, with the time
+            let used: Vec<(String, Vec<usize>, Vec<usize>)> = bodies
+                .iter()
+                .map(|&b| {
+                    let (iq, iv) = (m.idx_q[b], m.idx_v[b]);
+                    (m.joint_names[b].clone(), (iq..iq + m.nqs[b]).collect(), (iv..iv + m.nvs[b]).collect())
+                })
+                .collect();
             let st = stash.clone();
             let f = f.clone();
             let pf: sim::PrescriptionFn = Box::new(move |t, q, v, a| {
@@ -184,7 +192,19 @@ pub fn simulate<'py>(
                     })?;
                     fill(&rq, q, "prescription q")?;
                     fill(&rv, v, "prescription v")?;
-                    fill(&ra, a, "prescription a")
+                    fill(&ra, a, "prescription a")?;
+                    for (joint, qi, vi) in &used {
+                        for (what, x, idx) in [("q", &*q, qi), ("v", &*v, vi), ("a", &*a, vi)] {
+                            if let Some(&k) = idx.iter().find(|&&k| !x[k].is_finite()) {
+                                return Err(input_err(format!(
+                                    "argument `prescription`: at t = {t} its {what}[{k}] (joint '{joint}') is {}; a \
+                                     prescribed motion must be finite",
+                                    x[k]
+                                )));
+                            }
+                        }
+                    }
+                    Ok(())
                 });
                 r.map_err(|e| stash_err(&st, e, "the prescription"))
             });

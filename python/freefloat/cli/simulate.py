@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import sys
 import time
 from pathlib import Path
@@ -9,9 +10,9 @@ from pathlib import Path
 import click
 import numpy as np
 
-from .._core import Interrupted
+from .._core import InputError, Interrupted
 from ..simulation import simulate
-from ._common import load_model, parse_vector, print_summary, summarize, torque_options, write_outputs
+from ._common import load_model, out_paths, parse_vector, print_summary, summarize, torque_options, write_outputs
 
 
 @click.command("simulate")
@@ -80,6 +81,11 @@ def simulate_cmd(
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
     kw = torque_options(m, torques, amplitude)
+    if out:
+        # check --out now, and load the file writer before the run, so that a Ctrl-C is answered at once
+        pq, _, _ = out_paths(out, "trajectory")
+        if pq.suffix.lower() != ".csv":
+            import pyarrow.parquet  # noqa: F401
     t0 = time.perf_counter()
     try:
         traj = simulate(
@@ -102,6 +108,10 @@ def simulate_cmd(
     except Interrupted as e:
         _save_partial(e, m, out, time.perf_counter() - t0)
         sys.exit(130)
+    except InputError as e:
+        if "max_memory" in str(e):  # name the options, not the Python arguments
+            raise InputError(f"{e} (options --record-every, --dt, --t-final, --max-memory GB)") from None
+        raise
     s = summarize(traj, time.perf_counter() - t0)
     s["model"] = m.name
     print_summary(f"{m.name}: {t_final} s, {method}, {formulation}", s)
@@ -145,5 +155,8 @@ def _save_partial(e: Interrupted, m, out, elapsed: float) -> None:
     s["model"] = m.name
     s["interrupted"] = str(e)
     s["t_end"] = float(traj.t[-1])
-    write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation (interrupted at t = {traj.t[-1]:g} s)")
-    click.echo("  the files hold the part simulated before the interrupt", err=True)
+    # the trajectory and results.json only: the figure (matplotlib) would delay the exit by seconds
+    pq, js, _ = out_paths(out, "trajectory")
+    traj.to_csv(pq) if pq.suffix.lower() == ".csv" else traj.to_parquet(pq)
+    js.write_text(json.dumps(s, indent=2))
+    click.echo(f"  wrote {pq}, {js} (the part simulated before the interrupt; no figure)", err=True)

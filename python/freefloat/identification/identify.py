@@ -198,6 +198,8 @@ def identify_minimal(
             "least squares is biased towards zero (pass rate_noise='data', on the command line the default)",
             stacklevel=2,
         )
+    if rate_noise is not None:
+        _rate_sigmas(model, rate_noise)  # a bad level is named before any work
     t, q, v, h = _read(model, data, h0)
     check_known(model, known)  # before the method choice: an unknown body is not a reason to try another method
     if method == "auto":

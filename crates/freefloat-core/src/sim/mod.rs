@@ -413,14 +413,21 @@ pub fn simulate_with(
     let mut next_out = 0.0;
     let mut out_k = 0usize;
     let mut poller = Poller::new(progress);
-    // The stepping runs in a closure so that every way out of it (a stop from the hook, Ctrl-C seen by
-    // a callback) comes back here, where an interruption gets the samples recorded so far attached.
-    let mut run = || -> Result<()> {
+    // Every way out of the stepping that is an interruption (a stop from the hook, Ctrl-C seen by a callback)
+    // leaves with the samples recorded so far and the state reached (see `interrupted`).
+    macro_rules! or_stop {
+        ($e:expr) => {
+            match $e {
+                Ok(x) => x,
+                Err(e) => return Err(interrupted(e, &mut st, &mut traj, t, &q, &v, w, opts.t_final, steps)),
+            }
+        };
+    }
     loop {
-        ctrl_update(&mut st, t, &q, &v, &mut next_sample, &mut sample_k)?;
+        or_stop!(ctrl_update(&mut st, t, &q, &v, &mut next_sample, &mut sample_k));
         st.qs.copy_from_slice(&q);
         st.vs.copy_from_slice(&v);
-        st.eval(t, 0)?;
+        or_stop!(st.eval(t, 0));
         // Record the state together with the accelerations and forces evaluated at it.
         let record = match opts.method {
             Method::Rk4 => steps.is_multiple_of(opts.record_every) || steps == n_rk4,
@@ -443,7 +450,7 @@ pub fn simulate_with(
         }
         match opts.method {
             Method::Rk4 => {
-                let (w1, _) = st.step(tab, t, h, &q, &v, w, &mut q1, &mut v1, None)?;
+                let (w1, _) = or_stop!(st.step(tab, t, h, &q, &v, w, &mut q1, &mut v1, None));
                 w = w1;
                 steps += 1;
                 t = steps as f64 * h;
@@ -456,7 +463,7 @@ pub fn simulate_with(
                 }
                 loop {
                     let hh = h.min(stop - t).min(max_step);
-                    let (w1, err) = st.step(tab, t, hh, &q, &v, w, &mut q1, &mut v1, Some((rtol, atol)))?;
+                    let (w1, err) = or_stop!(st.step(tab, t, hh, &q, &v, w, &mut q1, &mut v1, Some((rtol, atol))));
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
                     if err <= 1.0 {
                         w = w1;
@@ -480,23 +487,43 @@ pub fn simulate_with(
         }
         std::mem::swap(&mut q, &mut q1);
         std::mem::swap(&mut v, &mut v1);
-        st.impose(t, &mut q, &mut v)?;
-        poller.poll(t / opts.t_final, || format!("simulation stopped at t = {t} s of {} s", opts.t_final))?;
+        or_stop!(st.impose(t, &mut q, &mut v));
+        or_stop!(poller.poll(t / opts.t_final, || format!("simulation stopped at t = {t} s of {} s", opts.t_final)));
     }
-    Ok(())
-    };
-    let outcome = run();
     traj.steps = steps;
     traj.rejected = rejected;
     traj.evaluations = st.evals;
-    match outcome {
-        Ok(()) => {}
-        Err(FfError::Interrupted { msg, partial: None }) => {
-            let msg = if msg.contains(" at t = ") { msg } else { format!("{msg} at t = {t} s of {} s", opts.t_final) };
-            return Err(FfError::Interrupted { msg, partial: Some(Partial::Trajectory(Box::new(traj))) });
-        }
-        Err(e) => return Err(e),
-    }
     poller.now(1.0);
     Ok(traj)
+}
+
+/// An error that leaves the stepping: an interruption gets the samples recorded so far, with the state reached
+/// as the last one (recorded with the dynamics at it, as every sample is) unless it was just recorded or cannot
+/// be evaluated (a callback that keeps raising); any other error passes unchanged.
+#[allow(clippy::too_many_arguments)]
+fn interrupted(
+    e: FfError,
+    st: &mut Stepper,
+    traj: &mut Trajectory,
+    t: f64,
+    q: &[f64],
+    v: &[f64],
+    w: f64,
+    t_final: f64,
+    steps: usize,
+) -> FfError {
+    let FfError::Interrupted { msg, partial: None } = e else { return e };
+    if traj.t.last() != Some(&t) {
+        // an interrupt inside `eval` leaves its buffers taken: give it fresh ones
+        st.qs = q.to_vec();
+        st.vs = v.to_vec();
+        if st.eval(t, 0).is_ok() {
+            traj.push(&st.d, t, q, v, w);
+        }
+    }
+    let mut tr = std::mem::take(traj);
+    tr.steps = steps;
+    tr.evaluations = st.evals;
+    let msg = if msg.contains(" at t = ") { msg } else { format!("{msg} at t = {t} s of {t_final} s") };
+    FfError::Interrupted { msg, partial: Some(Partial::Trajectory(Box::new(tr))) }
 }

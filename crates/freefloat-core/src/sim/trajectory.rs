@@ -52,7 +52,8 @@ impl Trajectory {
                 ),
             )
         };
-        for (buf, width) in [(&mut tr.q, nq), (&mut tr.v, nv), (&mut tr.ddq, nv), (&mut tr.tau, nv), (&mut tr.momentum, 6)]
+        for (buf, width) in
+            [(&mut tr.q, nq), (&mut tr.v, nv), (&mut tr.ddq, nv), (&mut tr.tau, nv), (&mut tr.momentum, 6)]
         {
             let n = samples.checked_mul(width).ok_or_else(refuse)?;
             buf.try_reserve_exact(n).map_err(|_| refuse())?;
