@@ -135,8 +135,9 @@ def check_known(model, known) -> None:
     missing = [n for n in known if n not in names]
     if missing:
         raise InputError(
-            f"argument `known`: model '{model.name}' has no bod{'y' if len(missing) == 1 else 'ies'} "
-            f"{', '.join(repr(n) for n in missing)}; its bodies are {', '.join(names)}"
+            f"argument `known`: {', '.join(repr(n) for n in missing)} "
+            f"{'is not a body' if len(missing) == 1 else 'are not bodies'} of model '{model.name}'; its bodies are "
+            f"{', '.join(names)}"
         )
 
 
