@@ -119,3 +119,18 @@ def test_cli_max_memory_option():
         timeout=300,
     )
     assert r.returncode == 2 and "memory limit of 0.00000100 GB" in r.stderr, r.stderr[-2000:]
+
+
+def test_a_postcapture_scenario_too_long_for_memory_is_refused(monkeypatch):
+    from freefloat import postcapture as pc
+
+    sc = pc.load_scenario("zhang2020_2d_small")
+    sc.duration = 1.0e7  # the scenario: 1e10 recorded steps
+    t0 = time.perf_counter()
+    with pytest.raises(ff.InputError, match="duration .* memory"):
+        pc.simulate(sc)
+    monkeypatch.setenv("FREEFLOAT_MAX_MEMORY", "1G")
+    sc.duration = 3.0e4  # 3e7 steps, ~8 GB: within a large machine's physical memory, not within 1 GB
+    with pytest.raises(ff.InputError, match="limit of 1.000 GB"):
+        pc.simulate(sc)
+    assert time.perf_counter() - t0 < 1.0

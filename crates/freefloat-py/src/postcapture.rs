@@ -26,7 +26,8 @@ fn shaped(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[Option<usize>]) -> P
 /// kinetic_energy, work) recorded every `record_every` RK4 steps.
 #[pyfunction]
 #[pyo3(signature = (
-    model, q0, v0, t_final, dt, f_max, k_f, m_max, k_m, k_d, k_p, jet, damping, amp, freq, phase, record_every = 1
+    model, q0, v0, t_final, dt, f_max, k_f, m_max, k_m, k_d, k_p, jet, damping, amp, freq, phase, record_every = 1,
+    max_memory = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn postcapture_simulate<'py>(
@@ -48,7 +49,21 @@ pub fn postcapture_simulate<'py>(
     freq: Vec<f64>,
     phase: Vec<f64>,
     record_every: usize,
+    max_memory: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // the recording must fit in `max_memory` bytes, checked before any work (the run records every step)
+    if let (Some(limit), true) = (max_memory, t_final.is_finite() && dt.is_finite() && dt > 0.0 && t_final > 0.0) {
+        let samples = (t_final / dt).round() / record_every.max(1) as f64 + 2.0;
+        let bytes = samples * freefloat_core::sim::Trajectory::bytes_per_sample(&model.inner) as f64;
+        if bytes > limit {
+            return Err(input_err(format!(
+                "duration {t_final} s at dt = {dt} s records {samples:.3e} samples = {:.3} GB, more than the memory \
+                 limit of {:.3} GB; shorten the duration",
+                bytes / 1e9,
+                limit / 1e9
+            )));
+        }
+    }
     if jet.len() != 3 {
         return Err(input_err(format!("argument `jet`: expected 3 entries, got {}", jet.len())));
     }
