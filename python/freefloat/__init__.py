@@ -17,7 +17,7 @@ from . import _cpu
 _cpu.check()  # before anything loads the engine: a clear ImportError on too old a processor, not SIGILL
 
 from . import constants, control, derivatives, dq, identification, io, models, trajectories, viz
-from ._core import InputError, ModelError, NumericalError
+from ._core import InputError, Interrupted, ModelError, NumericalError
 from .actuators import Actuators, Tank, Thruster, Wheel
 from .algorithms import (
     aba,
@@ -116,6 +116,7 @@ __all__ = [
     "ModelError",
     "InputError",
     "NumericalError",
+    "Interrupted",
     "constants",
     "control",
     "identification",

@@ -9,7 +9,12 @@ from ._core import InputError
 
 
 def as_f64(x, name: str) -> np.ndarray:
-    """Convert `x` to a C-contiguous float64 array, naming `name` if that fails."""
+    """Convert `x` to a C-contiguous float64 array, naming `name` if that fails. Complex numbers are refused
+    (numpy would drop the imaginary part with only a ComplexWarning)."""
+    if np.iscomplexobj(x):
+        raise InputError(
+            f"argument `{name}`: complex numbers are not accepted (got dtype {np.asarray(x).dtype}); give real numbers"
+        )
     try:
         return np.ascontiguousarray(x, dtype=np.float64)
     except (TypeError, ValueError) as e:

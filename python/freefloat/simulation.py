@@ -7,6 +7,9 @@ stays fourth order on the base attitude)."""
 from __future__ import annotations
 
 import json
+import math
+import os
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -224,8 +227,15 @@ def simulate(
     formulation: str = "aba",
     actuators=None,
     input_timing: str = "step",
+    max_memory: float | None = None,
 ) -> Trajectory:
     """Simulate the model from (q0, v0) for t_final seconds.
+
+    The run is sized before it starts: the recorded trajectory (samples x state size x 8 bytes) must fit in
+    `max_memory` bytes (default: half the memory available, see `memory_limit`; `math.inf` turns the check
+    off), and RK4 must finish within max_steps; otherwise it is refused with an InputError. Ctrl-C (or a
+    `progress` callable returning False) stops it within a fraction of a second and raises
+    `freefloat.Interrupted` (a KeyboardInterrupt) whose `partial` is the Trajectory recorded so far.
 
     method: "rk4" (fixed step dt) or "rk45" (Dormand-Prince with rtol/atol; dt is then the output
     interval and steps land exactly on output times and controller samples).
@@ -285,6 +295,8 @@ def simulate(
                 f"argument `actuators`: expected a freefloat.Actuators or a mapping, got {type(actuators).__name__}"
             )
         acts = actuators.to_dict()
+    _warn_silent_ends(t_final, dt, method, torques, tt, hold)
+    limit = memory_limit() if max_memory is None else float(max_memory)
     try:
         out = _core.simulate(
             model._core,
@@ -309,13 +321,24 @@ def simulate(
             formulation,
             acts,
             input_timing,
+            limit,
         )
         if bar is not None:  # a finished run fills its bar (however fast it was: tqdm redraws at most every 0.1 s)
             bar.update(bar.total - bar.n)
             bar.refresh()
+    except _core.Interrupted as e:
+        # what was finished comes with the interruption, as a Trajectory
+        if isinstance(getattr(e, "partial", None), dict):
+            e.partial = _trajectory(model, e.partial, q0, method, formulation, dt, t_final)
+            e.partial.stats["interrupted"] = str(e)
+        raise
     finally:
         if bar is not None:
             bar.close()
+    return _trajectory(model, out, q0, method, formulation, dt, t_final)
+
+
+def _trajectory(model, out: dict, q0, method, formulation, dt, t_final) -> Trajectory:
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
     stats.update(
         method=method,
@@ -328,6 +351,75 @@ def simulate(
         input_timing=input_timing,
     )
     return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
+
+
+def memory_limit(fraction: float = 0.5) -> float:
+    """The default `max_memory` of `simulate`: `fraction` of the memory available now (Linux: MemAvailable of
+    /proc/meminfo; elsewhere the physical memory from os.sysconf; 8 GB when neither can be read), in bytes. The
+    environment variable FREEFLOAT_MAX_MEMORY (bytes, or with a suffix: 500M, 4G) overrides it."""
+    env = os.environ.get("FREEFLOAT_MAX_MEMORY")
+    if env:
+        units = {"K": 1e3, "M": 1e6, "G": 1e9, "T": 1e12}
+        try:
+            e = env.strip().upper().rstrip("B")
+            return float(e[:-1]) * units[e[-1]] if e and e[-1] in units else float(e)
+        except (ValueError, IndexError):
+            raise InputError(f"FREEFLOAT_MAX_MEMORY={env!r}: expected a number of bytes, e.g. 2e9 or 2G") from None
+    avail = None
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    avail = float(line.split()[1]) * 1024
+                    break
+    except OSError:
+        pass
+    if avail is None:
+        try:
+            avail = float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+        except (AttributeError, ValueError, OSError):
+            avail = 16e9
+    return fraction * avail
+
+
+def _warn_silent_ends(t_final, dt, method, torques, torque_times, hold) -> None:
+    """Visible warnings for the two ways a run can quietly differ from what was asked: a fixed-step run whose
+    t_final is not a multiple of dt (it ends at round(t_final/dt)·dt), and a torque table that ends long before
+    t_final (its last row is then held for the rest of the run)."""
+    try:
+        t_final, dt = float(t_final), float(dt)
+    except (TypeError, ValueError):
+        return  # the engine names the argument
+    if not (math.isfinite(t_final) and math.isfinite(dt) and t_final > 0 and dt > 0):
+        return
+    if method == "rk4":
+        n = round(t_final / dt)
+        t_end = n * dt
+        if abs(t_end - t_final) > 1e-9 * max(t_final, dt):
+            warnings.warn(
+                f"t_final = {t_final:g} s is not a multiple of dt = {dt:g} s: the fixed-step run takes {n} steps and "
+                f"ends at t = {t_end:.12g} s; choose t_final = k·dt, or method='rk4' with another dt, or 'rk45'",
+                UserWarning,
+                stacklevel=3,
+            )
+    if torques is None or callable(torques) or np.ndim(torques) != 2 or len(torques) < 2:
+        return  # None, a function, or one constant row: nothing that can run out
+    rows = len(torques)
+    times = np.arange(rows) * dt if torque_times is None else np.asarray(torque_times, dtype=float)
+    if len(times) != rows or not np.all(np.isfinite(times)):
+        return  # the engine reports it
+    # zero-order hold: the last row covers one table interval past its time; linear hold ends at its time
+    step = float(np.median(np.diff(times))) if rows > 1 else dt
+    end = float(times[-1]) + (step if hold == "zoh" else 0.0)
+    past = t_final - end
+    if past > 1e-9 * t_final and past > 0.01 * t_final:
+        warnings.warn(
+            f"the torque table ({rows} rows) ends at t = {end:g} s but the run lasts {t_final:g} s: its last row is "
+            f"held for the remaining {past:g} s ({100 * past / t_final:.1f} % of the run); give rows up to t_final "
+            "or a shorter t_final",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 def simulate_driven(

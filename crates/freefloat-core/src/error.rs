@@ -42,6 +42,23 @@ pub enum FfError {
     /// The numbers themselves defeat the algorithm (singular mass matrix, diverging step...).
     #[error("numerical failure: {0}")]
     Numerical(String),
+
+    /// The caller stopped the run (Ctrl-C, or a progress hook returning false). Not a failure of the
+    /// numbers: what was finished before the stop is in `partial` where the routine has one.
+    #[error("interrupted: {msg}")]
+    Interrupted {
+        /// Where the run stopped (`at t = 12.3 s of 100 s`).
+        msg: String,
+        /// What was finished before the stop.
+        partial: Option<Partial>,
+    },
+}
+
+/// The finished part of an interrupted run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Partial {
+    /// A simulation's samples up to the interrupt.
+    Trajectory(Box<crate::sim::Trajectory>),
 }
 
 /// `Result` with the engine's error.
@@ -51,6 +68,16 @@ impl FfError {
     /// An argument error naming the argument `name`.
     pub fn arg(name: &str, msg: impl Into<String>) -> Self {
         FfError::Argument { name: name.to_string(), msg: msg.into() }
+    }
+
+    /// An interruption without a partial result (see [`FfError::Interrupted`]).
+    pub fn interrupted(msg: impl Into<String>) -> Self {
+        FfError::Interrupted { msg: msg.into(), partial: None }
+    }
+
+    /// Whether this error is an interruption rather than a failure.
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, FfError::Interrupted { .. })
     }
 }
 

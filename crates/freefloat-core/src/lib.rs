@@ -29,6 +29,8 @@ pub mod error;
 pub mod estimation;
 /// Exciting-trajectory design: zero-momentum base response and regressor rows (Naveen, Shah, Misra, Sec. V).
 pub mod excitation;
+/// The progress/interrupt hook long routines poll (Ctrl-C from the bindings, progress bars).
+pub mod interrupt;
 /// Forward kinematics, velocities, accelerations, centre of mass, momentum, energy, Jacobians.
 pub mod kinematics;
 /// `Model`: the immutable rigid-body tree, its builder and readers.

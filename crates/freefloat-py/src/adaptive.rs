@@ -4,7 +4,7 @@
 //! computed in freefloat-core.
 
 use crate::dq::PyDualQuaternion;
-use crate::errors::{guard, input_err};
+use crate::errors::{guard, input_err, reraise_foreign, signal_hook};
 use freefloat_core::control::adaptive::{
     self as ad, AdaptivePoseController, Gains, Harmonic3, Integrator, LawForm, Learning, Reference, RunOptions,
     Selection, Setup, Table, M7,
@@ -260,7 +260,19 @@ pub fn adaptive_simulate<'py>(
             };
             guard(|| ad::simulate(&setup, &opts, Some(&mut cb)))
         }
-        None => py.detach(|| guard(|| ad::simulate(&setup, &opts, None))),
+        None => {
+            // no Python runs: the GIL is released and the hook re-takes it only to check for Ctrl-C
+            let mut raised: Option<PyErr> = None;
+            let r = {
+                let raised = &mut raised;
+                py.detach(|| {
+                    let mut hook = signal_hook(raised);
+                    guard(|| ad::simulate(&setup, &opts, Some(&mut hook)))
+                })
+            };
+            reraise_foreign(py, raised)?;
+            r
+        }
     };
     if let Some(e) = stash.borrow_mut().take() {
         return Err(e);

@@ -30,6 +30,10 @@ pub fn array_arg<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonl
         return Ok(a);
     }
     let np = obj.py().import("numpy")?;
+    // numpy would drop an imaginary part with only a ComplexWarning
+    if np.call_method1("iscomplexobj", (obj,))?.is_truthy()? {
+        return Err(input_err(format!("argument `{name}`: complex numbers are not accepted; give real numbers")));
+    }
     let converted = np
         .call_method1("ascontiguousarray", (obj, "float64"))
         .map_err(|e| input_err(format!("argument `{name}`: cannot be read as an array of numbers ({e})")))?;

@@ -30,6 +30,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ModelError", py.get_type::<errors::ModelError>())?;
     m.add("InputError", py.get_type::<errors::InputError>())?;
     m.add("NumericalError", py.get_type::<errors::NumericalError>())?;
+    m.add("Interrupted", py.get_type::<errors::Interrupted>())?;
     m.add_function(wrap_pyfunction!(algorithms::forward_kinematics, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::frame_placement, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::center_of_mass, m)?)?;

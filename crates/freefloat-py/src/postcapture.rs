@@ -2,7 +2,7 @@
 //! estimators (ordinary RLS with forgetting; the paper's modified RLS, eqs. 34-38) as Python objects
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
-use crate::errors::{guard, input_err};
+use crate::errors::{guard, input_err, reraise_foreign, signal_hook};
 use crate::model::PyModel;
 use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
 use freefloat_core::postcapture::{simulate_postcapture, PostcaptureControl};
@@ -26,7 +26,8 @@ fn shaped(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[Option<usize>]) -> P
 /// kinetic_energy, work) recorded every `record_every` RK4 steps.
 #[pyfunction]
 #[pyo3(signature = (
-    model, q0, v0, t_final, dt, f_max, k_f, m_max, k_m, k_d, k_p, jet, damping, amp, freq, phase, record_every = 1
+    model, q0, v0, t_final, dt, f_max, k_f, m_max, k_m, k_d, k_p, jet, damping, amp, freq, phase, record_every = 1,
+    max_memory = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn postcapture_simulate<'py>(
@@ -48,7 +49,21 @@ pub fn postcapture_simulate<'py>(
     freq: Vec<f64>,
     phase: Vec<f64>,
     record_every: usize,
+    max_memory: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // the recording must fit in `max_memory` bytes, checked before any work (the run records every step)
+    if let (Some(limit), true) = (max_memory, t_final.is_finite() && dt.is_finite() && dt > 0.0 && t_final > 0.0) {
+        let samples = (t_final / dt).round() / record_every.max(1) as f64 + 2.0;
+        let bytes = samples * freefloat_core::sim::Trajectory::bytes_per_sample(&model.inner) as f64;
+        if bytes > limit {
+            return Err(input_err(format!(
+                "duration {t_final} s at dt = {dt} s records {samples:.3e} samples = {:.3} GB, more than the memory \
+                 limit of {:.3} GB; shorten the duration",
+                bytes / 1e9,
+                limit / 1e9
+            )));
+        }
+    }
     if jet.len() != 3 {
         return Err(input_err(format!("argument `jet`: expected 3 entries, got {}", jet.len())));
     }
@@ -75,7 +90,17 @@ pub fn postcapture_simulate<'py>(
         phase,
     };
     let (q0, v0) = (q0.as_array().to_vec(), v0.as_array().to_vec());
-    let tr = py.detach(move || guard(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, None)))?;
+    // Ctrl-C: the engine polls the hook (GIL re-taken for the signal check only) and stops with `Interrupted`
+    let mut raised: Option<PyErr> = None;
+    let r = {
+        let raised = &mut raised;
+        py.detach(move || {
+            let mut hook = signal_hook(raised);
+            guard(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, Some(&mut hook)))
+        })
+    };
+    reraise_foreign(py, raised)?;
+    let tr = r?;
     let d = PyDict::new(py);
     let n = tr.len();
     d.set_item("t", PyArray1::from_slice(py, &tr.t))?;

@@ -3,7 +3,7 @@
 //! run happens with the GIL released.
 
 use crate::algorithms::prescribed_bodies;
-use crate::errors::{guard, input_err};
+use crate::errors::{guard, guard_raw, input_err, interrupted_with, is_ctrl_c, reraise_foreign, signal_hook};
 use crate::model::PyModel;
 use freefloat_core::model::Model;
 use freefloat_core::sim::{
@@ -22,9 +22,14 @@ use std::rc::Rc;
 type Stash = Rc<RefCell<Option<PyErr>>>;
 
 fn stash_err(stash: &Stash, e: PyErr, what: &str) -> FfError {
+    let ctrl_c = Python::attach(|py| is_ctrl_c(py, &e));
     let mut s = stash.borrow_mut();
     if s.is_none() {
         *s = Some(e);
+    }
+    if ctrl_c {
+        // Ctrl-C seen while Python code ran in a callback: an interruption, with the samples so far
+        return FfError::interrupted("stopped by Ctrl-C");
     }
     FfError::Numerical(format!("{what} raised an exception"))
 }
@@ -56,7 +61,7 @@ fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'st
     model, q0, v0, t_final, dt, method = "rk4", rtol = 1e-9, atol = 1e-12, max_step = None, record_every = 1,
     torques = None, torque_times = None, hold = "zoh", controller = None, controller_period = None,
     prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba",
-    actuators = None, input_timing = "step"
+    actuators = None, input_timing = "step", max_memory = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -83,6 +88,7 @@ pub fn simulate<'py>(
     formulation: &str,
     actuators: Option<Bound<'py, PyAny>>,
     input_timing: &str,
+    max_memory: Option<f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model.inner.clone();
     let timing = match input_timing {
@@ -106,6 +112,24 @@ pub fn simulate<'py>(
         other => return Err(input_err(format!("method must be 'rk4' or 'rk45', got '{other}'"))),
     };
     let opts = SimOptions { t_final, dt, method, record_every, max_steps };
+    // Work sized up front: the recording must fit in `max_memory` bytes (the Python layer's default is a
+    // fraction of the memory available), checked before any work.
+    if let Some(limit) = max_memory {
+        if t_final.is_finite() && t_final > 0.0 && dt.is_finite() && dt > 0.0 && record_every > 0 {
+            let samples = sim::planned_samples(&opts);
+            let bytes = sim::planned_bytes(&m, &opts);
+            if bytes > limit {
+                return Err(input_err(format!(
+                    "argument `t_final`: this run would record {samples:.3e} samples of {} bytes = {} GB, more \
+                     than the memory limit of {} GB (max_memory); record fewer samples (a larger record_every \
+                     or dt, a shorter t_final) or raise max_memory",
+                    sim::Trajectory::bytes_per_sample(&m),
+                    sig3(bytes / 1e9),
+                    sig3(limit / 1e9)
+                )));
+            }
+        }
+    }
     let stash: Stash = Rc::new(RefCell::new(None));
 
     let hold = match hold {
@@ -166,6 +190,14 @@ pub fn simulate<'py>(
         (None, None) => None,
         (Some(names), Some(f)) if f.is_callable() => {
             let bodies = prescribed_bodies(&m, &names)?;
+            // the entries the prescription drives: a NaN or an infinity there is named, with the time
+            let used: Vec<(String, Vec<usize>, Vec<usize>)> = bodies
+                .iter()
+                .map(|&b| {
+                    let (iq, iv) = (m.idx_q[b], m.idx_v[b]);
+                    (m.joint_names[b].clone(), (iq..iq + m.nqs[b]).collect(), (iv..iv + m.nvs[b]).collect())
+                })
+                .collect();
             let st = stash.clone();
             let f = f.clone();
             let pf: sim::PrescriptionFn = Box::new(move |t, q, v, a| {
@@ -177,7 +209,19 @@ pub fn simulate<'py>(
                     })?;
                     fill(&rq, q, "prescription q")?;
                     fill(&rv, v, "prescription v")?;
-                    fill(&ra, a, "prescription a")
+                    fill(&ra, a, "prescription a")?;
+                    for (joint, qi, vi) in &used {
+                        for (what, x, idx) in [("q", &*q, qi), ("v", &*v, vi), ("a", &*a, vi)] {
+                            if let Some(&k) = idx.iter().find(|&&k| !x[k].is_finite()) {
+                                return Err(input_err(format!(
+                                    "argument `prescription`: at t = {t} its {what}[{k}] (joint '{joint}') is {}; a \
+                                     prescribed motion must be finite",
+                                    x[k]
+                                )));
+                            }
+                        }
+                    }
+                    Ok(())
                 });
                 r.map_err(|e| stash_err(&st, e, "the prescription"))
             });
@@ -198,6 +242,8 @@ pub fn simulate<'py>(
     let v0 = v0.as_array().to_vec();
     let nv = m.nv;
 
+    let mut raised: Option<PyErr> = None;
+    let mut returned_false = false;
     let result = if has_callbacks {
         let torque_src = match torque_spec {
             TorqueSpec::Zero => TorqueSource::Zero,
@@ -206,41 +252,72 @@ pub fn simulate<'py>(
         };
         let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc, actuators: acts, timing };
         let st = stash.clone();
-        let mut prog = progress.map(|p| {
-            move |frac: f64| -> bool {
-                match p.call1((frac,)) {
-                    Ok(r) => !matches!(r.extract::<bool>(), Ok(false)), // only an explicit False aborts
+        // Python code runs in the callbacks (GIL held): the hook checks for Ctrl-C itself (at most every
+        // 20 ms), then calls the progress callback, whose explicit False stops the run.
+        let rf = &mut returned_false;
+        let mut prog = move |frac: f64| -> bool {
+            if let Err(e) = py.check_signals() {
+                stash_err(&st, e, "Ctrl-C");
+                return false;
+            }
+            match &progress {
+                None => true,
+                Some(p) => match p.call1((frac,)) {
+                    Ok(r) => {
+                        let go = !matches!(r.extract::<bool>(), Ok(false));
+                        *rf = !go;
+                        go
+                    }
                     Err(e) => {
                         stash_err(&st, e, "the progress callback");
                         false
                     }
-                }
+                },
             }
-        });
-        let pr: Option<sim::Progress> = prog.as_mut().map(|p| p as &mut dyn FnMut(f64) -> bool);
-        guard(|| sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, pr))
+        };
+        let pr: Option<sim::Progress> = Some(&mut prog);
+        guard_raw(|| sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, pr))?
     } else {
         // No Python code runs during the simulation: release the GIL; the inputs are built from
-        // plain data on the detached side.
+        // plain data on the detached side. The hook re-takes the GIL only to check for Ctrl-C.
         let table = match torque_spec {
             TorqueSpec::Table(times, values) => Some((times, values)),
             _ => None,
         };
+        let raised = &mut raised;
         py.detach(move || {
-            guard(|| {
+            let mut hook = signal_hook(raised);
+            guard_raw(|| {
                 let torques = match table {
                     Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
                     None => TorqueSource::Zero,
                 };
                 let inputs = Inputs { torques, actuators: acts, timing, ..Default::default() };
-                sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, None)
+                sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, Some(&mut hook))
             })
-        })
+        })?
     };
-    if let Some(e) = stash.borrow_mut().take() {
-        return Err(e);
+    reraise_foreign(py, raised)?;
+    let stashed = stash.borrow_mut().take();
+    match (stashed, result) {
+        // Ctrl-C or a stop by the progress callback: raise `Interrupted` (a KeyboardInterrupt) with the samples
+        // recorded so far as `partial`.
+        (s, Err(FfError::Interrupted { msg, partial })) if s.as_ref().is_none_or(|e| is_ctrl_c(py, e)) => {
+            let msg = if returned_false { format!("{msg} (the progress callback returned False)") } else { msg };
+            let partial = match partial {
+                Some(freefloat_core::error::Partial::Trajectory(tr)) => Some(traj_dict(py, &tr)?.into_any().unbind()),
+                None => None,
+            };
+            Err(interrupted_with(py, &msg, partial))
+        }
+        (Some(e), _) => Err(e),
+        (None, Err(e)) => Err(crate::errors::to_py(e)),
+        (None, Ok(tr)) => traj_dict(py, &tr),
     }
-    let tr = result?;
+}
+
+/// The trajectory as the dict of arrays the Python layer turns into a `Trajectory`.
+fn traj_dict<'py>(py: Python<'py>, tr: &sim::Trajectory) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let n = tr.len();
     d.set_item("t", PyArray1::from_slice(py, &tr.t))?;
@@ -259,6 +336,19 @@ pub fn simulate<'py>(
     d.set_item("rejected", tr.rejected)?;
     d.set_item("evaluations", tr.evaluations)?;
     Ok(d)
+}
+
+/// `x` with three significant digits, in plain notation (`0.000100`, `6.90`, `69000`).
+fn sig3(x: f64) -> String {
+    if !(x.is_finite()) || x == 0.0 {
+        return format!("{x}");
+    }
+    let p = 2 - x.abs().log10().floor() as i32;
+    if p <= 0 {
+        format!("{x:.0}")
+    } else {
+        format!("{:.*}", p as usize, x)
+    }
 }
 
 /// What the caller gave as torques, before it becomes an engine `TorqueSource`.

@@ -78,6 +78,8 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
         res = pc.run(sc, seed=seed, progress=lambda what: (bar.set_postfix_str(what), bar.update(1)))
     wall = _time.perf_counter() - t0
     click.echo(res.table())
+    for w in res.warnings():  # also in results.json ("warnings")
+        click.echo(f"warning: {w}", err=True)
     r = res.residuals
     click.echo(
         f"equations at the true parameters: momentum form max residual {r['momentum']['paper_angular']:.2e} "

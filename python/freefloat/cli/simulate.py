@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+import json
+import sys
 import time
+from pathlib import Path
 
 import click
 import numpy as np
 
+from .._core import InputError, Interrupted
 from ..simulation import simulate
-from ._common import load_model, parse_vector, print_summary, summarize, torque_options, write_outputs
+from ._common import load_model, out_paths, parse_vector, print_summary, summarize, torque_options, write_outputs
 
 
 @click.command("simulate")
@@ -18,7 +22,7 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
     type=click.Choice(["free", "planar", "fixed"]),
     default="free",
     show_default=True,
-    help="Base joint for a URDF model.",
+    help="Base joint for a URDF model (built-in robots and YAML/MJCF files declare their own base joint).",
 )
 @click.option("--t-final", type=float, default=10.0, show_default=True, help="Simulated time [s].")
 @click.option("--dt", type=float, default=1e-3, show_default=True, help="RK4 step, or RK45 output interval [s].")
@@ -65,7 +69,15 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
 @click.option(
     "--out",
     help="FILE.parquet or FILE.csv (plus FILE.results.json and FILE.png beside it), or a directory (gets "
-    "trajectory.parquet, results.json, trajectory.png). Every file written is listed.",
+    "trajectory.parquet, results.json, trajectory.png). Every file written is listed. After Ctrl-C the part "
+    "simulated so far is written there.",
+)
+@click.option(
+    "--max-memory",
+    type=float,
+    default=None,
+    help="Largest recording to hold in memory [GB] (default: half the memory available). Longer runs are refused "
+    "before they start; record fewer samples with --record-every.",
 )
 def simulate_cmd(
     model,
@@ -84,34 +96,55 @@ def simulate_cmd(
     actuators_file,
     input_timing,
     out,
+    max_memory,
 ):
     """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.
 
     The robot floats freely; joints are driven by --torques. The summary gives the drift of total
     linear and angular momentum (conserved with internal torques only) and the difference between
-    the change of kinetic energy and the work done, both of which measure integration error."""
+    the change of kinetic energy and the work done, both of which measure integration error.
+
+    Ctrl-C stops the run within a fraction of a second; with --out the part simulated so far is written
+    (and results.json says the run was interrupted)."""
     m = load_model(model, base)
+    _check_base(click.get_current_context(), model, base, m)
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
     kw = torque_options(m, torques, amplitude)
     if actuators_file:
         kw["actuators"] = read_actuators(actuators_file)
+    if out:
+        # check --out now, and load the file writer before the run, so that a Ctrl-C is answered at once
+        pq, _, _ = out_paths(out, "trajectory")
+        if pq.suffix.lower() != ".csv":
+            import pyarrow.parquet  # noqa: F401
     t0 = time.perf_counter()
-    traj = simulate(
-        m,
-        q,
-        v,
-        t_final,
-        dt,
-        method=method,
-        rtol=rtol,
-        atol=atol,
-        record_every=record_every,
-        progress=True,
-        formulation=formulation,
-        input_timing=input_timing,
-        **kw,
-    )
+    try:
+        traj = simulate(
+            m,
+            q,
+            v,
+            t_final,
+            dt,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            record_every=record_every,
+            progress=True,
+            formulation=formulation,
+            input_timing=input_timing,
+            # interactive runs stop on Ctrl-C: no step limit, only the memory check
+            max_steps=2**62,
+            max_memory=None if max_memory is None else max_memory * 1e9,
+            **kw,
+        )
+    except Interrupted as e:
+        _save_partial(e, m, out, time.perf_counter() - t0)
+        sys.exit(130)
+    except InputError as e:
+        if "max_memory" in str(e):  # name the options, not the Python arguments
+            raise InputError(f"{e} (options --record-every, --dt, --t-final, --max-memory GB)") from None
+        raise
     s = summarize(traj, time.perf_counter() - t0)
     s["model"] = m.name
     print_summary(f"{m.name}: {t_final} s, {method}, {formulation}", s)
@@ -124,11 +157,8 @@ def simulate_cmd(
 
 def read_actuators(path):
     """The `actuators:` block of a YAML file (or the whole file if it is the block itself) as an Actuators."""
-    from pathlib import Path
-
     import yaml
 
-    from .._core import InputError
     from ..actuators import Actuators
 
     p = Path(path)
@@ -141,3 +171,43 @@ def read_actuators(path):
     if isinstance(d, dict) and "actuators" in d:
         d = d["actuators"]
     return Actuators.from_dict(d, where=f"{p}: actuators")
+
+
+def _check_base(ctx, spec: str, base: str, m) -> None:
+    """--base chooses the base joint of a URDF file only; given for another model it is an error, not ignored."""
+    explicit = ctx.get_parameter_source("base") not in (None, click.core.ParameterSource.DEFAULT)
+    if not explicit or Path(spec).suffix.lower() == ".urdf":
+        return
+    own = m.joint_types[0]
+    if base == own:
+        return
+    raise click.BadParameter(
+        f"'{spec}' declares its own base joint ('{own}'); --base {base} applies to URDF files only. To simulate it "
+        f"with a {base} base, save its description (`freefloat models --show {spec} > robot.yaml` for a built-in "
+        f"robot), change the root body's joint to {base}, and simulate that file",
+        param_hint="--base",
+    )
+
+
+def _save_partial(e: Interrupted, m, out, elapsed: float) -> None:
+    """After Ctrl-C: say where the run stopped and write the part simulated so far when --out was given."""
+    traj = getattr(e, "partial", None)
+    if traj is None or len(traj) == 0:
+        click.echo(f"interrupted: {e}; nothing was recorded", err=True)
+        return
+    click.echo(
+        f"interrupted: {e}; {len(traj)} samples recorded, t = {traj.t[0]:g} .. {traj.t[-1]:g} s",
+        err=True,
+    )
+    if not out:
+        click.echo("  (give --out to keep the part simulated so far)", err=True)
+        return
+    s = summarize(traj, elapsed)
+    s["model"] = m.name
+    s["interrupted"] = str(e)
+    s["t_end"] = float(traj.t[-1])
+    # the trajectory and results.json only: the figure (matplotlib) would delay the exit by seconds
+    pq, js, _ = out_paths(out, "trajectory")
+    traj.to_csv(pq) if pq.suffix.lower() == ".csv" else traj.to_parquet(pq)
+    js.write_text(json.dumps(s, indent=2))
+    click.echo(f"  wrote {pq}, {js} (the part simulated before the interrupt; no figure)", err=True)

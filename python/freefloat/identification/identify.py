@@ -25,7 +25,7 @@ from ..constants import TABLE3_RANGE_RAD, TABLE3_START_DEG  # noqa: F401  (re-ex
 from ..io.telemetry import Telemetry
 from .conventions import ConventionReport, check_conventions
 from .estimation import LeastSquaresResult, absolute_columns, known_parameters, least_squares, relative_errors
-from .minimal import MinimalParameters, minimal_parameters
+from .minimal import MinimalParameters, check_known, minimal_parameters
 
 
 @dataclass
@@ -198,7 +198,10 @@ def identify_minimal(
             "least squares is biased towards zero (pass rate_noise='data', on the command line the default)",
             stacklevel=2,
         )
+    if rate_noise is not None:
+        _rate_sigmas(model, rate_noise)  # a bad level is named before any work
     t, q, v, h = _read(model, data, h0)
+    check_known(model, known)  # before the method choice: an unknown body is not a reason to try another method
     if method == "auto":
         mp = minimal_parameters(model, "auto", known)
     elif method == "closed-form":
@@ -215,6 +218,14 @@ def identify_minimal(
             "parameters is unobservable (every parameter times any factor fits the data equally well; momentum "
             "identification fixes the scale through a known body, such as a reaction wheel). Name one with "
             "known=[...] (on the command line --known BODY), or tag it 'known' in the model file"
+        )
+    # each sample gives six momentum equations: fewer than the unknowns cannot determine them (say so in samples)
+    need = -(-mp.n_min // 6)
+    if len(t) < max(need, 2):
+        raise InputError(
+            f"argument `data`: {len(t)} sample{'s' if len(t) != 1 else ''} of telemetry; the {mp.n_min} unknown "
+            f"minimal parameters of model '{model.name}' need at least {max(need, 2)} samples (6 momentum equations "
+            "each), and in practice many more along an exciting motion"
         )
     report = None
     if check != "off" and not hasattr(data, "ddq") and len(q) > 0:
@@ -333,6 +344,12 @@ def _noise_share(N_G, GtG) -> float:
 def _rate_sigmas(model, rate_noise) -> np.ndarray:
     """(nv,) rate-noise standard deviations from a per-component vector or a (lin, ang, joint) triple."""
     r = np.atleast_1d(np.asarray(rate_noise, dtype=float))
+    bad = np.flatnonzero(~(r >= 0))  # negative or NaN: a standard deviation is a non-negative number
+    if bad.size:
+        k = int(bad[0])
+        raise InputError(
+            f"argument `rate_noise`: entry {k} is {r.flat[k]:g}; standard deviations must be zero or positive"
+        )
     if r.shape == (model.nv,):
         return r
     if r.shape == (3,) and model.joint_types[0] == "free":

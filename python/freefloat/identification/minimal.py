@@ -125,11 +125,28 @@ def minimal_parameters(model, method: str = "numeric", known=None) -> MinimalPar
 
 
 # ---------------------------------------------------------------------------------------------------- helpers
+def check_known(model, known) -> None:
+    """An InputError naming `known`, the bodies that do not exist and the model's bodies (the list a user needs)."""
+    if known is None:
+        return
+    if isinstance(known, str):
+        known = [known]
+    names = list(model.body_names)
+    missing = [n for n in known if n not in names]
+    if missing:
+        raise InputError(
+            f"argument `known`: {', '.join(repr(n) for n in missing)} "
+            f"{'is not a body' if len(missing) == 1 else 'are not bodies'} of model '{model.name}'; its bodies are "
+            f"{', '.join(names)}"
+        )
+
+
 def _split_bodies(model, known):
     if known is None:
         known_idx = [i for i, t in enumerate(model.tags) if "known" in t or "wheel" in t]
     else:
-        known_idx = sorted(model.body_index(n) for n in known)
+        check_known(model, known)
+        known_idx = sorted(model.body_index(n) for n in ([known] if isinstance(known, str) else known))
     unknown = [i for i in range(model.nbodies) if i not in known_idx]
     if not unknown:
         raise InputError("every body is declared known: there is nothing to identify")

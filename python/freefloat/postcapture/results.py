@@ -50,8 +50,28 @@ class PostcaptureResult:
         t, h = self.histories[(method, solver)]
         return transit_times(t, h, self.truth, self.scenario.tolerance)
 
+    def warnings(self) -> list[str]:
+        """Sentences for results that look like answers but are not: an estimate that never moved from its
+        initial guess (no excitation reached it), a scenario whose excitation amplitudes are all zero."""
+        out = []
+        amp = np.asarray(self.scenario.excitation.get("amp", []), float)
+        if amp.size == 0 or not np.any(amp):
+            out.append(
+                "the scenario's excitation amplitudes are all zero: the joints do not move relative to the base, so "
+                "the data carry little information about the payload"
+            )
+        for (method, solver), (_, h) in self.histories.items():
+            h = np.asarray(h, float)
+            if len(h) and np.all(np.abs(h - h[0]) <= 1e-12 * np.maximum(np.abs(h[0]), 1.0)):
+                out.append(
+                    f"the {method}-based {solver} estimate never moved from its initial guess (no excitation reached "
+                    "it): the printed values are the guess, not an identification"
+                )
+        return out
+
     def to_dict(self) -> dict:
         out = {
+            "warnings": self.warnings(),
             "scenario": self.scenario.name,
             "model": self.scenario.model,
             "tolerance": self.scenario.tolerance,

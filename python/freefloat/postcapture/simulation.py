@@ -9,6 +9,7 @@ from .. import _core, models
 from .. import algorithms as alg
 from .._core import InputError
 from ..algorithms import quat_to_matrix
+from ..simulation import memory_limit
 from . import equations as eq
 from .scenario import Scenario
 
@@ -35,6 +36,7 @@ def simulate(sc: Scenario, model=None) -> dict:
         e["freq"],
         e["phase"],
         1,
+        max_memory=memory_limit(),  # refused before any work, not an abort or a swapping machine
     )
 
 

@@ -136,7 +136,7 @@ pub(crate) fn hybrid_aba_unchecked(
                 let u = ia * s0;
                 let dd = s0.dot(&u);
                 if !(dd > 0.0) || !dd.is_finite() {
-                    return Err(singular(m, i));
+                    return Err(singular(m, d, i, v));
                 }
                 let uu = tau[iv] - s0.dot(&pa6);
                 d.u[i].set_column(0, &u);
@@ -219,7 +219,7 @@ pub(crate) fn hybrid_aba_unchecked(
                 // avoids forming U = Iᴬ X₀ and D = X₀ᵀ U, two 6×6×6 products).
                 let omi = d.o_mi[i];
                 let rhs0 = omi.act_force(&Force::from_slice(&tau[iv..iv + 6])) - d.of[i];
-                let a0 = solve_spd6(&d.ia[i], &rhs0.to_v6()).ok_or_else(|| singular(m, i))?;
+                let a0 = solve_spd6(&d.ia[i], &rhs0.to_v6()).ok_or_else(|| singular(m, d, i, v))?;
                 let qdd = omi.inv_act_motion(&Motion::from_v6(&(a0 - a)));
                 qdd.write(&mut d.ddq[iv..iv + 6]);
                 d.tau[iv..iv + 6].copy_from_slice(&tau[iv..iv + 6]);
@@ -232,7 +232,7 @@ pub(crate) fn hybrid_aba_unchecked(
             }
             if m.parents[i].is_none() && k > 1 {
                 // Root with several DoF: d.dinv holds D itself (see pass 2).
-                let x = solve_spd(&d.dinv[i], k, &rhs).ok_or_else(|| singular(m, i))?;
+                let x = solve_spd(&d.dinv[i], k, &rhs).ok_or_else(|| singular(m, d, i, v))?;
                 for r in 0..k {
                     d.ddq[iv + r] = x[r];
                     d.tau[iv + r] = tau[iv + r];
@@ -271,8 +271,11 @@ fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f6
         d.dinv[i].fixed_view_mut::<K, K>(0, 0).copy_from(&dm);
         return Ok(());
     };
-    let dinv =
-        dm.cholesky().map(|c| c.inverse()).filter(|x| x.iter().all(|v| v.is_finite())).ok_or_else(|| singular(m, i))?;
+    let dinv = dm
+        .cholesky()
+        .map(|c| c.inverse())
+        .filter(|x| x.iter().all(|v| v.is_finite()))
+        .ok_or_else(|| singular(m, d, i, &[]))?;
     let ud = uk * dinv;
     let ia_a = ia - ud * uk.transpose();
     let pa = pa6 + ia_a * d.oc[i].to_v6() + ud * uu;
@@ -282,7 +285,44 @@ fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f6
     Ok(())
 }
 
-fn singular(m: &Model, i: usize) -> FfError {
+/// The error for a joint whose articulated inertia cannot be inverted. An overflow or a NaN upstream makes it look
+/// singular too (a NaN configuration reaches every frame; velocities near 1e200 square past the largest double);
+/// those are reported as what they are, naming the body or the velocity entry.
+fn singular(m: &Model, d: &Data, i: usize, v: &[f64]) -> FfError {
+    let names = &m.body_names;
+    let n = m.nbodies();
+    if let Some(b) = (0..n).find(|&b| {
+        let x = &d.o_mi[b];
+        !(x.rot.iter().all(|a| a.is_finite()) && x.trans.iter().all(|a| a.is_finite()))
+    }) {
+        return FfError::Numerical(format!(
+            "overflow or NaN: the placement of body '{}' is not finite (a configuration entry or a joint origin is \
+             NaN or too large, e.g. 1e308)",
+            names[b]
+        ));
+    }
+    let vmax = v.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if vmax > 1e150 {
+        let k = v.iter().position(|x| x.abs() == vmax).unwrap_or(0);
+        return FfError::Numerical(format!(
+            "overflow: the velocity-product forces are not finite; the largest velocity entry is v[{k}] = {vmax:e} \
+             (velocities above ~1e150 square past the largest double)"
+        ));
+    }
+    if let Some(b) = (0..n).find(|&b| !d.ia[b].iter().all(|a| a.is_finite())) {
+        return FfError::Numerical(format!(
+            "overflow or NaN: the inertia of body '{}' in the inertial frame is not finite (its parameters or its \
+             placement are too large)",
+            names[b]
+        ));
+    }
+    if (0..n).any(|b| !d.of[b].to_v6().iter().all(|a| a.is_finite())) {
+        return FfError::Numerical(
+            "overflow or NaN: the velocity-product or external forces are not finite (velocities, external forces or \
+             inertias too large)"
+                .to_string(),
+        );
+    }
     FfError::Numerical(format!(
         "joint '{}': its articulated inertia about the joint is singular (massless or degenerate subtree)",
         m.joint_names[i]

@@ -21,7 +21,8 @@ use crate::config::{
 };
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
-use crate::error::{check_vec, FfError, Result};
+use crate::error::{check_vec, FfError, Partial, Result};
+use crate::interrupt::Poller;
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
 
@@ -93,8 +94,29 @@ impl Default for Inputs<'_> {
     }
 }
 
-/// Optional progress callback: called with the fraction done, returns false to abort.
-pub type Progress<'a> = &'a mut dyn FnMut(f64) -> bool;
+/// Optional progress callback: called with the fraction done, returns false to stop the run (polled through
+/// [`crate::interrupt::Poller`], at most every 20 ms; a stop is `FfError::Interrupted` carrying the samples
+/// recorded so far).
+pub type Progress<'a> = crate::interrupt::Hook<'a>;
+
+/// Smallest relative tolerance RK45 accepts: below 100 machine epsilons the local error estimate is
+/// round-off and the step size collapses (the bound scipy's `solve_ivp` uses too).
+pub const MIN_RTOL: f64 = 100.0 * f64::EPSILON;
+
+/// Number of samples a run will record (as f64, so that an absurd run does not overflow): RK4 records
+/// every `record_every`-th of its `round(t_final/dt)` steps and the last; RK45 one sample per `dt`.
+pub fn planned_samples(opts: &SimOptions) -> f64 {
+    let n = (opts.t_final / opts.dt).round();
+    match opts.method {
+        Method::Rk4 => (n / opts.record_every.max(1) as f64).floor() + 2.0,
+        Method::Rk45 { .. } => (opts.t_final / opts.dt).ceil() + 2.0,
+    }
+}
+
+/// Bytes the recorded trajectory of a run will take (samples × bytes per sample).
+pub fn planned_bytes(m: &Model, opts: &SimOptions) -> f64 {
+    planned_samples(opts) * Trajectory::bytes_per_sample(m) as f64
+}
 
 /// Work buffers of one simulation.
 struct Stepper<'m, 'i> {
@@ -367,7 +389,7 @@ pub fn simulate_with(
     opts: &SimOptions,
     inputs: Inputs,
     formulation: Formulation,
-    mut progress: Option<Progress>,
+    progress: Option<Progress>,
 ) -> Result<Trajectory> {
     let mut qbuf = Vec::new();
     let q0 = m.checked_q(q0, &mut qbuf)?.to_vec();
@@ -392,9 +414,40 @@ pub fn simulate_with(
             if !(rtol > 0.0) || !(atol > 0.0) {
                 return Err(FfError::arg("rtol/atol", "tolerances must be positive"));
             }
+            if rtol < MIN_RTOL {
+                return Err(FfError::arg(
+                    "rtol",
+                    format!(
+                        "{rtol:e} is below what double precision can resolve: the smallest useful relative \
+                         tolerance is 100 machine epsilons, {MIN_RTOL:.1e} (machine epsilon is {:.1e})",
+                        f64::EPSILON
+                    ),
+                ));
+            }
             &DOPRI5
         }
     };
+    // Work sized up front: a fixed-step run longer than max_steps is refused before it starts, and the
+    // whole recording is reserved now (fallibly), so that a run too large for memory is an error here, not an
+    // abort (or a machine swapping) hours later.
+    if matches!(opts.method, Method::Rk4) && (opts.t_final / opts.dt).round() > opts.max_steps as f64 {
+        return Err(FfError::arg(
+            "t_final",
+            format!(
+                "t_final / dt = {:.3e} steps, more than max_steps = {}; raise max_steps or dt, or shorten t_final",
+                (opts.t_final / opts.dt).round(),
+                opts.max_steps
+            ),
+        ));
+    }
+    let samples = planned_samples(opts);
+    if samples > (isize::MAX as usize / Trajectory::bytes_per_sample(m)) as f64 {
+        return Err(FfError::arg(
+            "t_final",
+            format!("{samples:.3e} samples cannot be recorded (more bytes than an address space holds)"),
+        ));
+    }
+    let mut traj = Trajectory::with_capacity(m, samples as usize)?;
     let mut st = Stepper::new(m, inputs, tab.stages())?;
     st.formulation = formulation;
     if formulation == Formulation::DualQuaternion && st.act.uses_fext {
@@ -403,11 +456,6 @@ pub fn simulate_with(
             "thrusters and wheel imbalance need formulation 'aba' (the work of external wrenches is formed from ABA's twists)",
         ));
     }
-    let expected = match opts.method {
-        Method::Rk4 => (opts.t_final / opts.dt).round() as usize / opts.record_every + 2,
-        Method::Rk45 { .. } => (opts.t_final / opts.dt).ceil() as usize + 2,
-    };
-    let mut traj = Trajectory::with_capacity(m, expected.min(10_000_000));
     let (mut q, mut v) = (q0, v0.to_vec());
     let (mut q1, mut v1) = (vec![0.0; m.nq], vec![0.0; m.nv]);
     let mut w = 0.0;
@@ -440,12 +488,23 @@ pub fn simulate_with(
     let mut rejected = 0usize;
     let mut next_out = 0.0;
     let mut out_k = 0usize;
+    let mut poller = Poller::new(progress);
+    // Every way out of the stepping that is an interruption (a stop from the hook, Ctrl-C seen by a callback)
+    // leaves with the samples recorded so far and the state reached (see `interrupted`).
+    macro_rules! or_stop {
+        ($e:expr) => {
+            match $e {
+                Ok(x) => x,
+                Err(e) => return Err(interrupted(e, &mut st, &mut traj, t, &q, &v, w, opts.t_final, steps)),
+            }
+        };
+    }
     loop {
-        ctrl_update(&mut st, t, &q, &v, &mut next_sample, &mut sample_k)?;
+        or_stop!(ctrl_update(&mut st, t, &q, &v, &mut next_sample, &mut sample_k));
         st.qs.copy_from_slice(&q);
         st.vs.copy_from_slice(&v);
         st.mps.copy_from_slice(&st.mp);
-        st.eval(t, 0)?;
+        or_stop!(st.eval(t, 0));
         // Record the state together with the accelerations and forces evaluated at it.
         let record = match opts.method {
             Method::Rk4 => steps.is_multiple_of(opts.record_every) || steps == n_rk4,
@@ -473,7 +532,7 @@ pub fn simulate_with(
         }
         match opts.method {
             Method::Rk4 => {
-                let (w1, _) = st.step(tab, t, h, &q, &v, w, &mut q1, &mut v1, None)?;
+                let (w1, _) = or_stop!(st.step(tab, t, h, &q, &v, w, &mut q1, &mut v1, None));
                 w = w1;
                 std::mem::swap(&mut st.mp, &mut st.mp1);
                 steps += 1;
@@ -492,7 +551,7 @@ pub fn simulate_with(
                 stop = stop.min(st.act.next_event(t));
                 loop {
                     let hh = h.min(stop - t).min(max_step);
-                    let (w1, err) = st.step(tab, t, hh, &q, &v, w, &mut q1, &mut v1, Some((rtol, atol)))?;
+                    let (w1, err) = or_stop!(st.step(tab, t, hh, &q, &v, w, &mut q1, &mut v1, Some((rtol, atol))));
                     let factor = if err == 0.0 { 5.0 } else { (0.9 * err.powf(-0.2)).clamp(0.2, 5.0) };
                     if err <= 1.0 {
                         w = w1;
@@ -517,18 +576,50 @@ pub fn simulate_with(
         }
         std::mem::swap(&mut q, &mut q1);
         std::mem::swap(&mut v, &mut v1);
-        st.impose(t, &mut q, &mut v)?;
-        if let Some(p) = progress.as_mut() {
-            if steps.is_multiple_of(256) && !p(t / opts.t_final) {
-                return Err(FfError::Numerical(format!("simulation aborted at t = {t}")));
-            }
-        }
+        or_stop!(st.impose(t, &mut q, &mut v));
+        or_stop!(poller.poll(t / opts.t_final, || format!("simulation stopped at t = {t} s of {} s", opts.t_final)));
     }
     traj.steps = steps;
     traj.rejected = rejected;
     traj.evaluations = st.evals;
-    if let Some(p) = progress.as_mut() {
-        p(1.0);
-    }
+    poller.now(1.0);
     Ok(traj)
+}
+
+/// An error that leaves the stepping: an interruption gets the samples recorded so far, with the state reached
+/// as the last one (recorded with the dynamics at it, as every sample is) unless it was just recorded or cannot
+/// be evaluated (a callback that keeps raising); any other error passes unchanged.
+#[allow(clippy::too_many_arguments)]
+fn interrupted(
+    e: FfError,
+    st: &mut Stepper,
+    traj: &mut Trajectory,
+    t: f64,
+    q: &[f64],
+    v: &[f64],
+    w: f64,
+    t_final: f64,
+    steps: usize,
+) -> FfError {
+    let FfError::Interrupted { msg, partial: None } = e else { return e };
+    if traj.t.last() != Some(&t) {
+        // an interrupt inside `eval` leaves its buffers taken: give it fresh ones
+        st.qs = q.to_vec();
+        st.vs = v.to_vec();
+        st.mps.copy_from_slice(&st.mp);
+        if st.eval(t, 0).is_ok() {
+            traj.push(&st.d, t, q, v, w);
+            if st.act.depletes() {
+                // the propellant columns keep the length of the other recorded columns
+                traj.propellant.extend_from_slice(&st.mp);
+                let ma = st.var_model.as_ref().unwrap_or(st.m);
+                traj.base_parameters.extend_from_slice(&ma.inertias[0].to_params());
+            }
+        }
+    }
+    let mut tr = std::mem::take(traj);
+    tr.steps = steps;
+    tr.evaluations = st.evals;
+    let msg = if msg.contains(" at t = ") { msg } else { format!("{msg} at t = {t} s of {t_final} s") };
+    FfError::Interrupted { msg, partial: Some(Partial::Trajectory(Box::new(tr))) }
 }

@@ -1,10 +1,11 @@
 //! The recorded result of a simulation.
 
 use crate::data::Data;
+use crate::error::{FfError, Result};
 use crate::model::Model;
 
 /// Samples stored row-major: `q` is T × nq, `v`, `ddq`, `tau` are T × nv, `momentum` T × 6.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Trajectory {
     /// Length of one configuration.
     pub nq: usize,
@@ -41,22 +42,36 @@ pub struct Trajectory {
 
 impl Trajectory {
     /// An empty trajectory with room for `samples` records (growing the arrays during a run costs
-    /// several percent of a simulation).
-    pub fn with_capacity(m: &Model, samples: usize) -> Self {
+    /// several percent of a simulation). The reservation is fallible: a size the allocator refuses
+    /// (or whose byte count overflows) is an error naming the size, never an abort.
+    pub fn with_capacity(m: &Model, samples: usize) -> Result<Self> {
         let (nq, nv) = (m.nq, m.nv);
-        Trajectory {
-            nq,
-            nv,
-            t: Vec::with_capacity(samples),
-            q: Vec::with_capacity(samples * nq),
-            v: Vec::with_capacity(samples * nv),
-            ddq: Vec::with_capacity(samples * nv),
-            tau: Vec::with_capacity(samples * nv),
-            momentum: Vec::with_capacity(samples * 6),
-            kinetic_energy: Vec::with_capacity(samples),
-            work: Vec::with_capacity(samples),
-            ..Default::default()
+        let mut tr = Trajectory { nq, nv, ..Default::default() };
+        let refuse = || {
+            FfError::arg(
+                "t_final",
+                format!(
+                    "a trajectory of {samples} samples ({:.3} GB) could not be allocated; record fewer samples \
+                     (a larger record_every or dt, a shorter t_final)",
+                    samples as f64 * Self::bytes_per_sample(m) as f64 / 1e9
+                ),
+            )
+        };
+        for (buf, width) in
+            [(&mut tr.q, nq), (&mut tr.v, nv), (&mut tr.ddq, nv), (&mut tr.tau, nv), (&mut tr.momentum, 6)]
+        {
+            let n = samples.checked_mul(width).ok_or_else(refuse)?;
+            buf.try_reserve_exact(n).map_err(|_| refuse())?;
         }
+        for buf in [&mut tr.t, &mut tr.kinetic_energy, &mut tr.work] {
+            buf.try_reserve_exact(samples).map_err(|_| refuse())?;
+        }
+        Ok(tr)
+    }
+
+    /// Bytes one recorded sample takes: t, q, v, ddq, tau, momentum, kinetic energy, work.
+    pub fn bytes_per_sample(m: &Model) -> usize {
+        8 * (m.nq + 3 * m.nv + 6 + 3)
     }
 
     /// Number of samples.
