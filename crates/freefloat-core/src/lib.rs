@@ -27,6 +27,8 @@ pub mod dynamics;
 pub mod error;
 /// Least squares, RLS and the modified RLS for inertial-parameter identification.
 pub mod estimation;
+/// The orbital environment: central-body gravity and orbit, gravity gradient, J2, constant disturbance.
+pub mod environment;
 /// Exciting-trajectory design: zero-momentum base response and regressor rows (Naveen, Shah, Misra, Sec. V).
 pub mod excitation;
 /// Forward kinematics, velocities, accelerations, centre of mass, momentum, energy, Jacobians.

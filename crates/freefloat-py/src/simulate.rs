@@ -4,7 +4,9 @@
 
 use crate::algorithms::prescribed_bodies;
 use crate::errors::{guard, input_err};
+use crate::environment::PyEnvironment;
 use crate::model::PyModel;
+use freefloat_core::environment::Environment;
 use freefloat_core::sim::{self, Controller, Hold, Inputs, Method, Prescription, SimOptions, TorqueSource};
 use freefloat_core::FfError;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -50,7 +52,8 @@ fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'st
 #[pyo3(signature = (
     model, q0, v0, t_final, dt, method = "rk4", rtol = 1e-9, atol = 1e-12, max_step = None, record_every = 1,
     torques = None, torque_times = None, hold = "zoh", controller = None, controller_period = None,
-    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba"
+    prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba",
+    environment = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -75,8 +78,13 @@ pub fn simulate<'py>(
     max_steps: usize,
     progress: Option<Bound<'py, PyAny>>,
     formulation: &str,
+    environment: Option<PyRef<'py, PyEnvironment>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model.inner.clone();
+    let env: Option<Environment> = environment.map(|e| e.inner);
+    if let Some(e) = &env {
+        guard(|| e.check(&m))?;
+    }
     let formulation = match formulation {
         "aba" => sim::Formulation::Aba,
         "dq" => sim::Formulation::DualQuaternion,
@@ -180,13 +188,14 @@ pub fn simulate<'py>(
     let v0 = v0.as_array().to_vec();
     let nv = m.nv;
 
+    let m_after = m.clone();
     let result = if has_callbacks {
         let torque_src = match torque_spec {
             TorqueSpec::Zero => TorqueSource::Zero,
             TorqueSpec::Table(times, values) => guard(|| TorqueSource::table(times, values, nv, hold))?,
             TorqueSpec::Callable(f) => TorqueSource::Function(state_fn(py, f, stash.clone(), "the torque function")),
         };
-        let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc };
+        let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc, environment: env.as_ref() };
         let st = stash.clone();
         let mut prog = progress.map(|p| {
             move |frac: f64| -> bool {
@@ -208,14 +217,15 @@ pub fn simulate<'py>(
             TorqueSpec::Table(times, values) => Some((times, values)),
             _ => None,
         };
+        let (q0, v0) = (&q0, &v0);
         py.detach(move || {
             guard(|| {
                 let torques = match table {
                     Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
                     None => TorqueSource::Zero,
                 };
-                let inputs = Inputs { torques, ..Default::default() };
-                sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, None)
+                let inputs = Inputs { torques, environment: env.as_ref(), ..Default::default() };
+                sim::simulate_with(&m, q0, v0, &opts, inputs, formulation, None)
             })
         })
     };
@@ -236,6 +246,11 @@ pub fn simulate<'py>(
     d.set_item("steps", tr.steps)?;
     d.set_item("rejected", tr.rejected)?;
     d.set_item("evaluations", tr.evaluations)?;
+    if let Some(e) = env.as_ref().filter(|e| e.orbit.is_some()) {
+        // the frame origin's inertial orbit at the recorded times (the propagation the run used)
+        let orbit = guard(|| freefloat_core::environment::reference_orbit(e, &m_after, &q0, &v0, &tr.t))?;
+        d.set_item("orbit", PyArray1::from_vec(py, orbit).reshape([n, 6])?)?;
+    }
     Ok(d)
 }
 

@@ -21,7 +21,7 @@ pub fn simulate_postcapture(
 ) -> Result<Trajectory> {
     let mut ctl = Controller::new(m, control)?;
     let torques = TorqueSource::Function(Box::new(move |t, q, v, out| ctl.generalized_forces(m, t, q, v, out)));
-    let inputs = Inputs { torques, controller: None, prescription: None };
+    let inputs = Inputs { torques, controller: None, prescription: None, environment: None };
     let opts = SimOptions { t_final, dt, method: Method::Rk4, record_every, max_steps: usize::MAX };
     simulate(m, q0, v0, &opts, inputs, progress)
 }

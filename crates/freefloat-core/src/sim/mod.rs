@@ -17,6 +17,8 @@ use crate::config::{
 };
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
+use crate::environment::{EnvWorkspace, Environment};
+use crate::kinematics::forward_kinematics_unchecked;
 use crate::error::{check_vec, FfError, Result};
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
@@ -71,11 +73,13 @@ pub struct Inputs<'a> {
     pub controller: Option<Controller<'a>>,
     /// Joints that follow a prescribed motion (hybrid dynamics).
     pub prescription: Option<Prescription<'a>>,
+    /// The orbital environment (gravity gradient, J2, disturbance); `None` or all off: no external forces.
+    pub environment: Option<&'a Environment>,
 }
 
 impl Default for Inputs<'_> {
     fn default() -> Self {
-        Inputs { torques: TorqueSource::Zero, controller: None, prescription: None }
+        Inputs { torques: TorqueSource::Zero, controller: None, prescription: None, environment: None }
     }
 }
 
@@ -105,6 +109,8 @@ struct Stepper<'m, 'i> {
     mag0: Vec<f64>,
     mag1: Vec<f64>,
     evals: usize,
+    /// The environment's workspace; its `fext` holds the per-body external wrenches of the current stage.
+    env: Option<EnvWorkspace>,
 }
 
 /// Result of one derivative evaluation at a stage.
@@ -140,6 +146,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
             mag0: vec![0.0; m.nv],
             mag1: vec![0.0; m.nv],
             evals: 0,
+            env: None,
         })
     }
 
@@ -166,17 +173,26 @@ impl<'m, 'i> Stepper<'m, 'i> {
         for (x, h) in self.tau.iter_mut().zip(&self.held) {
             *x += h;
         }
+        // The environment's per-body wrenches at this stage (needs the placements: one extra forward pass).
+        let fext = match (self.env.as_mut(), self.inputs.environment) {
+            (Some(ws), Some(env)) => {
+                forward_kinematics_unchecked(m, &mut self.d, &qs);
+                ws.eval(env, m, &self.d, t);
+                Some(ws.fext.as_slice())
+            }
+            _ => None,
+        };
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
         match self.formulation {
-            Formulation::Aba => hybrid_aba_unchecked(m, &mut self.d, &qs, &vs, &self.tau, None, presc)?,
+            Formulation::Aba => hybrid_aba_unchecked(m, &mut self.d, &qs, &vs, &self.tau, fext, presc)?,
             Formulation::DualQuaternion => {
                 // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
                 let (mask, ddq) = match presc {
                     Some(p) => (Some(p.mask), Some(p.ddq)),
                     None => (None, None),
                 };
-                crate::dqdynamics::solve_system_unchecked(m, &mut self.d, &qs, &vs, &self.tau, None, mask, ddq)?;
+                crate::dqdynamics::solve_system_unchecked(m, &mut self.d, &qs, &vs, &self.tau, fext, mask, ddq)?;
                 let d = &mut self.d;
                 d.ddq.copy_from_slice(&d.dq.out.ddq);
                 d.tau.copy_from_slice(&self.tau);
@@ -327,6 +343,9 @@ pub fn simulate_with(
     };
     let mut st = Stepper::new(m, inputs, tab.stages())?;
     st.formulation = formulation;
+    if let Some(env) = st.inputs.environment.filter(|e| !e.is_off()) {
+        st.env = Some(env.workspace(m, &mut st.d, &q0, v0)?);
+    }
     let expected = match opts.method {
         Method::Rk4 => (opts.t_final / opts.dt).round() as usize / opts.record_every + 2,
         Method::Rk45 { .. } => (opts.t_final / opts.dt).ceil() as usize + 2,

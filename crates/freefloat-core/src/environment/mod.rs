@@ -1,0 +1,223 @@
+//! The orbital environment of a simulation: point-mass gravity of a central body with the orbit of the
+//! system, the gravity gradient on every body, J2, and a constant disturbance wrench (Valverde 2018, §2.3.3,
+//! (2.61)–(2.68)). Everything is off by default, and an `Environment` that is all off changes nothing: the
+//! simulator then passes no external forces at all, as before.
+//!
+//! **Frame.** The simulator's world frame keeps inertial axes but its origin is a free-falling reference
+//! point O that starts at the system's centre of mass and moves on the orbit (`orbit::Propagator`). Positions
+//! in `q` stay metres, not 7e6 m, so millimetre arm motion keeps its digits. O accelerates with `g(R)`, so
+//! every body in this frame feels its gravity minus `m g(R)`: the differential (tidal) gravity
+//! `m [g(R + r) − g(R)]` on its centre of mass (`gravity_gradient`, with J2's differential part in `j2`), and
+//! the gravity-gradient torque about it. This is exact for any free-falling O (no linearisation), so the system
+//! CoM leaves O only by the tiny net tidal force (second order in size/radius). The inertial position of the
+//! system is `R(t) + r`. Inertial rather than LVLH axes: no fictitious Coriolis or centrifugal forces on
+//! every body, the momentum the simulator records keeps its meaning, and the free-flyer `q` stays Pinocchio's.
+
+pub mod disturbance;
+pub mod gravity_gradient;
+pub mod j2;
+pub mod orbit;
+
+pub use disturbance::{Axes, Disturbance};
+pub use orbit::{CentralBody, Elements, Orbit, Propagator, ReferenceState};
+
+use crate::data::Data;
+use crate::error::{check_vec, FfError, Result};
+use crate::kinematics::forward_kinematics_unchecked;
+use crate::model::Model;
+use crate::spatial::{Force, M3, V3};
+
+/// What acts on the system from outside. `Default` is all off.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Environment {
+    /// The central body and the orbit of the system's centre of mass at t = 0. Without it there is no gravity
+    /// field (and neither gravity gradient nor J2).
+    pub orbit: Option<Orbit>,
+    /// Apply the tidal force and the gravity-gradient torque to every body.
+    pub gravity_gradient: bool,
+    /// Add J2 to the orbit of the frame origin and its differential part to every body.
+    pub j2: bool,
+    /// A constant wrench on one body.
+    pub disturbance: Option<Disturbance>,
+}
+
+impl Environment {
+    /// Nothing acts: the simulator skips the environment entirely.
+    pub fn is_off(&self) -> bool {
+        self.orbit.is_none() && self.disturbance.is_none()
+    }
+
+    /// Checks the environment against the model it will act on.
+    pub fn check(&self, m: &Model) -> Result<()> {
+        if let Some(o) = &self.orbit {
+            o.central.check()?;
+            // `Orbit::new` checked the orbit when it was made; its fields are public, so check it again.
+            Orbit::new(o.central, o.position, o.velocity)?;
+            if m.gravity.norm() != 0.0 {
+                return Err(FfError::arg(
+                    "environment.orbit",
+                    format!(
+                        "the model has a uniform gravity {:?} m/s²; an orbit gives its own gravity field, so set the \
+                         model's gravity to zero",
+                        m.gravity.as_slice()
+                    ),
+                ));
+            }
+        } else if self.gravity_gradient || self.j2 {
+            let what = if self.j2 { "j2" } else { "gravity_gradient" };
+            return Err(FfError::arg(
+                &format!("environment.{what}"),
+                "needs an orbit (the central body and the system's orbit)",
+            ));
+        }
+        if let Some(dist) = &self.disturbance {
+            dist.check(m.nbodies())?;
+        }
+        Ok(())
+    }
+
+    /// The workspace of one simulation from (q0, v0): places the frame origin O at the system's centre of mass
+    /// with its velocity, on the orbit given for it (checked).
+    pub fn workspace(&self, m: &Model, d: &mut Data, q0: &[f64], v0: &[f64]) -> Result<EnvWorkspace> {
+        self.check(m)?;
+        check_vec("q0", q0, m.nq)?;
+        check_vec("v0", v0, m.nv)?;
+        let prop = match &self.orbit {
+            None => None,
+            Some(o) => {
+                let h = crate::kinematics::momentum(m, d, q0, v0)?;
+                let c = crate::kinematics::center_of_mass(m, d, q0)?;
+                // O starts where the system's CoM would be if its local position and velocity were zero; a
+                // system whose CoM is at rest at the local origin (the usual start) has O on the given orbit.
+                let (r0, v0c) = (o.position - c, o.velocity - h.lin / m.total_mass());
+                Some(Propagator::new(o.central, r0, v0c, self.j2))
+            }
+        };
+        let n = m.nbodies();
+        Ok(EnvWorkspace {
+            prop,
+            fext: vec![0.0; 6 * n],
+            com: m.inertias.iter().map(|i| i.com()).collect(),
+            i_com: m.inertias.iter().map(|i| i.i_com()).collect(),
+        })
+    }
+}
+
+/// Per-simulation buffers of the environment: the orbit propagator, the per-body external wrenches handed to
+/// the dynamics (`fext`: body frame, about the body origin, `[force; torque]` per body), and each body's CoM and
+/// inertia about it.
+#[derive(Clone, Debug)]
+pub struct EnvWorkspace {
+    prop: Option<Propagator>,
+    /// Per-body external wrenches of the last `eval` (6 per body).
+    pub fext: Vec<f64>,
+    com: Vec<V3>,
+    i_com: Vec<M3>,
+}
+
+impl EnvWorkspace {
+    /// The frame origin's inertial state at time t (None without an orbit).
+    pub fn reference(&mut self, t: f64) -> Option<ReferenceState> {
+        self.prop.as_mut().map(|p| p.state(t))
+    }
+
+    /// Fills `self.fext` for time t from the placements in `d` (forward kinematics done). Each body's dual
+    /// force about its CoM in body axes, `f + ετ` (2.39), is the sum of the effects, then moves to the body
+    /// origin by (2.40), `f + ε(τ + c × f)` with `c` the CoM in body axes.
+    pub fn eval(&mut self, env: &Environment, m: &Model, d: &Data, t: f64) {
+        let refst = self.reference(t);
+        self.fext.fill(0.0);
+        for i in 0..m.nbodies() {
+            let mass = m.inertias[i].mass;
+            let x = &d.o_mi[i];
+            let mut w = crate::dualquat::DualQuat::vector(&V3::zeros(), &V3::zeros());
+            let mut any = false;
+            if let (Some(o), Some(rs)) = (&env.orbit, &refst) {
+                if mass > 0.0 {
+                    let r = x.act_point(&self.com[i]);
+                    if env.gravity_gradient {
+                        w = w + gravity_gradient::wrench(&x.rot, &rs.position, &r, mass, &self.i_com[i], o.central.mu);
+                        any = true;
+                    }
+                    if env.j2 {
+                        w = w + j2::wrench(&x.rot, &rs.position, &r, mass, &o.central);
+                        any = true;
+                    }
+                }
+            }
+            if let Some(dist) = env.disturbance.as_ref().filter(|dd| dd.body == i) {
+                w = w + dist.wrench(&x.rot);
+                any = true;
+            }
+            if any {
+                let (f, tau) = (w.r.v, w.d.v + self.com[i].cross(&w.r.v));
+                self.fext[6 * i..6 * i + 3].copy_from_slice(f.as_slice());
+                self.fext[6 * i + 3..6 * i + 6].copy_from_slice(tau.as_slice());
+            }
+        }
+    }
+
+    /// Total external wrench of the last `eval` about the frame origin, inertial axes (`d` as in `eval`).
+    pub fn total_wrench(&self, m: &Model, d: &Data) -> Force {
+        let mut tot = Force::ZERO;
+        for i in 0..m.nbodies() {
+            tot += d.o_mi[i].act_force(&Force::from_slice(&self.fext[6 * i..6 * i + 6]));
+        }
+        tot
+    }
+}
+
+/// The frame origin's inertial state `[position (3), velocity (3)]` at each of `times` for a simulation that
+/// starts at (q0, v0): the same propagation the simulator uses, so the system's inertial position at a recorded
+/// sample is this position plus the local one.
+pub fn reference_orbit(env: &Environment, m: &Model, q0: &[f64], v0: &[f64], times: &[f64]) -> Result<Vec<f64>> {
+    let mut d = Data::new(m);
+    let mut ws = env.workspace(m, &mut d, q0, v0)?;
+    if ws.prop.is_none() {
+        return Err(FfError::arg("environment.orbit", "the environment has no orbit"));
+    }
+    check_times(times)?;
+    let mut out = Vec::with_capacity(6 * times.len());
+    for &t in times {
+        let s = ws.reference(t).expect("checked above");
+        out.extend_from_slice(s.position.as_slice());
+        out.extend_from_slice(s.velocity.as_slice());
+    }
+    Ok(out)
+}
+
+/// The environment's total external wrench `[force (3), moment about the frame origin (3)]`, inertial axes,
+/// at each sample `(times[k], qs[k])` of a simulation that started at (q0, v0): what the simulator applied there.
+pub fn external_wrenches(
+    env: &Environment,
+    m: &Model,
+    q0: &[f64],
+    v0: &[f64],
+    times: &[f64],
+    qs: &[f64],
+) -> Result<Vec<f64>> {
+    let mut d = Data::new(m);
+    let mut ws = env.workspace(m, &mut d, q0, v0)?;
+    check_times(times)?;
+    if qs.len() != times.len() * m.nq {
+        return Err(FfError::arg("q", format!("expected {} × {} configurations, got {} values", times.len(), m.nq, qs.len())));
+    }
+    let mut out = Vec::with_capacity(6 * times.len());
+    let mut qbuf = Vec::new();
+    for (k, &t) in times.iter().enumerate() {
+        let q = m.checked_q(&qs[k * m.nq..(k + 1) * m.nq], &mut qbuf)?;
+        forward_kinematics_unchecked(m, &mut d, q);
+        ws.eval(env, m, &d, t);
+        let w = ws.total_wrench(m, &d);
+        out.extend_from_slice(w.lin.as_slice());
+        out.extend_from_slice(w.ang.as_slice());
+    }
+    Ok(out)
+}
+
+fn check_times(times: &[f64]) -> Result<()> {
+    if let Some(k) = times.iter().position(|t| !(t.is_finite() && *t >= 0.0)) {
+        return Err(FfError::arg("times", format!("entry {k} is not a finite time ≥ 0")));
+    }
+    Ok(())
+}
