@@ -57,11 +57,14 @@ from .identification import (
 )
 from .io import Telemetry, telemetry
 from .model import Model
+from .environment import Environment, load_environment
 from .simulation import Trajectory, simulate
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "Environment",
+    "load_environment",
     "Model",
     "Trajectory",
     "models",

@@ -40,6 +40,9 @@ class Trajectory:
     q_labels: list = field(default_factory=list)
     v_labels: list = field(default_factory=list)
     stats: dict = field(default_factory=dict)
+    orbit: np.ndarray | None = None
+    """With an orbital environment: (T, 6) inertial [position, velocity] of the simulation frame's origin (from
+    the central body's centre); a body's inertial position is this plus its local one."""
 
     def __len__(self) -> int:
         return len(self.t)
@@ -60,6 +63,8 @@ class Trajectory:
     def integration_warning(self, limit: float = 1e-8) -> str | None:
         """A sentence when the integration error is visible — momentum drift or kinetic energy minus work
         above `limit` (relative) — suggesting a smaller step or rk45; None when the run stays near round-off."""
+        if self.stats.get("external_forces"):
+            return None  # an environment's forces change momentum and do work that `work` does not hold
         d, e = self.momentum_drift(), self.energy_balance()
         worst = max(d["linear_rel"], d["angular_rel"], e["rel"])
         if worst <= limit:
@@ -210,6 +215,7 @@ def simulate(
     progress=False,
     max_steps: int = 50_000_000,
     formulation: str = "aba",
+    environment: _core.Environment | None = None,
 ) -> Trajectory:
     """Simulate the model from (q0, v0) for t_final seconds.
 
@@ -229,7 +235,10 @@ def simulate(
     formulation: "aba" (the engine's articulated-body algorithm) or "dq" (the dual-quaternion Newton-Euler
       system of Valverde 2018 ch. 6, `dq_dynamics`: same motion to round-off, slower; free or fixed base with
       revolute, prismatic, spherical, cylindrical, universal and fixed joints). With "dq" the recorded momentum
-      and kinetic energy are the formulation's own (2.53)/(2.54)."""
+      and kinetic energy are the formulation's own (2.53)/(2.54).
+    environment: a `freefloat.Environment` (orbit with gravity gradient, J2, a constant disturbance); its forces
+      reach every body as external wrenches, and the returned trajectory's `orbit` holds the inertial state of
+      the simulation frame's origin. None (the default): no external forces at all."""
     if not isinstance(model, Model):
         raise TypeError(f"expected a freefloat.Model, got {type(model).__name__}")
     if isinstance(prescribed, str):
@@ -272,6 +281,7 @@ def simulate(
             int(max_steps),
             cb,
             formulation,
+            environment,
         )
         if bar is not None:  # a finished run fills its bar (however fast it was: tqdm redraws at most every 0.1 s)
             bar.update(bar.total - bar.n)
@@ -280,6 +290,9 @@ def simulate(
         if bar is not None:
             bar.close()
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
+    orbit = out.pop("orbit", None)
+    if environment is not None and not environment.is_off:
+        stats.update(environment=repr(environment), external_forces=True)
     stats.update(
         method=method,
         formulation=formulation,
@@ -288,7 +301,9 @@ def simulate(
         total_mass=model.total_mass,
         radius=_radius(model, q0),
     )
-    return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
+    return Trajectory(
+        **out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats, orbit=orbit
+    )
 
 
 def simulate_driven(

@@ -7,6 +7,7 @@ import time
 import click
 import numpy as np
 
+from ..environment import load_environment
 from ..simulation import simulate
 from ._common import load_model, parse_vector, print_summary, summarize, torque_options, write_outputs
 
@@ -49,12 +50,33 @@ from ._common import load_model, parse_vector, print_summary, summarize, torque_
     help="Dynamics: the engine's ABA, or the dual-quaternion Newton-Euler system (Valverde 2018 ch. 6).",
 )
 @click.option(
+    "--environment",
+    "environment_file",
+    type=click.Path(exists=True, dir_okay=False),
+    help="A YAML file with an `environment:` block (orbit, gravity_gradient, j2, disturbance; or a scenario file "
+    "holding one): the robot then orbits a central body and feels its gravity gradient.",
+)
+@click.option(
     "--out",
     help="FILE.parquet or FILE.csv (plus FILE.results.json and FILE.png beside it), or a directory (gets "
     "trajectory.parquet, results.json, trajectory.png). Every file written is listed.",
 )
 def simulate_cmd(
-    model, base, t_final, dt, method, rtol, atol, torques, amplitude, q0, v0, record_every, formulation, out
+    model,
+    base,
+    t_final,
+    dt,
+    method,
+    rtol,
+    atol,
+    torques,
+    amplitude,
+    q0,
+    v0,
+    record_every,
+    formulation,
+    environment_file,
+    out,
 ):
     """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.
 
@@ -65,6 +87,8 @@ def simulate_cmd(
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
     kw = torque_options(m, torques, amplitude)
+    if environment_file:
+        kw["environment"] = load_environment(environment_file)
     t0 = time.perf_counter()
     traj = simulate(
         m,
