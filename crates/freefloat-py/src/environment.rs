@@ -27,6 +27,16 @@ fn v3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<V3> {
     Ok(V3::new(v[0], v[1], v[2]))
 }
 
+/// A `freefloat.Model` (or its engine model).
+fn as_model<'py>(obj: &Bound<'py, PyAny>) -> PyResult<PyRef<'py, PyModel>> {
+    if let Ok(m) = obj.extract::<PyRef<'py, PyModel>>() {
+        return Ok(m);
+    }
+    obj.getattr("_core")
+        .and_then(|c| c.extract::<PyRef<'py, PyModel>>().map_err(Into::into))
+        .map_err(|_| input_err("argument `model`: expected a freefloat.Model"))
+}
+
 /// The orbital environment of a simulation; every effect is off unless asked for.
 ///
 /// Orbit (of the system's centre of mass at t = 0, about a central body; the Earth by default): give either
@@ -186,12 +196,13 @@ impl PyEnvironment {
     fn reference_orbit<'py>(
         &self,
         py: Python<'py>,
-        model: &PyModel,
+        model: &Bound<'py, PyAny>,
         q0: PyReadonlyArray1<'py, f64>,
         v0: PyReadonlyArray1<'py, f64>,
         times: PyReadonlyArray1<'py, f64>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q0, v0, times) = (q0.as_slice()?, v0.as_slice()?, times.as_slice()?);
+        let model = as_model(model)?;
         let out = guard(|| env::reference_orbit(&self.inner, &model.inner, q0, v0, times))?;
         Ok(PyArray1::from_vec(py, out).reshape([times.len(), 6])?.into_any())
     }
@@ -201,7 +212,7 @@ impl PyEnvironment {
     fn external_wrenches<'py>(
         &self,
         py: Python<'py>,
-        model: &PyModel,
+        model: &Bound<'py, PyAny>,
         q0: PyReadonlyArray1<'py, f64>,
         v0: PyReadonlyArray1<'py, f64>,
         times: PyReadonlyArray1<'py, f64>,
@@ -209,6 +220,7 @@ impl PyEnvironment {
     ) -> PyResult<Bound<'py, PyAny>> {
         let (q0, v0, times) = (q0.as_slice()?, v0.as_slice()?, times.as_slice()?);
         let qs: Vec<f64> = q.as_array().iter().copied().collect();
+        let model = as_model(model)?;
         let out = guard(|| env::external_wrenches(&self.inner, &model.inner, q0, v0, times, &qs))?;
         Ok(PyArray1::from_vec(py, out).reshape([times.len(), 6])?.into_any())
     }

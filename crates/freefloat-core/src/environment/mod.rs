@@ -3,14 +3,16 @@
 //! (2.61)–(2.68)). Everything is off by default, and an `Environment` that is all off changes nothing: the
 //! simulator then passes no external forces at all, as before.
 //!
-//! **Frame.** The simulator's world frame keeps inertial axes but its origin is a free-falling reference
-//! point O that starts at the system's centre of mass and moves on the orbit (`orbit::Propagator`). Positions
-//! in `q` stay metres, not 7e6 m, so millimetre arm motion keeps its digits. O accelerates with `g(R)`, so
-//! every body in this frame feels its gravity minus `m g(R)`: the differential (tidal) gravity
-//! `m [g(R + r) − g(R)]` on its centre of mass (`gravity_gradient`, with J2's differential part in `j2`), and
-//! the gravity-gradient torque about it. This is exact for any free-falling O (no linearisation), so the system
-//! CoM leaves O only by the tiny net tidal force (second order in size/radius). The inertial position of the
-//! system is `R(t) + r`. Inertial rather than LVLH axes: no fictitious Coriolis or centrifugal forces on
+//! **Frame.** The simulator's world frame keeps inertial axes but its origin translates with a free-falling
+//! reference point: the reference point P moves on the given orbit of the system's centre of mass
+//! (`orbit::Propagator`) and the frame origin is `O = P − c0 − ċ0 t`, c0 and ċ0 the CoM's local position and
+//! velocity at t = 0 (O is P when the CoM starts at rest at the local origin). Positions in `q` stay metres, not
+//! 7e6 m, so millimetre arm motion keeps its digits. O accelerates with `g(R)`, R = P, so every body in this
+//! frame feels its gravity minus `m g(R)`: the differential (tidal) gravity `m [g(R + r) − g(R)]` (r: the
+//! body's CoM relative to P) on its centre of mass (`gravity_gradient`, with J2's differential part in `j2`), and
+//! the gravity-gradient torque about it. This is exact (no linearisation: O's acceleration is exactly g(P)), so the system
+//! CoM leaves c0 + ċ0 t only by the tiny net tidal force (second order in size/radius). A local point x is inertially
+//! at `O(t) + x`. Inertial rather than LVLH axes: no fictitious Coriolis or centrifugal forces on
 //! every body, the momentum the simulator records keeps its meaning, and the free-flyer `q` stays Pinocchio's.
 
 pub mod disturbance;
@@ -76,8 +78,8 @@ impl Environment {
         Ok(())
     }
 
-    /// The workspace of one simulation from (q0, v0): places the frame origin O at the system's centre of mass
-    /// with its velocity, on the orbit given for it (checked).
+    /// The workspace of one simulation from (q0, v0): the reference point starts on the given orbit of the
+    /// system's centre of mass, the frame origin at `P − c0` (checked).
     pub fn workspace(&self, m: &Model, d: &mut Data, q0: &[f64], v0: &[f64]) -> Result<EnvWorkspace> {
         self.check(m)?;
         check_vec("q0", q0, m.nq)?;
@@ -87,15 +89,22 @@ impl Environment {
             Some(o) => {
                 let h = crate::kinematics::momentum(m, d, q0, v0)?;
                 let c = crate::kinematics::center_of_mass(m, d, q0)?;
-                // O starts where the system's CoM would be if its local position and velocity were zero; a
-                // system whose CoM is at rest at the local origin (the usual start) has O on the given orbit.
-                let (r0, v0c) = (o.position - c, o.velocity - h.lin / m.total_mass());
-                Some(Propagator::new(o.central, r0, v0c, self.j2))
+                // The reference point P follows the given orbit of the system's CoM; the frame origin O is
+                // P − c0 − ċ0 t (c0, ċ0: the CoM's local position and velocity at t = 0), which accelerates with
+                // P, g(P): a body at local r is at P + (r − c0 − ċ0 t) and feels the tidal gravity of that
+                // offset. The CoM then stays at c0 + ċ0 t locally, to second order in size/radius.
+                Some((Propagator::new(o.central, o.position, o.velocity, self.j2), c, h.lin / m.total_mass()))
             }
         };
         let n = m.nbodies();
+        let (prop, c0, cdot0) = match prop {
+            Some((p, c, cd)) => (Some(p), c, cd),
+            None => (None, V3::zeros(), V3::zeros()),
+        };
         Ok(EnvWorkspace {
             prop,
+            c0,
+            cdot0,
             fext: vec![0.0; 6 * n],
             com: m.inertias.iter().map(|i| i.com()).collect(),
             i_com: m.inertias.iter().map(|i| i.i_com()).collect(),
@@ -109,6 +118,8 @@ impl Environment {
 #[derive(Clone, Debug)]
 pub struct EnvWorkspace {
     prop: Option<Propagator>,
+    c0: V3,
+    cdot0: V3,
     /// Per-body external wrenches of the last `eval` (6 per body).
     pub fext: Vec<f64>,
     com: Vec<V3>,
@@ -116,9 +127,15 @@ pub struct EnvWorkspace {
 }
 
 impl EnvWorkspace {
-    /// The frame origin's inertial state at time t (None without an orbit).
+    /// The reference point's inertial state at time t: the orbit of the system's CoM (None without an orbit).
     pub fn reference(&mut self, t: f64) -> Option<ReferenceState> {
         self.prop.as_mut().map(|p| p.state(t))
+    }
+
+    /// The frame origin's inertial state at time t, `P − c0 − ċ0 t` (None without an orbit).
+    pub fn origin(&mut self, t: f64) -> Option<ReferenceState> {
+        let (c0, cd) = (self.c0, self.cdot0);
+        self.reference(t).map(|s| ReferenceState { position: s.position - c0 - cd * t, velocity: s.velocity - cd })
     }
 
     /// Fills `self.fext` for time t from the placements in `d` (forward kinematics done). Each body's dual
@@ -134,7 +151,8 @@ impl EnvWorkspace {
             let mut any = false;
             if let (Some(o), Some(rs)) = (&env.orbit, &refst) {
                 if mass > 0.0 {
-                    let r = x.act_point(&self.com[i]);
+                    // the body's CoM relative to the reference point P
+                    let r = x.act_point(&self.com[i]) - self.c0 - self.cdot0 * t;
                     if env.gravity_gradient {
                         w = w + gravity_gradient::wrench(&x.rot, &rs.position, &r, mass, &self.i_com[i], o.central.mu);
                         any = true;
@@ -167,7 +185,7 @@ impl EnvWorkspace {
     }
 }
 
-/// The frame origin's inertial state `[position (3), velocity (3)]` at each of `times` for a simulation that
+/// The frame origin O's inertial state `[position (3), velocity (3)]` at each of `times` for a simulation that
 /// starts at (q0, v0): the same propagation the simulator uses, so the system's inertial position at a recorded
 /// sample is this position plus the local one.
 pub fn reference_orbit(env: &Environment, m: &Model, q0: &[f64], v0: &[f64], times: &[f64]) -> Result<Vec<f64>> {
@@ -179,7 +197,7 @@ pub fn reference_orbit(env: &Environment, m: &Model, q0: &[f64], v0: &[f64], tim
     check_times(times)?;
     let mut out = Vec::with_capacity(6 * times.len());
     for &t in times {
-        let s = ws.reference(t).expect("checked above");
+        let s = ws.origin(t).expect("checked above");
         out.extend_from_slice(s.position.as_slice());
         out.extend_from_slice(s.velocity.as_slice());
     }
