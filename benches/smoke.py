@@ -122,6 +122,18 @@ def _check_cl(out: Path) -> list[str]:
     return bad
 
 
+def _check_environment(out: Path) -> list[str]:
+    res = json.loads((out / "environment_bench.json").read_text())
+    bad = [
+        f"{k}: an environment that is off changed the run"
+        for k, a in res["agreement"].items()
+        if not a["off_bitwise_equal"]
+    ]
+    if set(res["results"]) != {"naveen_dual_arm", "valverde_ch9_two_arm", "zhang2020_3d"}:
+        bad.append(f"unexpected models {sorted(res['results'])}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -133,6 +145,7 @@ BENCHES = {
     "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
     "cl": ("cl_vs_numpy.py", [], (), _check_cl),
+    "environment": ("environment_bench.py", [], (), _check_environment),
 }
 
 

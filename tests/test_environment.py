@@ -218,7 +218,12 @@ def test_environment_errors_against_the_model():
     m = ff.models.load("valverde_ch5_single_arm")
     with pytest.raises(ff.InputError, match="disturbance.body"):
         ff.simulate(
-            m, m.neutral(), np.zeros(m.nv), 0.1, 0.01, environment=ff.Environment(disturbance_force=[1, 0, 0], disturbance_body=99)
+            m,
+            m.neutral(),
+            np.zeros(m.nv),
+            0.1,
+            0.01,
+            environment=ff.Environment(disturbance_force=[1, 0, 0], disturbance_body=99),
         )
 
 
@@ -264,12 +269,25 @@ def test_environment_block_and_cli(tmp_path):
     out = tmp_path / "run"
     res = CliRunner().invoke(
         main,
-        ["simulate", "valverde_ch5_single_arm", "--t-final", "0.5", "--dt", "0.01", "--environment", str(path), "--out", str(out)],
+        [
+            "simulate",
+            "valverde_ch5_single_arm",
+            "--t-final",
+            "0.5",
+            "--dt",
+            "0.01",
+            "--environment",
+            str(path),
+            "--out",
+            str(out),
+        ],
     )
     assert res.exit_code == 0, res.output
     assert json.loads((out / "results.json").read_text())
     bad = tmp_path / "bad.yaml"
     bad.write_text("environment:\n  orbit: {altitude: -1.0}\n")
-    res = CliRunner().invoke(main, ["simulate", "valverde_ch5_single_arm", "--t-final", "0.1", "--environment", str(bad)])
+    res = CliRunner().invoke(
+        main, ["simulate", "valverde_ch5_single_arm", "--t-final", "0.1", "--environment", str(bad)]
+    )
     assert res.exit_code != 0
     assert "environment.orbit.altitude" in res.output

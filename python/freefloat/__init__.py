@@ -44,6 +44,7 @@ from .algorithms import (
 )
 from .derivatives import aba_derivatives, rnea_derivatives, step_derivatives
 from .dq import reactions
+from .environment import Environment, load_environment
 from .identification import (
     IdentificationResult,
     MinimalParameters,
@@ -57,7 +58,6 @@ from .identification import (
 )
 from .io import Telemetry, telemetry
 from .model import Model
-from .environment import Environment, load_environment
 from .simulation import Trajectory, simulate
 
 __version__ = "0.1.0"

@@ -102,7 +102,8 @@ def environment_from_dict(block: Mapping | None) -> Environment | None:
                 kw[k] = _number(orbit[k], f"orbit.{k}")
         if "altitude" in kw and kw["altitude"] <= 0:
             raise InputError(
-                f"environment.orbit.altitude: the orbit must be above the central body's surface, got {kw['altitude']} m"
+                "environment.orbit.altitude: the orbit must be above the central body's surface, "
+                f"got {kw['altitude']} m"
             )
         for k in ("inclination", "raan", "arg_periapsis", "true_anomaly"):
             if f"{k}_deg" in orbit and k in orbit:

@@ -23,12 +23,12 @@ pub mod dqdynamics;
 pub mod dualquat;
 /// RNEA, CRBA, ABA and hybrid ABA (Featherstone, body coordinates).
 pub mod dynamics;
+/// The orbital environment: central-body gravity and orbit, gravity gradient, J2, constant disturbance.
+pub mod environment;
 /// The engine's error type.
 pub mod error;
 /// Least squares, RLS and the modified RLS for inertial-parameter identification.
 pub mod estimation;
-/// The orbital environment: central-body gravity and orbit, gravity gradient, J2, constant disturbance.
-pub mod environment;
 /// Exciting-trajectory design: zero-momentum base response and regressor rows (Naveen, Shah, Misra, Sec. V).
 pub mod excitation;
 /// Forward kinematics, velocities, accelerations, centre of mass, momentum, energy, Jacobians.

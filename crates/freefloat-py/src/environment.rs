@@ -27,13 +27,16 @@ fn v3(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<V3> {
     Ok(V3::new(v[0], v[1], v[2]))
 }
 
+/// Two float arrays.
+type Pair<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// A `freefloat.Model` (or its engine model).
 fn as_model<'py>(obj: &Bound<'py, PyAny>) -> PyResult<PyRef<'py, PyModel>> {
     if let Ok(m) = obj.extract::<PyRef<'py, PyModel>>() {
         return Ok(m);
     }
     obj.getattr("_core")
-        .and_then(|c| c.extract::<PyRef<'py, PyModel>>().map_err(Into::into))
+        .and_then(|c| c.extract::<PyRef<'py, PyModel>>())
         .map_err(|_| input_err("argument `model`: expected a freefloat.Model"))
 }
 
@@ -87,8 +90,11 @@ impl PyEnvironment {
         disturbance_body: usize,
     ) -> PyResult<Self> {
         let e = CentralBody::EARTH;
-        let central =
-            CentralBody { mu: mu.unwrap_or(e.mu), radius: radius.unwrap_or(e.radius), j2: j2_coefficient.unwrap_or(e.j2) };
+        let central = CentralBody {
+            mu: mu.unwrap_or(e.mu),
+            radius: radius.unwrap_or(e.radius),
+            j2: j2_coefficient.unwrap_or(e.j2),
+        };
         let orbit = match (altitude, semi_major_axis, &position, &velocity) {
             (None, None, None, None) => {
                 if mu.is_some() || radius.is_some() {
@@ -103,7 +109,7 @@ impl PyEnvironment {
                 guard(|| central.check())?;
                 let a = match (alt, sma) {
                     (Some(h), _) => {
-                        if !(h > 0.0) || !h.is_finite() {
+                        if h.is_nan() || h <= 0.0 || h.is_infinite() {
                             return Err(input_err(format!(
                                 "argument `altitude`: the orbit must be above the central body's surface, got {h} m"
                             )));
@@ -132,7 +138,9 @@ impl PyEnvironment {
             "inertial" => Axes::Inertial,
             "body" => Axes::Body,
             other => {
-                return Err(input_err(format!("argument `disturbance_axes`: must be 'inertial' or 'body', got '{other}'")))
+                return Err(input_err(format!(
+                    "argument `disturbance_axes`: must be 'inertial' or 'body', got '{other}'"
+                )))
             }
         };
         let disturbance = match (disturbance_force, disturbance_torque) {
@@ -185,10 +193,10 @@ impl PyEnvironment {
 
     /// The system's centre-of-mass orbit at t = 0 as (position, velocity) (inertial, m and m/s), or None.
     #[getter]
-    fn orbit_state<'py>(&self, py: Python<'py>) -> Option<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
-        self.inner.orbit.map(|o| {
-            (PyArray1::from_slice(py, o.position.as_slice()), PyArray1::from_slice(py, o.velocity.as_slice()))
-        })
+    fn orbit_state<'py>(&self, py: Python<'py>) -> Option<Pair<'py>> {
+        self.inner
+            .orbit
+            .map(|o| (PyArray1::from_slice(py, o.position.as_slice()), PyArray1::from_slice(py, o.velocity.as_slice())))
     }
 
     /// Inertial state `[position, velocity]` (T, 6) of the simulation frame's origin at `times` for a run

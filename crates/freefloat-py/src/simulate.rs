@@ -3,8 +3,8 @@
 //! run happens with the GIL released.
 
 use crate::algorithms::prescribed_bodies;
-use crate::errors::{guard, input_err};
 use crate::environment::PyEnvironment;
+use crate::errors::{guard, input_err};
 use crate::model::PyModel;
 use freefloat_core::environment::Environment;
 use freefloat_core::sim::{self, Controller, Hold, Inputs, Method, Prescription, SimOptions, TorqueSource};

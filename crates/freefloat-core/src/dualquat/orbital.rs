@@ -43,7 +43,7 @@ pub fn gravity_gradient_of(i_com: &M3, r_b: &V3, mu: f64) -> DualQuat {
 pub fn tidal_acceleration(big_r: &V3, r: &V3, mu: f64) -> V3 {
     let d = big_r + r;
     let x = (2.0 * big_r.dot(r) + r.norm_squared()) / big_r.norm_squared();
-    let s = x * (3.0 + x * (3.0 + x)) / (1.0 + (1.0 + x).powf(1.5));
+    let s = x * (3.0 + x * (3.0 + x)) / (1.0 + (1.0 + x) * (1.0 + x).sqrt());
     -(r - big_r * s) * (mu / d.norm().powi(3))
 }
 

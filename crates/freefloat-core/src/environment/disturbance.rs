@@ -37,7 +37,10 @@ impl Disturbance {
             return Err(FfError::arg("disturbance.torque", format!("entry {k} is not finite")));
         }
         if self.body >= nbodies {
-            return Err(FfError::arg("disturbance.body", format!("body {} does not exist ({nbodies} bodies)", self.body)));
+            return Err(FfError::arg(
+                "disturbance.body",
+                format!("body {} does not exist ({nbodies} bodies)", self.body),
+            ));
         }
         Ok(())
     }

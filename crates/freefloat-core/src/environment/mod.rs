@@ -218,7 +218,10 @@ pub fn external_wrenches(
     let mut ws = env.workspace(m, &mut d, q0, v0)?;
     check_times(times)?;
     if qs.len() != times.len() * m.nq {
-        return Err(FfError::arg("q", format!("expected {} × {} configurations, got {} values", times.len(), m.nq, qs.len())));
+        return Err(FfError::arg(
+            "q",
+            format!("expected {} × {} configurations, got {} values", times.len(), m.nq, qs.len()),
+        ));
     }
     let mut out = Vec::with_capacity(6 * times.len());
     let mut qbuf = Vec::new();

@@ -30,7 +30,10 @@ impl CentralBody {
             return Err(FfError::arg("mu", format!("the gravitational parameter must be positive, got {}", self.mu)));
         }
         if !(self.radius > 0.0) || !self.radius.is_finite() {
-            return Err(FfError::arg("radius", format!("the central body's radius must be positive, got {}", self.radius)));
+            return Err(FfError::arg(
+                "radius",
+                format!("the central body's radius must be positive, got {}", self.radius),
+            ));
         }
         if !self.j2.is_finite() {
             return Err(FfError::arg("j2", format!("must be finite, got {}", self.j2)));
@@ -87,7 +90,8 @@ impl Orbit {
     /// From classical elements (checked: a bound orbit whose periapsis is above the central body's radius).
     pub fn from_elements(central: CentralBody, el: &Elements) -> Result<Orbit> {
         central.check()?;
-        for (name, x) in [("inclination", el.i), ("raan", el.raan), ("arg_periapsis", el.argp), ("true_anomaly", el.nu)] {
+        for (name, x) in [("inclination", el.i), ("raan", el.raan), ("arg_periapsis", el.argp), ("true_anomaly", el.nu)]
+        {
             if !x.is_finite() {
                 return Err(FfError::arg(name, format!("must be finite, got {x}")));
             }
@@ -179,7 +183,13 @@ impl Orbit {
             let fp = 1.0 + c1 * s - c2 * c;
             let step = f / fp;
             de -= step;
-            if step.abs() <= 1e-15 * de.abs().max(1.0) {
+            // ΔE is in [0, 2π + …]: an absolute bound; Newton converges quadratically, so the step after one
+            // of 1e-9 is already at round-off
+            if step.abs() <= 1e-9 {
+                if step.abs() > 1e-16 {
+                    let (s, c) = de.sin_cos();
+                    de -= (de + c1 * (1.0 - c) - c2 * s - m) / (1.0 + c1 * s - c2 * c);
+                }
                 break;
             }
         }
@@ -232,6 +242,7 @@ pub struct Propagator {
     node: usize,
     state: [V3; 2],
     checkpoints: Vec<[V3; 2]>,
+    cache: [(f64, ReferenceState); 2],
 }
 
 impl Propagator {
@@ -248,6 +259,7 @@ impl Propagator {
             node: 0,
             state: [r0, v0],
             checkpoints: vec![[r0, v0]],
+            cache: [(f64::NAN, ReferenceState { position: r0, velocity: v0 }); 2],
         }
     }
 
@@ -272,6 +284,19 @@ impl Propagator {
 
     /// Reference state at time t ≥ 0.
     pub fn state(&mut self, t: f64) -> ReferenceState {
+        // RK4 asks for t + h/2 twice and a step's end again as the next step's start: keep the last two answers
+        for (tc, sc) in &self.cache {
+            if *tc == t {
+                return *sc;
+            }
+        }
+        let s = self.compute(t);
+        self.cache[1] = self.cache[0];
+        self.cache[0] = (t, s);
+        s
+    }
+
+    fn compute(&mut self, t: f64) -> ReferenceState {
         if !self.j2 {
             let (position, velocity) = Orbit::kepler(self.central.mu, &self.r0, &self.v0, t);
             return ReferenceState { position, velocity };

@@ -18,8 +18,8 @@ use crate::config::{
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
 use crate::environment::{EnvWorkspace, Environment};
-use crate::kinematics::forward_kinematics_unchecked;
 use crate::error::{check_vec, FfError, Result};
+use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
 
