@@ -242,3 +242,60 @@ fn check_times(times: &[f64]) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dualquat::orbital::tidal_acceleration;
+
+    #[test]
+    fn tidal_acceleration_is_the_difference_of_gravities_without_its_cancellation() {
+        let mu = CentralBody::EARTH.mu;
+        // near the centre the plain difference keeps its digits: both agree to round-off
+        let (big_r, r) = (V3::new(3.0, -4.0, 12.0), V3::new(0.3, 0.2, -0.1));
+        let g = |x: &V3| -x * (mu / x.norm().powi(3));
+        let plain = g(&(big_r + r)) - g(&big_r);
+        assert!((tidal_acceleration(&big_r, &r, mu) - plain).norm() < 1e-13 * plain.norm());
+        // at 7000 km: the first-order tidal tensor (μ/R³)(3 R̂R̂ᵀ − I) r, to O(‖r‖/‖R‖)
+        let (big_r, r) = (V3::new(4.0e6, -3.0e6, 5.0e6), V3::new(0.5, -1.0, 2.0));
+        let rh = big_r.normalize();
+        let lin = (rh * (3.0 * rh.dot(&r)) - r) * (mu / big_r.norm().powi(3));
+        let t = tidal_acceleration(&big_r, &r, mu);
+        assert!((t - lin).norm() < 1e-5 * lin.norm(), "{t} vs {lin}");
+    }
+
+    #[test]
+    fn kepler_closed_form_matches_the_rk4_grid_without_j2() {
+        let c = CentralBody { j2: 0.0, ..CentralBody::EARTH };
+        let el = Elements { a: 7.2e6, e: 0.05, i: 0.5, raan: 0.2, argp: 0.7, nu: 1.0 };
+        let o = Orbit::from_elements(c, &el).unwrap();
+        let mut grid = Propagator::new(c, o.position, o.velocity, true);
+        let mut closed = Propagator::new(c, o.position, o.velocity, false);
+        for k in 0..=10 {
+            let t = o.period() * k as f64 / 10.0 + 0.37;
+            let (a, b) = (grid.state(t), closed.state(t));
+            assert!((a.position - b.position).norm() < 1e-4, "t = {t}: {}", (a.position - b.position).norm());
+            assert!((a.velocity - b.velocity).norm() < 1e-7);
+        }
+        // an earlier time after a later one (an RK45 rejection) gives the same answer as in order
+        let later = grid.state(3000.5);
+        let earlier = grid.state(1000.25);
+        let mut fresh = Propagator::new(c, o.position, o.velocity, true);
+        assert_eq!(fresh.state(1000.25), earlier);
+        assert_eq!(fresh.state(3000.5), later);
+        // a whole period later the closed form is back where it started
+        let p = closed.state(o.period());
+        assert!((p.position - o.position).norm() < 1e-7, "{}", (p.position - o.position).norm());
+    }
+
+    #[test]
+    fn orbits_below_the_surface_and_bad_constants_are_refused() {
+        let c = CentralBody::EARTH;
+        let low = Elements { a: 6.5e6, e: 0.1, i: 0.0, raan: 0.0, argp: 0.0, nu: 0.0 };
+        assert!(Orbit::from_elements(c, &low).unwrap_err().to_string().contains("semi_major_axis"));
+        let bad = CentralBody { mu: -1.0, ..c };
+        assert!(bad.check().unwrap_err().to_string().contains("mu"));
+        let esc = Orbit::new(c, V3::new(7e6, 0.0, 0.0), V3::new(0.0, 2e4, 0.0));
+        assert!(esc.unwrap_err().to_string().contains("bound"));
+    }
+}
