@@ -159,6 +159,18 @@ def _check_basilisk_wheels(out: Path) -> list[str]:
     return bad
 
 
+def _check_environment(out: Path) -> list[str]:
+    res = json.loads((out / "environment_bench.json").read_text())
+    bad = [
+        f"{k}: an environment that is off changed the run"
+        for k, a in res["agreement"].items()
+        if not a["off_bitwise_equal"]
+    ]
+    if set(res["results"]) != {"naveen_dual_arm", "valverde_ch9_two_arm", "zhang2020_3d"}:
+        bad.append(f"unexpected models {sorted(res['results'])}")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -174,6 +186,7 @@ BENCHES = {
     "kernels": ("kernels_vs_pinocchio.py", [], ("pinocchio",), _check_kernels),
     "mujoco": ("sim_vs_mujoco.py", [], ("mujoco",), _check_sim_vs_mujoco),
     "basilisk_wheels": ("basilisk_wheels.py", [], ("Basilisk",), _check_basilisk_wheels),
+    "environment": ("environment_bench.py", [], (), _check_environment),
 }
 
 

@@ -46,6 +46,7 @@ from .algorithms import (
 from .batch_simulation import Trajectories, simulate_many, torque_table
 from .derivatives import aba_derivatives, rnea_derivatives, step_derivatives
 from .dq import reactions
+from .environment import Environment, load_environment
 from .identification import (
     IdentificationResult,
     MinimalParameters,
@@ -68,6 +69,8 @@ __all__ = [
     "Wheel",
     "Thruster",
     "Tank",
+    "Environment",
+    "load_environment",
     "Model",
     "Trajectory",
     "models",

@@ -47,6 +47,9 @@ class Trajectory:
     q_labels: list = field(default_factory=list)
     v_labels: list = field(default_factory=list)
     stats: dict = field(default_factory=dict)
+    orbit: np.ndarray | None = None
+    """With an orbital environment: (T, 6) inertial [position, velocity] of the simulation frame's origin (from
+    the central body's centre); a body's inertial position is this plus its local one."""
 
     def __len__(self) -> int:
         return len(self.t)
@@ -67,6 +70,8 @@ class Trajectory:
     def integration_warning(self, limit: float = 1e-8) -> str | None:
         """A sentence when the integration error is visible — momentum drift or kinetic energy minus work
         above `limit` (relative) — suggesting a smaller step or rk45; None when the run stays near round-off."""
+        if self.stats.get("external_forces"):
+            return None  # an environment's forces change momentum and do work that `work` does not hold
         d, e = self.momentum_drift(), self.energy_balance()
         worst = max(d["linear_rel"], d["angular_rel"], e["rel"])
         if worst <= limit:
@@ -228,6 +233,7 @@ def simulate(
     actuators=None,
     input_timing: str = "step",
     max_memory: float | None = None,
+    environment: _core.Environment | None = None,
 ) -> Trajectory:
     """Simulate the model from (q0, v0) for t_final seconds.
 
@@ -263,7 +269,10 @@ def simulate(
       zero-order-hold switch on a step boundary acts from exactly there (rk45 lands on every table time);
       "stage": read at every Runge-Kutta stage time (keeps RK4's order for a smooth torque function of the
       state; a held switch on a step boundary then leaks 1/6 of a step into the step before). A table with
-      hold="linear" is read at every stage in both cases."""
+      hold="linear" is read at every stage in both cases.
+    environment: a `freefloat.Environment` (orbit with gravity gradient, J2, a constant disturbance); its forces
+      reach every body as external wrenches, and the returned trajectory's `orbit` holds the inertial state of
+      the simulation frame's origin. None (the default): no external forces at all."""
     if not isinstance(model, Model):
         raise TypeError(f"expected a freefloat.Model, got {type(model).__name__}")
     if isinstance(prescribed, str):
@@ -322,6 +331,7 @@ def simulate(
             acts,
             input_timing,
             limit,
+            environment,
         )
         if bar is not None:  # a finished run fills its bar (however fast it was: tqdm redraws at most every 0.1 s)
             bar.update(bar.total - bar.n)
@@ -329,17 +339,20 @@ def simulate(
     except _core.Interrupted as e:
         # what was finished comes with the interruption, as a Trajectory
         if isinstance(getattr(e, "partial", None), dict):
-            e.partial = _trajectory(model, e.partial, q0, method, formulation, dt, t_final)
+            e.partial = _trajectory(model, e.partial, q0, method, formulation, dt, t_final, input_timing, environment)
             e.partial.stats["interrupted"] = str(e)
         raise
     finally:
         if bar is not None:
             bar.close()
-    return _trajectory(model, out, q0, method, formulation, dt, t_final)
+    return _trajectory(model, out, q0, method, formulation, dt, t_final, input_timing, environment)
 
 
-def _trajectory(model, out: dict, q0, method, formulation, dt, t_final) -> Trajectory:
+def _trajectory(model, out: dict, q0, method, formulation, dt, t_final, input_timing, environment) -> Trajectory:
     stats = {k: out.pop(k) for k in ("steps", "rejected", "evaluations")}
+    orbit = out.pop("orbit", None)
+    if environment is not None and not environment.is_off:
+        stats.update(environment=repr(environment), external_forces=True)
     stats.update(
         method=method,
         formulation=formulation,
@@ -350,7 +363,9 @@ def _trajectory(model, out: dict, q0, method, formulation, dt, t_final) -> Traje
         rotational_inertia=_rotational_inertia(model, q0),
         input_timing=input_timing,
     )
-    return Trajectory(**out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)
+    return Trajectory(
+        **out, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats, orbit=orbit
+    )
 
 
 def memory_limit(fraction: float = 0.5) -> float:

@@ -23,6 +23,8 @@ pub mod dqdynamics;
 pub mod dualquat;
 /// RNEA, CRBA, ABA and hybrid ABA (Featherstone, body coordinates).
 pub mod dynamics;
+/// The orbital environment: central-body gravity and orbit, gravity gradient, J2, constant disturbance.
+pub mod environment;
 /// The engine's error type.
 pub mod error;
 /// Least squares, RLS and the modified RLS for inertial-parameter identification.

@@ -10,6 +10,7 @@ mod ddp;
 mod derivatives;
 mod dq;
 mod dqdynamics;
+mod environment;
 mod errors;
 mod estimation;
 mod excitation;
@@ -27,6 +28,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
     m.add("COMPILED_CPU_FEATURES", cpu::compiled_features())?;
     m.add_class::<model::PyModel>()?;
+    m.add_class::<environment::PyEnvironment>()?;
     m.add("ModelError", py.get_type::<errors::ModelError>())?;
     m.add("InputError", py.get_type::<errors::InputError>())?;
     m.add("NumericalError", py.get_type::<errors::NumericalError>())?;

@@ -3,8 +3,10 @@
 //! run happens with the GIL released.
 
 use crate::algorithms::prescribed_bodies;
+use crate::environment::PyEnvironment;
 use crate::errors::{guard, guard_raw, input_err, interrupted_with, is_ctrl_c, reraise_foreign, signal_hook};
 use crate::model::PyModel;
+use freefloat_core::environment::Environment;
 use freefloat_core::model::Model;
 use freefloat_core::sim::{
     self, Actuators, Controller, Hold, InputTiming, Inputs, Method, Prescription, SimOptions, Tank, Thruster,
@@ -61,7 +63,7 @@ fn state_fn<'py>(py: Python<'py>, f: Bound<'py, PyAny>, stash: Stash, what: &'st
     model, q0, v0, t_final, dt, method = "rk4", rtol = 1e-9, atol = 1e-12, max_step = None, record_every = 1,
     torques = None, torque_times = None, hold = "zoh", controller = None, controller_period = None,
     prescribed = None, prescription = None, max_steps = 50_000_000, progress = None, formulation = "aba",
-    actuators = None, input_timing = "step", max_memory = None
+    actuators = None, input_timing = "step", max_memory = None, environment = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate<'py>(
@@ -89,8 +91,13 @@ pub fn simulate<'py>(
     actuators: Option<Bound<'py, PyAny>>,
     input_timing: &str,
     max_memory: Option<f64>,
+    environment: Option<PyRef<'py, PyEnvironment>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = model.inner.clone();
+    let env: Option<Environment> = environment.map(|e| e.inner);
+    if let Some(e) = &env {
+        guard(|| e.check(&m))?;
+    }
     let timing = match input_timing {
         "step" => InputTiming::PerStep,
         "stage" => InputTiming::Stage,
@@ -244,13 +251,21 @@ pub fn simulate<'py>(
 
     let mut raised: Option<PyErr> = None;
     let mut returned_false = false;
+    let m_after = m.clone();
     let result = if has_callbacks {
         let torque_src = match torque_spec {
             TorqueSpec::Zero => TorqueSource::Zero,
             TorqueSpec::Table(times, values) => guard(|| TorqueSource::table(times, values, nv, hold))?,
             TorqueSpec::Callable(f) => TorqueSource::Function(state_fn(py, f, stash.clone(), "the torque function")),
         };
-        let inputs = Inputs { torques: torque_src, controller: ctrl, prescription: presc, actuators: acts, timing };
+        let inputs = Inputs {
+            torques: torque_src,
+            controller: ctrl,
+            prescription: presc,
+            actuators: acts,
+            timing,
+            environment: env.as_ref(),
+        };
         let st = stash.clone();
         // Python code runs in the callbacks (GIL held): the hook checks for Ctrl-C itself (at most every
         // 20 ms), then calls the progress callback, whose explicit False stops the run.
@@ -285,6 +300,7 @@ pub fn simulate<'py>(
             _ => None,
         };
         let raised = &mut raised;
+        let (q0, v0, env) = (&q0, &v0, &env);
         py.detach(move || {
             let mut hook = signal_hook(raised);
             guard_raw(|| {
@@ -292,8 +308,8 @@ pub fn simulate<'py>(
                     Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
                     None => TorqueSource::Zero,
                 };
-                let inputs = Inputs { torques, actuators: acts, timing, ..Default::default() };
-                sim::simulate_with(&m, &q0, &v0, &opts, inputs, formulation, Some(&mut hook))
+                let inputs = Inputs { torques, actuators: acts, timing, environment: env.as_ref(), ..Default::default() };
+                sim::simulate_with(&m, q0, v0, &opts, inputs, formulation, Some(&mut hook))
             })
         })?
     };
@@ -312,7 +328,15 @@ pub fn simulate<'py>(
         }
         (Some(e), _) => Err(e),
         (None, Err(e)) => Err(crate::errors::to_py(e)),
-        (None, Ok(tr)) => traj_dict(py, &tr),
+        (None, Ok(tr)) => {
+            let d = traj_dict(py, &tr)?;
+            if let Some(e) = env.as_ref().filter(|e| e.orbit.is_some()) {
+                // the frame origin's inertial orbit at the recorded times (the propagation the run used)
+                let orbit = guard(|| freefloat_core::environment::reference_orbit(e, &m_after, &q0, &v0, &tr.t))?;
+                d.set_item("orbit", PyArray1::from_vec(py, orbit).reshape([tr.len(), 6])?)?;
+            }
+            Ok(d)
+        }
     }
 }
 

@@ -11,6 +11,7 @@ import click
 import numpy as np
 
 from .._core import InputError, Interrupted
+from ..environment import load_environment
 from ..simulation import simulate
 from ._common import load_model, out_paths, parse_vector, print_summary, summarize, torque_options, write_outputs
 
@@ -67,6 +68,13 @@ from ._common import load_model, out_paths, parse_vector, print_summary, summari
     help="Read --torques once per step and hold it (step), or at every Runge-Kutta stage (stage).",
 )
 @click.option(
+    "--environment",
+    "environment_file",
+    type=click.Path(exists=True, dir_okay=False),
+    help="A YAML file with an `environment:` block (orbit, gravity_gradient, j2, disturbance; or a scenario file "
+    "holding one): the robot then orbits a central body and feels its gravity gradient.",
+)
+@click.option(
     "--out",
     help="FILE.parquet or FILE.csv (plus FILE.results.json and FILE.png beside it), or a directory (gets "
     "trajectory.parquet, results.json, trajectory.png). Every file written is listed. After Ctrl-C the part "
@@ -95,6 +103,7 @@ def simulate_cmd(
     formulation,
     actuators_file,
     input_timing,
+    environment_file,
     out,
     max_memory,
 ):
@@ -111,6 +120,8 @@ def simulate_cmd(
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
     v = parse_vector(v0, m.nv, "--v0", np.zeros(m.nv))
     kw = torque_options(m, torques, amplitude)
+    if environment_file:
+        kw["environment"] = load_environment(environment_file)
     if actuators_file:
         kw["actuators"] = read_actuators(actuators_file)
     if out:

@@ -4,7 +4,7 @@
 
 use super::dual_quaternion::DualQuat;
 use super::inertia::DualInertia;
-use crate::spatial::V3;
+use crate::spatial::{M3, V3};
 
 /// Earth's gravitational parameter μ [km³/s²] (the thesis, after (2.62)).
 pub const MU_EARTH: f64 = 398600.4418;
@@ -22,8 +22,29 @@ pub fn gravity(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
 /// Gravity gradient, the thesis' "new" form (2.67): `3μ/‖r‖⁵ (r̂)^s × (M ⋆ r̂)` with `r̂ = 0 + ε r`.
 /// Equals `0 + ε 3μ r × (Ī r)/‖r‖⁵` (2.63).
 pub fn gravity_gradient(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
+    gravity_gradient_of(&m.i_com(), r_b, mu)
+}
+
+/// (2.67) from the inertia about the CoM alone: `M ⋆ r̂` with `r̂ = 0 + ε r` only reads the `Ī` block of `M`
+/// (`M ⋆ r̂ = 0 + ε Ī r`), so the mass (and an invertible `Ī`, which `DualInertia` demands) is not needed. The
+/// simulator uses this form for every body, including point masses and thin rods.
+pub fn gravity_gradient_of(i_com: &M3, r_b: &V3, mu: f64) -> DualQuat {
     let rd = DualQuat::vector(&V3::zeros(), r_b);
-    rd.swap().cross(&m.apply(&rd)).scale(3.0 * mu / r_b.norm().powi(5))
+    let m_rd = DualQuat::vector(&V3::zeros(), &(i_com * r_b));
+    rd.swap().cross(&m_rd).scale(3.0 * mu / r_b.norm().powi(5))
+}
+
+/// Differential point-mass gravity `g(R + r) − g(R)`, `g(x) = −μ x/‖x‖³` (2.62), for a point at `r` from a
+/// reference point at `R` (both inertial axes): the tidal acceleration of a body relative to a free-falling
+/// frame origin. Formed without the cancellation of the plain difference (which loses ‖R‖/‖r‖ ≈ 1e7 of the
+/// ≈1e-5 m/s² result at low Earth orbit): with `d = R + r` and `x = (2R·r + r·r)/‖R‖²`,
+/// `g(d) − g(R) = −μ/‖d‖³ [r − R x(3 + 3x + x²)/(1 + (1 + x)^{3/2})]`, since `1 − (1 + x)^{3/2} =
+/// −x(3 + 3x + x²)/(1 + (1 + x)^{3/2})` (Battin 1999, §8.4, the same device as his f(q)).
+pub fn tidal_acceleration(big_r: &V3, r: &V3, mu: f64) -> V3 {
+    let d = big_r + r;
+    let x = (2.0 * big_r.dot(r) + r.norm_squared()) / big_r.norm_squared();
+    let s = x * (3.0 + x * (3.0 + x)) / (1.0 + (1.0 + x) * (1.0 + x).sqrt());
+    -(r - big_r * s) * (mu / d.norm().powi(3))
 }
 
 /// Gravity gradient, the "old" form of [50] (2.68): `3μ/‖r‖⁵ r̂ × (M ⋆ r̂^s)` with `r̂ = r + ε0`.

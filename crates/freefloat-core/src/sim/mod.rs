@@ -21,8 +21,10 @@ use crate::config::{
 };
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
+use crate::environment::{EnvWorkspace, Environment};
 use crate::error::{check_vec, FfError, Partial, Result};
 use crate::interrupt::Poller;
+use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
 use tableau::{Tableau, DOPRI5, RK4};
 
@@ -80,6 +82,8 @@ pub struct Inputs<'a> {
     pub actuators: Option<Actuators>,
     /// When the torque source is read within a step (default: once per step, held).
     pub timing: InputTiming,
+    /// The orbital environment (gravity gradient, J2, disturbance); `None` or all off: no external forces.
+    pub environment: Option<&'a Environment>,
 }
 
 impl Default for Inputs<'_> {
@@ -90,6 +94,7 @@ impl Default for Inputs<'_> {
             prescription: None,
             actuators: None,
             timing: InputTiming::PerStep,
+            environment: None,
         }
     }
 }
@@ -156,6 +161,8 @@ struct Stepper<'m, 'i> {
     mag0: Vec<f64>,
     mag1: Vec<f64>,
     evals: usize,
+    /// The environment's workspace; its `fext` holds the per-body external wrenches of the current stage.
+    env: Option<EnvWorkspace>,
 }
 
 /// Result of one derivative evaluation at a stage.
@@ -204,6 +211,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
             mag0: vec![0.0; m.nv],
             mag1: vec![0.0; m.nv],
             evals: 0,
+            env: None,
         })
     }
 
@@ -240,10 +248,25 @@ impl<'m, 'i> Stepper<'m, 'i> {
         if let Some(vm) = self.var_model.as_mut() {
             self.act.deplete(vm, &self.mps);
         }
-        let fext = if self.act.uses_fext { Some(&self.fext[..]) } else { None };
+        let ma: &Model = self.var_model.as_ref().unwrap_or(m);
+        // The environment's per-body wrenches at this stage (they need the placements: one extra forward
+        // pass), added to the actuators' external wrenches; both in ABA's `fext` convention.
+        let mut any_fext = self.act.uses_fext;
+        if let (Some(ws), Some(env)) = (self.env.as_mut(), self.inputs.environment) {
+            forward_kinematics_unchecked(ma, &mut self.d, &qs);
+            ws.eval(env, ma, &self.d, t);
+            if any_fext {
+                for (a, b) in self.fext.iter_mut().zip(&ws.fext) {
+                    *a += b;
+                }
+            } else {
+                self.fext.copy_from_slice(&ws.fext);
+            }
+            any_fext = true;
+        }
+        let fext = if any_fext { Some(&self.fext[..]) } else { None };
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
-        let ma: &Model = self.var_model.as_ref().unwrap_or(m);
         match self.formulation {
             Formulation::Aba => hybrid_aba_unchecked(ma, &mut self.d, &qs, &vs, &self.tau, fext, presc)?,
             Formulation::DualQuaternion => {
@@ -455,6 +478,9 @@ pub fn simulate_with(
             "formulation",
             "thrusters and wheel imbalance need formulation 'aba' (the work of external wrenches is formed from ABA's twists)",
         ));
+    }
+    if let Some(env) = st.inputs.environment.filter(|e| !e.is_off()) {
+        st.env = Some(env.workspace(m, &mut st.d, &q0, v0)?);
     }
     let (mut q, mut v) = (q0, v0.to_vec());
     let (mut q1, mut v1) = (vec![0.0; m.nq], vec![0.0; m.nv]);

@@ -1,0 +1,301 @@
+//! The orbital environment of a simulation: point-mass gravity of a central body with the orbit of the
+//! system, the gravity gradient on every body, J2, and a constant disturbance wrench (Valverde 2018, §2.3.3,
+//! (2.61)–(2.68)). Everything is off by default, and an `Environment` that is all off changes nothing: the
+//! simulator then passes no external forces at all, as before.
+//!
+//! **Frame.** The simulator's world frame keeps inertial axes but its origin translates with a free-falling
+//! reference point: the reference point P moves on the given orbit of the system's centre of mass
+//! (`orbit::Propagator`) and the frame origin is `O = P − c0 − ċ0 t`, c0 and ċ0 the CoM's local position and
+//! velocity at t = 0 (O is P when the CoM starts at rest at the local origin). Positions in `q` stay metres, not
+//! 7e6 m, so millimetre arm motion keeps its digits. O accelerates with `g(R)`, R = P, so every body in this
+//! frame feels its gravity minus `m g(R)`: the differential (tidal) gravity `m [g(R + r) − g(R)]` (r: the
+//! body's CoM relative to P) on its centre of mass (`gravity_gradient`, with J2's differential part in `j2`), and
+//! the gravity-gradient torque about it. This is exact (no linearisation: O's acceleration is exactly g(P)), so the system
+//! CoM leaves c0 + ċ0 t only by the tiny net tidal force (second order in size/radius). A local point x is inertially
+//! at `O(t) + x`. Inertial rather than LVLH axes: no fictitious Coriolis or centrifugal forces on
+//! every body, the momentum the simulator records keeps its meaning, and the free-flyer `q` stays Pinocchio's.
+
+pub mod disturbance;
+pub mod gravity_gradient;
+pub mod j2;
+pub mod orbit;
+
+pub use disturbance::{Axes, Disturbance};
+pub use orbit::{CentralBody, Elements, Orbit, Propagator, ReferenceState};
+
+use crate::data::Data;
+use crate::error::{check_vec, FfError, Result};
+use crate::kinematics::forward_kinematics_unchecked;
+use crate::model::Model;
+use crate::spatial::{Force, M3, V3};
+
+/// What acts on the system from outside. `Default` is all off.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Environment {
+    /// The central body and the orbit of the system's centre of mass at t = 0. Without it there is no gravity
+    /// field (and neither gravity gradient nor J2).
+    pub orbit: Option<Orbit>,
+    /// Apply the tidal force and the gravity-gradient torque to every body.
+    pub gravity_gradient: bool,
+    /// Add J2 to the orbit of the frame origin and its differential part to every body.
+    pub j2: bool,
+    /// A constant wrench on one body.
+    pub disturbance: Option<Disturbance>,
+}
+
+impl Environment {
+    /// Nothing acts: the simulator skips the environment entirely.
+    pub fn is_off(&self) -> bool {
+        self.orbit.is_none() && self.disturbance.is_none()
+    }
+
+    /// Checks the environment against the model it will act on.
+    pub fn check(&self, m: &Model) -> Result<()> {
+        if let Some(o) = &self.orbit {
+            o.central.check()?;
+            // `Orbit::new` checked the orbit when it was made; its fields are public, so check it again.
+            Orbit::new(o.central, o.position, o.velocity)?;
+            if m.gravity.norm() != 0.0 {
+                return Err(FfError::arg(
+                    "environment.orbit",
+                    format!(
+                        "the model has a uniform gravity {:?} m/s²; an orbit gives its own gravity field, so set the \
+                         model's gravity to zero",
+                        m.gravity.as_slice()
+                    ),
+                ));
+            }
+        } else if self.gravity_gradient || self.j2 {
+            let what = if self.j2 { "j2" } else { "gravity_gradient" };
+            return Err(FfError::arg(
+                &format!("environment.{what}"),
+                "needs an orbit (the central body and the system's orbit)",
+            ));
+        }
+        if let Some(dist) = &self.disturbance {
+            dist.check(m.nbodies())?;
+        }
+        Ok(())
+    }
+
+    /// The workspace of one simulation from (q0, v0): the reference point starts on the given orbit of the
+    /// system's centre of mass, the frame origin at `P − c0` (checked).
+    pub fn workspace(&self, m: &Model, d: &mut Data, q0: &[f64], v0: &[f64]) -> Result<EnvWorkspace> {
+        self.check(m)?;
+        check_vec("q0", q0, m.nq)?;
+        check_vec("v0", v0, m.nv)?;
+        let prop = match &self.orbit {
+            None => None,
+            Some(o) => {
+                let h = crate::kinematics::momentum(m, d, q0, v0)?;
+                let c = crate::kinematics::center_of_mass(m, d, q0)?;
+                // The reference point P follows the given orbit of the system's CoM; the frame origin O is
+                // P − c0 − ċ0 t (c0, ċ0: the CoM's local position and velocity at t = 0), which accelerates with
+                // P, g(P): a body at local r is at P + (r − c0 − ċ0 t) and feels the tidal gravity of that
+                // offset. The CoM then stays at c0 + ċ0 t locally, to second order in size/radius.
+                Some((Propagator::new(o.central, o.position, o.velocity, self.j2), c, h.lin / m.total_mass()))
+            }
+        };
+        let n = m.nbodies();
+        let (prop, c0, cdot0) = match prop {
+            Some((p, c, cd)) => (Some(p), c, cd),
+            None => (None, V3::zeros(), V3::zeros()),
+        };
+        Ok(EnvWorkspace {
+            prop,
+            c0,
+            cdot0,
+            fext: vec![0.0; 6 * n],
+            com: m.inertias.iter().map(|i| i.com()).collect(),
+            i_com: m.inertias.iter().map(|i| i.i_com()).collect(),
+        })
+    }
+}
+
+/// Per-simulation buffers of the environment: the orbit propagator, the per-body external wrenches handed to
+/// the dynamics (`fext`: body frame, about the body origin, `[force; torque]` per body), and each body's CoM and
+/// inertia about it.
+#[derive(Clone, Debug)]
+pub struct EnvWorkspace {
+    prop: Option<Propagator>,
+    c0: V3,
+    cdot0: V3,
+    /// Per-body external wrenches of the last `eval` (6 per body).
+    pub fext: Vec<f64>,
+    com: Vec<V3>,
+    i_com: Vec<M3>,
+}
+
+impl EnvWorkspace {
+    /// The reference point's inertial state at time t: the orbit of the system's CoM (None without an orbit).
+    pub fn reference(&mut self, t: f64) -> Option<ReferenceState> {
+        self.prop.as_mut().map(|p| p.state(t))
+    }
+
+    /// The frame origin's inertial state at time t, `P − c0 − ċ0 t` (None without an orbit).
+    pub fn origin(&mut self, t: f64) -> Option<ReferenceState> {
+        let (c0, cd) = (self.c0, self.cdot0);
+        self.reference(t).map(|s| ReferenceState { position: s.position - c0 - cd * t, velocity: s.velocity - cd })
+    }
+
+    /// Fills `self.fext` for time t from the placements in `d` (forward kinematics done). Each body's dual
+    /// force about its CoM in body axes, `f + ετ` (2.39), is the sum of the effects, then moves to the body
+    /// origin by (2.40), `f + ε(τ + c × f)` with `c` the CoM in body axes.
+    pub fn eval(&mut self, env: &Environment, m: &Model, d: &Data, t: f64) {
+        let refst = self.reference(t);
+        self.fext.fill(0.0);
+        for i in 0..m.nbodies() {
+            let mass = m.inertias[i].mass;
+            let x = &d.o_mi[i];
+            let mut w = crate::dualquat::DualQuat::vector(&V3::zeros(), &V3::zeros());
+            let mut any = false;
+            if let (Some(o), Some(rs)) = (&env.orbit, &refst) {
+                if mass > 0.0 {
+                    // the body's CoM relative to the reference point P
+                    let r = x.act_point(&self.com[i]) - self.c0 - self.cdot0 * t;
+                    if env.gravity_gradient {
+                        w = w + gravity_gradient::wrench(&x.rot, &rs.position, &r, mass, &self.i_com[i], o.central.mu);
+                        any = true;
+                    }
+                    if env.j2 {
+                        w = w + j2::wrench(&x.rot, &rs.position, &r, mass, &o.central);
+                        any = true;
+                    }
+                }
+            }
+            if let Some(dist) = env.disturbance.as_ref().filter(|dd| dd.body == i) {
+                w = w + dist.wrench(&x.rot);
+                any = true;
+            }
+            if any {
+                let (f, tau) = (w.r.v, w.d.v + self.com[i].cross(&w.r.v));
+                self.fext[6 * i..6 * i + 3].copy_from_slice(f.as_slice());
+                self.fext[6 * i + 3..6 * i + 6].copy_from_slice(tau.as_slice());
+            }
+        }
+    }
+
+    /// Total external wrench of the last `eval` about the frame origin, inertial axes (`d` as in `eval`).
+    pub fn total_wrench(&self, m: &Model, d: &Data) -> Force {
+        let mut tot = Force::ZERO;
+        for i in 0..m.nbodies() {
+            tot += d.o_mi[i].act_force(&Force::from_slice(&self.fext[6 * i..6 * i + 6]));
+        }
+        tot
+    }
+}
+
+/// The frame origin O's inertial state `[position (3), velocity (3)]` at each of `times` for a simulation that
+/// starts at (q0, v0): the same propagation the simulator uses, so the system's inertial position at a recorded
+/// sample is this position plus the local one.
+pub fn reference_orbit(env: &Environment, m: &Model, q0: &[f64], v0: &[f64], times: &[f64]) -> Result<Vec<f64>> {
+    let mut d = Data::new(m);
+    let mut ws = env.workspace(m, &mut d, q0, v0)?;
+    if ws.prop.is_none() {
+        return Err(FfError::arg("environment.orbit", "the environment has no orbit"));
+    }
+    check_times(times)?;
+    let mut out = Vec::with_capacity(6 * times.len());
+    for &t in times {
+        let s = ws.origin(t).expect("checked above");
+        out.extend_from_slice(s.position.as_slice());
+        out.extend_from_slice(s.velocity.as_slice());
+    }
+    Ok(out)
+}
+
+/// The environment's total external wrench `[force (3), moment about the frame origin (3)]`, inertial axes,
+/// at each sample `(times[k], qs[k])` of a simulation that started at (q0, v0): what the simulator applied there.
+pub fn external_wrenches(
+    env: &Environment,
+    m: &Model,
+    q0: &[f64],
+    v0: &[f64],
+    times: &[f64],
+    qs: &[f64],
+) -> Result<Vec<f64>> {
+    let mut d = Data::new(m);
+    let mut ws = env.workspace(m, &mut d, q0, v0)?;
+    check_times(times)?;
+    if qs.len() != times.len() * m.nq {
+        return Err(FfError::arg(
+            "q",
+            format!("expected {} × {} configurations, got {} values", times.len(), m.nq, qs.len()),
+        ));
+    }
+    let mut out = Vec::with_capacity(6 * times.len());
+    let mut qbuf = Vec::new();
+    for (k, &t) in times.iter().enumerate() {
+        let q = m.checked_q(&qs[k * m.nq..(k + 1) * m.nq], &mut qbuf)?;
+        forward_kinematics_unchecked(m, &mut d, q);
+        ws.eval(env, m, &d, t);
+        let w = ws.total_wrench(m, &d);
+        out.extend_from_slice(w.lin.as_slice());
+        out.extend_from_slice(w.ang.as_slice());
+    }
+    Ok(out)
+}
+
+fn check_times(times: &[f64]) -> Result<()> {
+    if let Some(k) = times.iter().position(|t| !(t.is_finite() && *t >= 0.0)) {
+        return Err(FfError::arg("times", format!("entry {k} is not a finite time ≥ 0")));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::dualquat::orbital::tidal_acceleration;
+
+    #[test]
+    fn tidal_acceleration_is_the_difference_of_gravities_without_its_cancellation() {
+        let mu = CentralBody::EARTH.mu;
+        // near the centre the plain difference keeps its digits: both agree to round-off
+        let (big_r, r) = (V3::new(3.0, -4.0, 12.0), V3::new(0.3, 0.2, -0.1));
+        let g = |x: &V3| -x * (mu / x.norm().powi(3));
+        let plain = g(&(big_r + r)) - g(&big_r);
+        assert!((tidal_acceleration(&big_r, &r, mu) - plain).norm() < 1e-13 * plain.norm());
+        // at 7000 km: the first-order tidal tensor (μ/R³)(3 R̂R̂ᵀ − I) r, to O(‖r‖/‖R‖)
+        let (big_r, r) = (V3::new(4.0e6, -3.0e6, 5.0e6), V3::new(0.5, -1.0, 2.0));
+        let rh = big_r.normalize();
+        let lin = (rh * (3.0 * rh.dot(&r)) - r) * (mu / big_r.norm().powi(3));
+        let t = tidal_acceleration(&big_r, &r, mu);
+        assert!((t - lin).norm() < 1e-5 * lin.norm(), "{t} vs {lin}");
+    }
+
+    #[test]
+    fn kepler_closed_form_matches_the_rk4_grid_without_j2() {
+        let c = CentralBody { j2: 0.0, ..CentralBody::EARTH };
+        let el = Elements { a: 7.2e6, e: 0.05, i: 0.5, raan: 0.2, argp: 0.7, nu: 1.0 };
+        let o = Orbit::from_elements(c, &el).unwrap();
+        let mut grid = Propagator::new(c, o.position, o.velocity, true);
+        let mut closed = Propagator::new(c, o.position, o.velocity, false);
+        for k in 0..=10 {
+            let t = o.period() * k as f64 / 10.0 + 0.37;
+            let (a, b) = (grid.state(t), closed.state(t));
+            assert!((a.position - b.position).norm() < 1e-4, "t = {t}: {}", (a.position - b.position).norm());
+            assert!((a.velocity - b.velocity).norm() < 1e-7);
+        }
+        // an earlier time after a later one (an RK45 rejection) gives the same answer as in order
+        let later = grid.state(3000.5);
+        let earlier = grid.state(1000.25);
+        let mut fresh = Propagator::new(c, o.position, o.velocity, true);
+        assert_eq!(fresh.state(1000.25), earlier);
+        assert_eq!(fresh.state(3000.5), later);
+        // a whole period later the closed form is back where it started
+        let p = closed.state(o.period());
+        assert!((p.position - o.position).norm() < 1e-7, "{}", (p.position - o.position).norm());
+    }
+
+    #[test]
+    fn orbits_below_the_surface_and_bad_constants_are_refused() {
+        let c = CentralBody::EARTH;
+        let low = Elements { a: 6.5e6, e: 0.1, i: 0.0, raan: 0.0, argp: 0.0, nu: 0.0 };
+        assert!(Orbit::from_elements(c, &low).unwrap_err().to_string().contains("semi_major_axis"));
+        let bad = CentralBody { mu: -1.0, ..c };
+        assert!(bad.check().unwrap_err().to_string().contains("mu"));
+        let esc = Orbit::new(c, V3::new(7e6, 0.0, 0.0), V3::new(0.0, 2e4, 0.0));
+        assert!(esc.unwrap_err().to_string().contains("bound"));
+    }
+}
