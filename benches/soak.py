@@ -106,8 +106,8 @@ def main(argv=None) -> dict:
         series["residual"].append(float(np.max(res)))
         if not a.quick and chunks % 20 == 0:
             print(
-                f"  {series['wall_s'][-1] / 60:5.1f} min, {t0_sim:7.0f} s simulated, RSS {series['rss_mb'][-1]:6.1f} MB, "
-                f"drift {dp:.1e} / {dl:.1e}, residual {series['residual'][-1]:.1e}",
+                f"  {series['wall_s'][-1] / 60:5.1f} min, {t0_sim:7.0f} s simulated, "
+                f"RSS {series['rss_mb'][-1]:6.1f} MB, drift {dp:.1e} / {dl:.1e}, residual {series['residual'][-1]:.1e}",
                 flush=True,
             )
 

@@ -15,10 +15,11 @@ import numpy as np
 import pytest
 
 import freefloat as ff
+from freefloat.io import data as ffdata
 
-PC = ff.data.read_text("scenarios", "zhang2020_2d_medium")
-CL = ff.data.read_text("scenarios", "valverde_ch9_two_arm")
-AD = ff.data.read_text("scenarios", "valverde_ch4_example_a")
+PC = ffdata.read_text("scenarios", "zhang2020_2d_medium")
+CL = ffdata.read_text("scenarios", "valverde_ch9_two_arm")
+AD = ffdata.read_text("scenarios", "valverde_ch4_example_a")
 
 
 def run(*args, cwd=None, timeout=120):
@@ -167,8 +168,8 @@ def test_every_command_refuses_bad_input_without_a_traceback(tmp_path):
         ("control", "adaptive", str(binary)),
         ("control", "ddp", str(binary)),
         ("control", "ddp", "no_such_scenario"),
-        ("campaign", str(binary)),
-        ("campaign", missing),
+        ("campaign", str(binary), "--out", str(tmp_path / "c1")),
+        ("campaign", missing, "--out", str(tmp_path / "c2")),
         ("convert", missing, "--from", "mujoco", "--model", "zhang2020_2d_medium"),
         ("report", str(tmp_path)),
     ]
@@ -188,7 +189,9 @@ def test_bad_model_file_names_key_and_closest(tmp_path):
 def test_campaign_spec_unknown_key(tmp_path):
     f = tmp_path / "c.yaml"
     f.write_text("name: c\nkind: postcapture\nscenario: zhang2020_2d_medium\ngird:\n  duration: [1.0]\n")
-    refused(run("campaign", str(f)), "did you mean 'grid'?")
+    refused(run("campaign", str(f), "--out", str(tmp_path / "o")), "did you mean 'grid'?", "line 4")
+    f.write_text("name: c\nkind: postcapture\nscenario: zhang2020_2d_medium\ngrid:\n  duration: [60.0, ten]\n")
+    refused(run("campaign", str(f), "--out", str(tmp_path / "o")), "grid 'duration' = 'ten'", "expected a number")
 
 
 def test_debug_shows_the_traceback(tmp_path):

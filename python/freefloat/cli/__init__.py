@@ -12,7 +12,6 @@ import sys
 
 import click
 
-from .. import _core
 from . import (
     _common,
     adaptive,

@@ -19,7 +19,7 @@ from pathlib import Path
 import yaml
 
 from .._core import InputError
-from . import data, schema, scenario_schemas  # noqa: F401  (scenario_schemas declares the kinds)
+from . import data, scenario_schemas, schema  # noqa: F401  (scenario_schemas declares the kinds)
 
 #: kind -> the command that runs scenarios of that kind
 KINDS = {
@@ -55,7 +55,9 @@ def _parse_yaml(text: str, source: str, check: bool = True) -> dict:
         problem = getattr(e, "problem", None) or str(e)
         raise InputError(f"{source}:{where}: not valid YAML ({problem})") from None
     if d is None:
-        raise InputError(f"{source}: the file is empty (a scenario file is a YAML mapping of keys: model, duration, ...)")
+        raise InputError(
+            f"{source}: the file is empty (a scenario file is a YAML mapping of keys: model, duration, ...)"
+        )
     if not isinstance(d, dict):
         raise InputError(f"{source}: a scenario file must be a YAML mapping of keys, got {type(d).__name__}")
     bad = [k for k in d if not isinstance(k, str)]

@@ -11,6 +11,7 @@ from __future__ import annotations
 from pydantic import model_validator
 
 from .schema import (
+    _TYPES_ONLY,
     Anything,
     Block,
     Bool,
@@ -20,8 +21,8 @@ from .schema import (
     Text,
     _Bad,
     integer,
-    number,
     literal,
+    number,
     numbers,
     register_kind,
 )
@@ -118,6 +119,8 @@ class Postcapture(_Scenario):
 
     @model_validator(mode="after")
     def _timing(self):
+        if _TYPES_ONLY.get():
+            return self
         ratio = self.sample_period / self.dt
         if round(ratio) < 2 or abs(ratio - round(ratio)) > 1e-6 * ratio or round(ratio) % 2:
             raise _Bad(

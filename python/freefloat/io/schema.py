@@ -25,6 +25,8 @@ after which every file of those kinds may have that block, checked like the rest
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import difflib
 import math
 import re
@@ -82,8 +84,24 @@ def _number(x, what: str = "a number") -> float:
     return float(x)
 
 
+# types_only(): ranges (and checks across keys) are not enforced — a campaign checks its grid values' types up
+# front and lets a value out of range fail its own run, which the campaign records as that run's error
+_TYPES_ONLY = contextvars.ContextVar("freefloat_schema_types_only", default=False)
+
+
+@contextlib.contextmanager
+def types_only():
+    tok = _TYPES_ONLY.set(True)
+    try:
+        yield
+    finally:
+        _TYPES_ONLY.reset(tok)
+
+
 def _range(lo=None, hi=None, lo_open=False, hi_open=False):
     def check(x: float) -> float:
+        if _TYPES_ONLY.get():
+            return x
         if lo is not None and (x <= lo if lo_open else x < lo):
             raise _Bad(f"must be {'>' if lo_open else '>='} {lo:g}, got {x:g}")
         if hi is not None and (x >= hi if hi_open else x > hi):
@@ -278,10 +296,9 @@ def _message(kind: str, d: dict, err: dict, source: str, root) -> str:
         key = path[-1]
         valid = fields_of(kind, path[:-1])
         close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
-        inside = f" in '{_dotted(path[:-1])}'" if path[:-1] else ""
         if close:
-            return f"{source}:{line} unknown key '{key}'{inside} (did you mean '{close[0]}'?)"
-        return f"{source}:{line} unknown key '{key}'{inside}; valid keys here: {', '.join(valid)}"
+            return f"{source}:{line} unknown key '{_dotted(path)}' (did you mean '{close[0]}'?)"
+        return f"{source}:{line} unknown key '{_dotted(path)}'; valid keys here: {', '.join(valid)}"
     if typ == "missing":
         return f"{source}:{line} missing key '{_dotted(path)}'"
     msg = err["msg"]
