@@ -122,6 +122,18 @@ def _check_cl(out: Path) -> list[str]:
     return bad
 
 
+def _check_soak(out: Path) -> list[str]:
+    s = json.loads((out / "soak.json").read_text())["summary"]
+    bad = []
+    if not (s["drift_linear_rel_max"] < 1e-12 and s["drift_angular_rel_max"] < 1e-12):
+        bad.append(f"momentum drift above round-off: {s['drift_linear_rel_max']:.3g}, {s['drift_angular_rel_max']:.3g}")
+    if not s["rss_growth_after_warmup_mb"] < 50:
+        bad.append(f"resident memory grew by {s['rss_growth_after_warmup_mb']:.1f} MB")
+    if not (s["chunks"] >= 1 and s["rls_samples"] >= 100):
+        bad.append(f"too little work done: {s['chunks']} chunks, {s['rls_samples']} RLS samples")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -133,6 +145,7 @@ BENCHES = {
     "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
     "cl": ("cl_vs_numpy.py", [], (), _check_cl),
+    "soak": ("soak.py", [], (), _check_soak),
 }
 
 

@@ -333,7 +333,8 @@ def check(kind: str, d: dict, source: str, text: str | None = None) -> None:
                 root = yaml.compose(text, Loader=yaml.SafeLoader)
             except yaml.YAMLError:
                 root = None
-        errs = e.errors(include_url=False)
+        # a typo shows as an unknown key and a missing one: the unknown key (with its suggestion) is the news
+        errs = sorted(e.errors(include_url=False), key=lambda x: x["type"] != "extra_forbidden")
         first = _message(kind, d, errs[0], source, root)
         more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" if len(errs) > 1 else ""
         raise InputError(first + more) from None
