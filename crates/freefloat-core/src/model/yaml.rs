@@ -95,7 +95,8 @@ enum InertiaYaml {
     Full(InertiaMap),
 }
 
-const INERTIA_FORMS: &str = "the principal moments [Ixx, Iyy, Izz] or a mapping {xx, yy, zz, xy, xz, yz} (xy, xz, yz default to 0)";
+const INERTIA_FORMS: &str =
+    "the principal moments [Ixx, Iyy, Izz] or a mapping {xx, yy, zz, xy, xz, yz} (xy, xz, yz default to 0)";
 
 impl<'de> Deserialize<'de> for InertiaYaml {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
