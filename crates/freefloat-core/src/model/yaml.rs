@@ -394,6 +394,23 @@ fn edit_distance(a: &str, b: &str) -> usize {
     row[b.len()]
 }
 
+fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> std::result::Result<Se3, String> {
+    let xyz = V3::from(o.xyz.unwrap_or([0.0; 3]));
+    if let Some(q) = o.quat {
+        if o.rpy.is_some() {
+            return Err("give `rpy` or `quat`, not both".into());
+        }
+        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if !n.is_finite() || (n - 1.0).abs() > 1e-6 {
+            return Err(format!("`quat` [x, y, z, w] must be a unit quaternion, its norm is {n}"));
+        }
+        let u = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
+        return Ok(Se3::new(rot_from_quat(&u), xyz));
+    }
+    let rpy = o.rpy.map(|r| V3::new(ang(r[0]), ang(r[1]), ang(r[2]))).unwrap_or_else(V3::zeros);
+    Ok(Se3::new(rpy_to_rot(&rpy), xyz))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -428,21 +445,4 @@ mod tests {
         assert!(e.contains("unknown field `x_y` (did you mean `xy`?)"), "{e}");
         assert!(from_yaml_str(&BASE.replace("[1, 1, 1]", "{xx: 1, yy: 2, zz: 3, xy: 0.1}"), "t").is_ok());
     }
-}
-
-fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> std::result::Result<Se3, String> {
-    let xyz = V3::from(o.xyz.unwrap_or([0.0; 3]));
-    if let Some(q) = o.quat {
-        if o.rpy.is_some() {
-            return Err("give `rpy` or `quat`, not both".into());
-        }
-        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-        if !n.is_finite() || (n - 1.0).abs() > 1e-6 {
-            return Err(format!("`quat` [x, y, z, w] must be a unit quaternion, its norm is {n}"));
-        }
-        let u = [q[0] / n, q[1] / n, q[2] / n, q[3] / n];
-        return Ok(Se3::new(rot_from_quat(&u), xyz));
-    }
-    let rpy = o.rpy.map(|r| V3::new(ang(r[0]), ang(r[1]), ang(r[2]))).unwrap_or_else(V3::zeros);
-    Ok(Se3::new(rpy_to_rot(&rpy), xyz))
 }
