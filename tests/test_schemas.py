@@ -123,7 +123,8 @@ def test_other_kinds_have_schemas_too():
 
 def test_campaign_files_are_checked_with_lines(tmp_path):
     f = tmp_path / "c.yaml"
-    f.write_text("name: c\nkind: postcapture\nscenario: zhang2020_2d_medium\ngrid:\n  duration: [1.0]\nmonte_carlo:\n  rnus: 3\n")
+    head = "name: c\nkind: postcapture\nscenario: zhang2020_2d_medium\n"
+    f.write_text(head + "grid:\n  duration: [1.0]\nmonte_carlo:\n  rnus: 3\n")
     with pytest.raises(InputError, match=r"c.yaml: line 7: unknown key 'monte_carlo.rnus' \(did you mean 'runs'"):
         campaign_spec.load(f)
     f.write_text("name: c\nkind: postcapture\nscenario: zhang2020_2d_medium\ngrid:\n  duration: [1.0, ten]\n")
