@@ -1,8 +1,8 @@
 """A short coverage-guided fuzzing run (atheris) of the four readers: every mutated YAML or URDF model, telemetry
 CSV file or post-capture scenario file is either accepted or refused with one of freefloat's errors; a Python
 traceback, a Rust panic or a crash fails the run, and libFuzzer writes the input that caused it (its path is in
-the failure message). The long run is `sh fuzz/long_run.sh` (docs/reliability.md). The scenario and telemetry readers run slower (a scenario loads its
-robot; telemetry goes through a file), so their short runs are shorter."""
+the failure message). The long run is `sh fuzz/long_run.sh` (docs/reliability.md). The scenario and telemetry
+readers run slower (a scenario loads its robot; telemetry goes through a file), so their short runs are shorter."""
 
 import subprocess
 import sys
