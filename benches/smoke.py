@@ -171,6 +171,18 @@ def _check_environment(out: Path) -> list[str]:
     return bad
 
 
+def _check_soak(out: Path) -> list[str]:
+    s = json.loads((out / "soak.json").read_text())["summary"]
+    bad = []
+    if not (s["drift_linear_rel_max"] < 1e-12 and s["drift_angular_rel_max"] < 1e-12):
+        bad.append(f"momentum drift above round-off: {s['drift_linear_rel_max']:.3g}, {s['drift_angular_rel_max']:.3g}")
+    if not s["rss_growth_after_warmup_mb"] < 50:
+        bad.append(f"resident memory grew by {s['rss_growth_after_warmup_mb']:.1f} MB")
+    if not (s["chunks"] >= 1 and s["rls_samples"] >= 100):
+        bad.append(f"too little work done: {s['chunks']} chunks, {s['rls_samples']} RLS samples")
+    return bad
+
+
 #: name -> (script, extra arguments, modules it needs, check of its output)
 BENCHES = {
     "compare": ("compare_pinocchio.py", [], ("pinocchio", "crocoddyl"), _check_compare_pinocchio),
@@ -187,6 +199,7 @@ BENCHES = {
     "mujoco": ("sim_vs_mujoco.py", [], ("mujoco",), _check_sim_vs_mujoco),
     "basilisk_wheels": ("basilisk_wheels.py", [], ("Basilisk",), _check_basilisk_wheels),
     "environment": ("environment_bench.py", [], (), _check_environment),
+    "soak": ("soak.py", [], (), _check_soak),
 }
 
 

@@ -7,6 +7,7 @@ process (abort, segfault), which libFuzzer reports with the input that caused it
     python fuzz/readers.py TARGET [libFuzzer options]       # TARGET: yaml_model, urdf_model, telemetry, scenario
     python fuzz/readers.py yaml_model -runs=20000            # a short run (the test suite does this)
     python fuzz/readers.py urdf_model -max_total_time=3600   # the long run (see docs/reliability.md)
+    FREEFLOAT_FUZZ_FINDINGS=findings/ python fuzz/readers.py scenario -max_total_time=900   # keep going on findings
 
 The seed corpus is built from the built-in robots (their YAML, their URDF export), a telemetry file of a short
 simulation and the built-in scenarios, written to `fuzz/corpus/TARGET/` (or `$FREEFLOAT_FUZZ_CORPUS/TARGET/`) on
@@ -102,17 +103,46 @@ def _seed_corpus(target: str) -> Path:
     return out
 
 
+def _record(findings: str, target: str, e: Exception, data: bytes, seen: set[str]) -> None:
+    """Keep-going mode (the long run): write each distinct finding once (exception type and the innermost frame
+    of the freefloat package, or the innermost frame) to FREEFLOAT_FUZZ_FINDINGS/TARGET/ and go on fuzzing, so
+    one known finding does not end an hour's run. A Rust panic or a process crash still stops libFuzzer."""
+    import hashlib
+    import traceback
+
+    frames = traceback.extract_tb(e.__traceback__)
+    own = [f for f in frames if "freefloat" in f.filename] or frames
+    where = f"{Path(own[-1].filename).name}:{own[-1].lineno}" if own else "?"
+    sig = f"{type(e).__name__} at {where}"
+    if sig in seen:
+        return
+    seen.add(sig)
+    out = Path(findings) / target
+    out.mkdir(parents=True, exist_ok=True)
+    name = hashlib.sha1(sig.encode()).hexdigest()[:12]
+    (out / f"{name}.input").write_bytes(data)
+    (out / f"{name}.txt").write_text(f"{sig}\n{type(e).__name__}: {e}\n\n{''.join(traceback.format_exception(e))}")
+    print(f"FINDING {target}: {sig}: {str(e)[:200]}", file=sys.stderr, flush=True)
+
+
 def main(argv: list[str]) -> None:
     if len(argv) < 2 or argv[1] not in TARGETS:
         sys.exit(f"usage: python fuzz/readers.py TARGET [libFuzzer options]; TARGET one of {', '.join(TARGETS)}")
     target = argv[1]
     reader = globals()[target]
 
+    findings = os.environ.get("FREEFLOAT_FUZZ_FINDINGS")
+    seen: set[str] = set()
+
     def one_input(data: bytes) -> None:
         try:
             reader(data)
         except EXPECTED:
             pass
+        except Exception as e:  # a finding
+            if not findings:
+                raise  # libFuzzer stops and writes crash-<hash>
+            _record(findings, target, e, data, seen)
 
     corpus = _seed_corpus(target)
     atheris.Setup([argv[0], *argv[2:], str(corpus)], one_input)

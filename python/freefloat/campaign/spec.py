@@ -238,6 +238,7 @@ def parse(d: dict, source: str, base_dir: Path | None = None) -> CampaignSpec:
         mc = _parse_mc(mc, source, valid, kind.name)
     if not grid and mc is None:
         raise InputError(f"{source}: neither 'grid' nor 'monte_carlo': the campaign would have no runs to vary")
+    _check_values(kind.name, base, fixed, grid, source)
     spec = CampaignSpec(
         name=str(d["name"]),
         kind=kind.name,
@@ -252,6 +253,26 @@ def parse(d: dict, source: str, base_dir: Path | None = None) -> CampaignSpec:
         raw=d,
     )
     return spec
+
+
+def _check_values(kind: str, base: dict, fixed: dict, grid: dict, source: str) -> None:
+    """The base scenario with `set`, and with each grid value in turn, against the kind's declared schema
+    (io/scenario_schemas.py): a value of the wrong type (a typo: every run would fail) is refused before any run
+    starts; a value out of range is left to fail its own run, recorded as that run's error."""
+    from ..io import schema
+
+    if kind not in schema.kinds():
+        return
+    with schema.types_only():
+        sc = copy.deepcopy(base)
+        for p, v in fixed.items():
+            set_path(sc, str(p), copy.deepcopy(v))
+        schema.check(kind, sc, f"{source}: the scenario with 'set' applied")
+        for p, values in grid.items():
+            for v in values:
+                one = copy.deepcopy(sc)
+                set_path(one, str(p), copy.deepcopy(v))
+                schema.check(kind, one, f"{source}: grid '{p}' = {v!r}")
 
 
 def _parse_mc(mc, source, valid, kind) -> dict:
@@ -317,6 +338,10 @@ def load(spec: str | Path) -> CampaignSpec:
         mark = getattr(e, "problem_mark", None)
         where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         raise InputError(f"{source}:{where}: not valid YAML ({getattr(e, 'problem', None) or e})") from None
+    if isinstance(d, dict):  # the declared schema (io/scenario_schemas.py): unknown keys and types, with lines
+        from ..io import schema
+
+        schema.check("campaign", d, source, text)
     return parse(d, source, base_dir)
 
 

@@ -12,8 +12,8 @@ import sys
 
 import click
 
-from .. import _core
 from . import (
+    _common,
     adaptive,
     campaign,
     concurrent,
@@ -35,23 +35,39 @@ from . import (
 
 
 class FriendlyGroup(click.Group):
-    """Turn the engine's errors into one clear line instead of a traceback."""
+    """No Python traceback reaches a command-line user: every error becomes one line on stderr and a non-zero
+    exit code (`_common.report_error`); `freefloat --debug COMMAND ...` (or FREEFLOAT_DEBUG=1) shows the
+    traceback instead."""
 
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
-        except (_core.ModelError, _core.InputError, _core.NumericalError, FileNotFoundError) as e:
-            click.echo(f"error: {e}", err=True)
-            sys.exit(2)
+        except (click.exceptions.ClickException, click.exceptions.Exit, click.exceptions.Abort, SystemExit):
+            raise  # click's own usage errors and exits: already one clear line
+        except KeyboardInterrupt:
+            raise  # click reports "Aborted!" (commands that keep partial results handle Ctrl-C themselves)
+        except BaseException as e:  # noqa: BLE001  (a Rust panic arrives as pyo3's PanicException, a BaseException)
+            if _common.debug_enabled(ctx):
+                raise
+            sys.exit(_common.report_error(e))
 
 
 @click.group(cls=FriendlyGroup, context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="freefloat")
-def main():
+@click.option(
+    "--debug",
+    is_flag=True,
+    envvar="FREEFLOAT_DEBUG",
+    help="On an error, show the Python traceback instead of the one-line message (for a bug report).",
+)
+@click.pass_context
+def main(ctx, debug):
     """freefloat: model, simulate and identify free-floating space robots.
 
     Start with `freefloat demo`, list robots with `freefloat models`, and simulate one with
     `freefloat simulate naveen_dual_arm --out run.parquet`."""
+    ctx.ensure_object(dict)
+    ctx.obj["debug"] = debug
 
 
 main.add_command(models.models_cmd)

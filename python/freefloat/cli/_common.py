@@ -14,6 +14,8 @@ from ..model import Model
 
 __all__ = [
     "MODEL_HELP",
+    "debug_enabled",
+    "report_error",
     "load_model",
     "out_paths",
     "parse_vector",
@@ -26,6 +28,54 @@ __all__ = [
 ]
 
 MODEL_HELP = "a built-in robot name (see `freefloat models`) or a .yaml / .urdf / MJCF (.xml) file"
+
+
+def debug_enabled(ctx: click.Context | None = None) -> bool:
+    """Whether `--debug` (or FREEFLOAT_DEBUG=1) asked for tracebacks."""
+    import os
+
+    ctx = ctx or click.get_current_context(silent=True)
+    root = ctx.find_root() if ctx is not None else None
+    if root is not None and isinstance(root.obj, dict) and root.obj.get("debug"):
+        return True
+    return os.environ.get("FREEFLOAT_DEBUG", "").lower() in ("1", "true", "yes")
+
+
+def _where(e: BaseException) -> str:
+    """The innermost frame of freefloat's own code (file:line) where an unexpected exception came from."""
+    import traceback
+
+    frames = [f for f in traceback.extract_tb(e.__traceback__) if "freefloat" in f.filename]
+    if not frames:
+        return ""
+    f = frames[-1]
+    return f" in {Path(f.filename).name}:{f.lineno}"
+
+
+def report_error(e: BaseException) -> int:
+    """Print `e` as one line on stderr and return the exit code: 2 for a refused input (freefloat's errors, a
+    file that cannot be read), 3 for anything unexpected (a bug: the line says so and how to get the traceback)."""
+    from .. import _core
+
+    if isinstance(e, (_core.InputError, _core.ModelError, _core.NumericalError)):
+        msg, code = str(e), 2
+    elif isinstance(e, UnicodeDecodeError):
+        msg, code = f"not UTF-8 text (byte {e.start}: {e.reason}); save the file as UTF-8", 2
+    elif isinstance(e, OSError) and e.filename is not None:
+        msg, code = f"{e.filename}: {e.strerror or e}", 2
+    elif isinstance(e, MemoryError):
+        msg, code = "out of memory (the run or model is too large for this machine)", 2
+    else:
+        kind = type(e).__name__
+        text = str(e).strip().splitlines()[0] if str(e).strip() else ""
+        msg = (
+            f"internal error{_where(e)}: {kind}{': ' + text if text else ''} "
+            "(this is a bug in freefloat: please report it with the output of `freefloat --debug ...`)"
+        )
+        code = 3
+    msg = " ".join(line.strip() for line in msg.splitlines() if line.strip())  # one line, whatever the source
+    click.echo(f"error: {msg}", err=True)
+    return code
 
 
 def tqdm_bar(total: int, desc: str):

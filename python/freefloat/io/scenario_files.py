@@ -2,7 +2,8 @@
 
 Every scenario file has a `kind` (absent means `postcapture`, the first kind there was), and each kind belongs to
 one command. This module finds a scenario by built-in name or file path, parses it with errors that name the file
-and line, and checks it is of the kind the calling command runs; each command parses its own keys.
+and line, checks it against its kind's declared schema (`scenario_schemas.py`: unknown keys, types, ranges; errors name
+the file, line and key) and that it is of the kind the calling command runs; each command then reads its keys.
 
     from freefloat.io import scenario_files
     d, source = scenario_files.read("valverde_ch4_example_a", kind="control_adaptive")
@@ -11,13 +12,14 @@ and line, and checks it is of the kind the calling command runs; each command pa
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
 
 from .._core import InputError
-from . import data
+from . import data, scenario_schemas, schema  # noqa: F401  (scenario_schemas declares the kinds)
 
 #: kind -> the command that runs scenarios of that kind
 KINDS = {
@@ -42,19 +44,32 @@ class ScenarioEntry:
         return f"{KINDS[self.kind]} {self.name}"
 
 
-def _parse_yaml(text: str, source: str) -> dict:
+def _parse_yaml(text: str, source: str, check: bool = True) -> dict:
     try:
         d = yaml.safe_load(text)
+    except RecursionError:
+        raise InputError(f"{source}: nested too deeply to be a scenario file") from None
     except yaml.YAMLError as e:
         mark = getattr(e, "problem_mark", None)
         where = f" line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(e, "problem", None) or str(e)
         raise InputError(f"{source}:{where}: not valid YAML ({problem})") from None
+    if d is None:
+        raise InputError(
+            f"{source}: the file is empty (a scenario file is a YAML mapping of keys: model, duration, ...)"
+        )
     if not isinstance(d, dict):
         raise InputError(f"{source}: a scenario file must be a YAML mapping of keys, got {type(d).__name__}")
+    bad = [k for k in d if not isinstance(k, str)]
+    if bad:
+        raise InputError(f"{source}: key {bad[0]!r}: keys must be names (text), got {type(bad[0]).__name__}")
     kind = d.get("kind", DEFAULT_KIND)
-    if kind not in KINDS:
-        raise InputError(f"{source}: key 'kind': unknown scenario kind '{kind}' (one of: {', '.join(KINDS)})")
+    if not isinstance(kind, str) or kind not in KINDS:
+        close = difflib.get_close_matches(str(kind), KINDS, n=1)
+        hint = f" (did you mean '{close[0]}'?)" if close else ""
+        raise InputError(f"{source}: key 'kind': unknown scenario kind '{kind}'{hint} (one of: {', '.join(KINDS)})")
+    if check:
+        schema.check(kind, d, source, text)
     return d
 
 
@@ -88,7 +103,7 @@ def listing() -> list[ScenarioEntry]:
     """Every built-in scenario, sorted by kind (in the order of KINDS) and name."""
     out = []
     for name in data.names("scenarios"):
-        d = _parse_yaml(data.read_text("scenarios", name), f"built-in scenario '{name}'")
+        d = _parse_yaml(data.read_text("scenarios", name), f"built-in scenario '{name}'", check=False)
         out.append(ScenarioEntry(name, d.get("kind", DEFAULT_KIND), str(d.get("description", "")).strip()))
     order = list(KINDS)
     return sorted(out, key=lambda s: (order.index(s.kind), s.name))

@@ -165,7 +165,7 @@ def _read_rate_noise(p: Path):
             r = json.loads(meta.get(b"freefloat", b"{}")).get("rate_noise")
         else:
             r = None
-            with open(p) as f:
+            with open(p, encoding="utf-8-sig") as f:
                 for line in f:
                     if not line.startswith("#"):
                         break
@@ -188,11 +188,14 @@ def _read_parquet(p: Path) -> dict:
 
 
 def _read_csv(p: Path) -> dict:
-    lines = p.read_text().splitlines()
+    try:  # utf-8-sig: a byte-order mark (as spreadsheet programs write) is not part of the first column's name
+        lines = p.read_text(encoding="utf-8-sig").splitlines()
+    except UnicodeDecodeError as e:
+        raise InputError(f"{p}: not UTF-8 text (byte {e.start}: {e.reason}); save the CSV file as UTF-8") from None
     body = [(i, ln) for i, ln in enumerate(lines) if ln.strip() and not ln.lstrip().startswith("#")]
     if not body:
         raise InputError(f"{p}: empty CSV file (no header line)")
-    names = [c.strip() for c in body[0][1].split(",")]
+    names = [c.strip().strip('"') for c in body[0][1].split(",")]  # pyarrow and spreadsheets quote the names
     rows = []
     for r, (i, ln) in enumerate(body[1:]):
         fields = ln.split(",")

@@ -87,11 +87,45 @@ struct InertialYaml {
     params: Option<Vec<f64>>,
 }
 
-#[derive(Deserialize)]
-#[serde(untagged)]
+/// An inertia written either way the format allows. Deserialized by hand (not `#[serde(untagged)]`) so that a
+/// block of the wrong shape is answered with the key and the two accepted forms, instead of serde's "data did not
+/// match any variant of untagged enum", and a typo inside the mapping form is still an unknown-field error.
 enum InertiaYaml {
     Principal([f64; 3]),
     Full(InertiaMap),
+}
+
+const INERTIA_FORMS: &str =
+    "the principal moments [Ixx, Iyy, Izz] or a mapping {xx, yy, zz, xy, xz, yz} (xy, xz, yz default to 0)";
+
+impl<'de> Deserialize<'de> for InertiaYaml {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = InertiaYaml;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(INERTIA_FORMS)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(self, mut seq: A) -> std::result::Result<Self::Value, A::Error> {
+                let mut out = [0.0; 3];
+                for (i, x) in out.iter_mut().enumerate() {
+                    *x = seq.next_element()?.ok_or_else(|| {
+                        serde::de::Error::custom(format!("expected {INERTIA_FORMS}; the list has {i} entries"))
+                    })?;
+                }
+                if seq.next_element::<serde::de::IgnoredAny>()?.is_some() {
+                    return Err(serde::de::Error::custom(format!(
+                        "expected {INERTIA_FORMS}; the list has more than 3 entries"
+                    )));
+                }
+                Ok(InertiaYaml::Principal(out))
+            }
+            fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> std::result::Result<Self::Value, A::Error> {
+                InertiaMap::deserialize(serde::de::value::MapAccessDeserializer::new(map)).map(InertiaYaml::Full)
+            }
+        }
+        d.deserialize_any(V)
+    }
 }
 
 #[derive(Deserialize)]
@@ -130,7 +164,7 @@ pub fn from_yaml_str(text: &str, source_name: &str) -> Result<Model> {
     let spec: FileSpec = serde_norway::from_str(text).map_err(|e| FfError::ModelFile {
         source_name: source_name.to_string(),
         line: e.location().map(|l| l.line()),
-        msg: e.to_string(),
+        msg: with_suggestion(&e.to_string()),
     })?;
     Loader { text, source_name }.build(spec)
 }
@@ -322,6 +356,44 @@ impl Loader<'_> {
     }
 }
 
+/// serde's unknown-field message ("unknown field `mas`, expected one of `mass`, `com`") with the closest valid
+/// key named first: "unknown field `mas` (did you mean `mass`?), expected one of ...".
+fn with_suggestion(msg: &str) -> String {
+    let Some(start) = msg.find("unknown field `") else { return msg.to_string() };
+    let rest = &msg[start + "unknown field `".len()..];
+    let Some(end) = rest.find('`') else { return msg.to_string() };
+    let key = &rest[..end];
+    let valid: Vec<&str> = rest[end + 1..].split('`').skip(1).step_by(2).collect();
+    let best = valid
+        .iter()
+        .map(|v| (edit_distance(&key.to_lowercase(), &v.to_lowercase()), *v))
+        .filter(|(d, v)| *d <= (v.len().max(key.len()) / 3).max(1))
+        .min_by_key(|(d, _)| *d);
+    match best {
+        Some((_, v)) => {
+            let at = start + "unknown field `".len() + end + 1;
+            format!("{} (did you mean `{v}`?){}", &msg[..at], &msg[at..])
+        }
+        None => msg.to_string(),
+    }
+}
+
+/// Levenshtein distance (insertions, deletions, substitutions), on characters.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut prev = row[0];
+        row[0] = i + 1;
+        for (j, cb) in b.iter().enumerate() {
+            let cur = row[j + 1];
+            row[j + 1] = (prev + usize::from(ca != *cb)).min(row[j] + 1).min(cur + 1);
+            prev = cur;
+        }
+    }
+    row[b.len()]
+}
+
 fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> std::result::Result<Se3, String> {
     let xyz = V3::from(o.xyz.unwrap_or([0.0; 3]));
     if let Some(q) = o.quat {
@@ -337,4 +409,40 @@ fn origin_se3(o: &OriginYaml, ang: &dyn Fn(f64) -> f64) -> std::result::Result<S
     }
     let rpy = o.rpy.map(|r| V3::new(ang(r[0]), ang(r[1]), ang(r[2]))).unwrap_or_else(V3::zeros);
     Ok(Se3::new(rpy_to_rot(&rpy), xyz))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const BASE: &str = "name: t\nbodies:\n  - name: base\n    inertial: {mass: 10, inertia: [1, 1, 1]}\n";
+
+    fn err(text: &str) -> String {
+        match from_yaml_str(text, "t.yaml") {
+            Err(e) => e.to_string(),
+            Ok(_) => panic!("accepted: {text}"),
+        }
+    }
+
+    #[test]
+    fn unknown_key_names_the_closest_valid_key() {
+        let e = err(&BASE.replace("mass:", "mas:"));
+        assert!(e.contains("unknown field `mas` (did you mean `mass`?)"), "{e}");
+        let e = err(&BASE.replace("inertial:", "inertal:"));
+        assert!(e.contains("did you mean `inertial`?"), "{e}");
+        let e = err(&format!("{BASE}    zzzzzz: 1\n"));
+        assert!(e.contains("unknown field `zzzzzz`") && !e.contains("did you mean"), "{e}");
+    }
+
+    #[test]
+    fn inertia_of_the_wrong_shape_names_the_key_and_the_accepted_forms() {
+        for bad in ["inertia: [1, 1]", "inertia: [1, 1, 1, 1]", "inertia: 5", "inertia: abc"] {
+            let e = err(&BASE.replace("inertia: [1, 1, 1]", bad));
+            assert!(e.contains("inertia") && e.contains("[Ixx, Iyy, Izz]"), "{bad}: {e}");
+            assert!(!e.contains("untagged"), "{bad}: {e}");
+        }
+        let e = err(&BASE.replace("inertia: [1, 1, 1]", "inertia: {xx: 1, yy: 1, zz: 1, x_y: 0}"));
+        assert!(e.contains("unknown field `x_y` (did you mean `xy`?)"), "{e}");
+        assert!(from_yaml_str(&BASE.replace("[1, 1, 1]", "{xx: 1, yy: 2, zz: 3, xy: 0.1}"), "t").is_ok());
+    }
 }
