@@ -171,8 +171,54 @@ class DualQuaternion:
     def vec(self) -> Any:
         ...
 
+class Environment:
+    """The orbital environment of a simulation; every effect is off unless asked for.
+
+Orbit (of the system's centre of mass at t = 0, about a central body; the Earth by default): give either
+`altitude` or `semi_major_axis` (m) with `eccentricity`, `inclination`, `raan`, `arg_periapsis` and
+`true_anomaly` (radians), or an inertial `position` and `velocity` (m, m/s, from the body's centre).
+`mu` (m³/s²), `radius` (m) and `j2_coefficient` override the Earth's constants. With an orbit the
+simulator's world frame is a free-falling frame with inertial axes whose origin follows the orbit
+(starting at the system's centre of mass), so `q` keeps metre-sized positions.
+
+`gravity_gradient=True` applies the tidal force and gravity-gradient torque to every body; `j2=True` adds
+J2 to the orbit and its differential part to every body. A constant disturbance wrench
+(`disturbance_force`, `disturbance_torque`, N and N·m about the centre of mass of body
+`disturbance_body`, the base by default) is given in `disturbance_axes` "inertial" or "body".
+    """
+    def __init__(self, altitude: ArrayLike | None = None, semi_major_axis: ArrayLike | None = None, eccentricity: ArrayLike = 0.0, inclination: ArrayLike = 0.0, raan: ArrayLike = 0.0, arg_periapsis: ArrayLike = 0.0, true_anomaly: ArrayLike = 0.0, position: ArrayLike | None = None, velocity: ArrayLike | None = None, mu: ArrayLike | None = None, radius: ArrayLike | None = None, j2_coefficient: ArrayLike | None = None, gravity_gradient: ArrayLike = False, j2: ArrayLike = False, disturbance_force: ArrayLike | None = None, disturbance_torque: ArrayLike | None = None, disturbance_axes: ArrayLike = 'inertial', disturbance_body: ArrayLike = 0) -> None: ...
+    def external_wrenches(self, model: Model, q0: ArrayLike, v0: ArrayLike, times: ArrayLike, q: ArrayLike) -> Any:
+        """Total external wrench `[force, moment about the frame origin]` (T, 6), inertial axes, that the
+environment applies at the samples (times[k], q[k]) of a run that started at (q0, v0).
+        """
+    @property
+    def gravity_gradient(self) -> Any:
+        """Whether the tidal force and gravity-gradient torque act on every body."""
+    @property
+    def is_off(self) -> Any:
+        """True when nothing acts (the simulation is then exactly the environment-free one)."""
+    @property
+    def j2(self) -> Any:
+        """Whether J2 acts."""
+    @property
+    def mu(self) -> Any:
+        """Gravitational parameter μ of the central body (m³/s²), or None without an orbit."""
+    @property
+    def orbit_state(self) -> Any:
+        """The system's centre-of-mass orbit at t = 0 as (position, velocity) (inertial, m and m/s), or None."""
+    @property
+    def period(self) -> Any:
+        """Orbital period of the t = 0 state (s), or None without an orbit."""
+    def reference_orbit(self, model: Model, q0: ArrayLike, v0: ArrayLike, times: ArrayLike) -> Any:
+        """Inertial state `[position, velocity]` (T, 6) of the simulation frame's origin at `times` for a run
+from (q0, v0): add a body's local position to get its inertial one. The same propagation as the run.
+        """
+
 class InputError(ValueError):
     """An argument has the wrong shape, non-finite entries or an invalid value."""
+
+class Interrupted(KeyboardInterrupt):
+    """A long run was stopped (Ctrl-C, or a progress callback returning False); `partial` holds what was finished (a Trajectory for a simulation), or None."""
 
 class Model:
     ...
@@ -617,7 +663,7 @@ t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict wi
 parameters about the reference points). Arrays have a leading sample axis.
     """
 
-def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1) -> Any:
+def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1, max_memory: ArrayLike | None = None) -> Any:
     """Simulate the post-capture scenario. Returns a dict like `simulate` (t, q, v, ddq, tau, momentum,
 kinetic_energy, work) recorded every `record_every` RK4 steps.
     """
@@ -635,7 +681,7 @@ def rnea_derivatives(model: Model, q: ArrayLike, v: ArrayLike, a: ArrayLike, fex
 (nv, nv); q along its local tangent (see aba_derivatives).
     """
 
-def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba', actuators: ArrayLike | None = None, input_timing: ArrayLike = 'step') -> Any:
+def simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', controller: Callable[..., ArrayLike] | None = None, controller_period: float | None = None, prescribed: ArrayLike | None = None, prescription: Callable[..., Any] | None = None, max_steps: int = 50000000, progress: Callable[[float], Any] | None = None, formulation: str = 'aba', actuators: ArrayLike | None = None, input_timing: ArrayLike = 'step', max_memory: ArrayLike | None = None, environment: ArrayLike | None = None) -> Any:
     ...
 
 def simulate_many(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, method: str = 'rk4', rtol: float = 1e-09, atol: float = 1e-12, max_step: float | None = None, record_every: int = 1, torques: ArrayLike | Callable[..., ArrayLike] | None = None, torque_times: ArrayLike | None = None, hold: str = 'zoh', params: ArrayLike | None = None, threads: int = 0, max_steps: int = 50000000) -> Any:
