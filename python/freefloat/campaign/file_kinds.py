@@ -140,7 +140,7 @@ def run_control_ddp(scenario: dict, seed: int) -> dict:
 def register_all() -> None:
     from .registry import Kind, leaf_paths, register
 
-    def kind(name, description, run, headline, extra=()):
+    def kind(name, description, run, headline, extra=(), campaign_keys=()):
         register(
             Kind(
                 name=name,
@@ -152,6 +152,7 @@ def register_all() -> None:
                 run=run,
                 normalize=_normalize,
                 headline=headline,
+                campaign_keys=campaign_keys,
             )
         )
 
@@ -162,6 +163,7 @@ def register_all() -> None:
         run_identify_cl,
         ("max_final_relative_error", "median_final_relative_error", "time_within_1pct_s"),
         extra=("noise.wrench", "noise.rate"),  # sensor noise of the run (N, N m; m/s, rad/s), drawn with the seed
+        campaign_keys=("noise",),
     )
     kind(
         "control_adaptive",

@@ -49,6 +49,9 @@ class Kind:
     normalize: Callable[[dict], dict] = _identity
     #: summary names a report shows first
     headline: tuple = field(default_factory=tuple)
+    #: top-level sections a campaign may add that the kind's `run` consumes itself (not keys of its scenario
+    #: files, so the scenario schema does not check them; `run` does)
+    campaign_keys: tuple = field(default_factory=tuple)
 
 
 KINDS: dict[str, Kind] = {}

@@ -238,7 +238,7 @@ def parse(d: dict, source: str, base_dir: Path | None = None) -> CampaignSpec:
         mc = _parse_mc(mc, source, valid, kind.name)
     if not grid and mc is None:
         raise InputError(f"{source}: neither 'grid' nor 'monte_carlo': the campaign would have no runs to vary")
-    _check_values(kind.name, base, fixed, grid, source)
+    _check_values(kind.name, base, fixed, grid, source, kind.campaign_keys)
     spec = CampaignSpec(
         name=str(d["name"]),
         kind=kind.name,
@@ -255,24 +255,29 @@ def parse(d: dict, source: str, base_dir: Path | None = None) -> CampaignSpec:
     return spec
 
 
-def _check_values(kind: str, base: dict, fixed: dict, grid: dict, source: str) -> None:
+def _check_values(kind: str, base: dict, fixed: dict, grid: dict, source: str, campaign_keys=()) -> None:
     """The base scenario with `set`, and with each grid value in turn, against the kind's declared schema
     (io/scenario_schemas.py): a value of the wrong type (a typo: every run would fail) is refused before any run
-    starts; a value out of range is left to fail its own run, recorded as that run's error."""
+    starts; a value out of range is left to fail its own run, recorded as that run's error. The kind's
+    `campaign_keys` (sections its run consumes itself) are left out of the schema check."""
     from ..io import schema
 
     if kind not in schema.kinds():
         return
+
+    def scenario_part(d: dict) -> dict:
+        return {k: v for k, v in d.items() if k not in campaign_keys}
+
     with schema.types_only():
         sc = copy.deepcopy(base)
         for p, v in fixed.items():
             set_path(sc, str(p), copy.deepcopy(v))
-        schema.check(kind, sc, f"{source}: the scenario with 'set' applied")
+        schema.check(kind, scenario_part(sc), f"{source}: the scenario with 'set' applied")
         for p, values in grid.items():
             for v in values:
                 one = copy.deepcopy(sc)
                 set_path(one, str(p), copy.deepcopy(v))
-                schema.check(kind, one, f"{source}: grid '{p}' = {v!r}")
+                schema.check(kind, scenario_part(one), f"{source}: grid '{p}' = {v!r}")
 
 
 def _parse_mc(mc, source, valid, kind) -> dict:
