@@ -278,7 +278,11 @@ def simulate(
     if isinstance(prescribed, str):
         prescribed = [prescribed]
     bar = None
-    if progress is True:
+    try:
+        drawable = math.isfinite(float(t_final)) and float(t_final) > 0
+    except (TypeError, ValueError):
+        drawable = False  # the engine names the argument
+    if progress is True and drawable:
         from tqdm.auto import tqdm
 
         bar = tqdm(

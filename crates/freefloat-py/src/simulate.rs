@@ -308,7 +308,8 @@ pub fn simulate<'py>(
                     Some((times, values)) => TorqueSource::table(times, values, nv, hold)?,
                     None => TorqueSource::Zero,
                 };
-                let inputs = Inputs { torques, actuators: acts, timing, environment: env.as_ref(), ..Default::default() };
+                let inputs =
+                    Inputs { torques, actuators: acts, timing, environment: env.as_ref(), ..Default::default() };
                 sim::simulate_with(&m, q0, v0, &opts, inputs, formulation, Some(&mut hook))
             })
         })?

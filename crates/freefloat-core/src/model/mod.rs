@@ -305,6 +305,8 @@ impl Model {
     }
 
     fn finalize(&mut self) -> Result<()> {
+        /// Largest magnitude of a length [m] or an inertial parameter [kg, kg m, kg m^2] a model may hold.
+        const MAX_MAGNITUDE: f64 = 1e50;
         let n = self.nbodies();
         check_unique("body", &self.body_names)?;
         check_unique("joint", &self.joint_names)?;
@@ -325,6 +327,23 @@ impl Model {
                 check_finite_nonnegative_mass(name, &self.inertias[i])?;
             } else {
                 check_physical(name, &self.inertias[i])?;
+            }
+            // Finite is not enough: the algorithms multiply masses by squared lengths and rates, so a mass of
+            // 1e308 or a joint origin at 1e200 m overflows to inf/NaN inside them. Far above any spacecraft, far
+            // below overflow for the products the dynamics form (a few factors of this size).
+            if let Some(x) = p.trans.iter().copied().find(|x| x.abs() > MAX_MAGNITUDE) {
+                return Err(FfError::Model(format!(
+                    "joint '{}': origin coordinate {x:e} m is beyond {MAX_MAGNITUDE:e} (the dynamics would overflow \
+                     double precision)",
+                    self.joint_names[i]
+                )));
+            }
+            let params = self.inertias[i].to_params();
+            if let Some(x) = params.iter().copied().find(|x| x.abs() > MAX_MAGNITUDE) {
+                return Err(FfError::Model(format!(
+                    "body '{name}': inertial parameter {x:e} (mass, first or second moment) is beyond \
+                     {MAX_MAGNITUDE:e} (the dynamics would overflow double precision)"
+                )));
             }
         }
         if !self.gravity.iter().all(|g| g.is_finite()) {
