@@ -222,7 +222,116 @@ def rows_dq(res: dict) -> list[Row]:
     ]
 
 
-#: name -> (script, full args, fast args, modules needed, extractor)
+def rows_kernels(res: dict) -> list[Row]:
+    targets = {"aba": "freefloat <= 0.5x (ratio >= 2)", "rnea": "<= 0.7x (ratio >= 1.43)", "crba": "<= 0.7x"}
+    peers = {"aba": "Pinocchio abaInParallel", "rnea": "Pinocchio rneaInParallel", "crba": "Pinocchio crba (C++ est.)"}
+    out = []
+    for robot, r in res["results"].items():
+        for k, v in r["rows"].items():  # freefloat time / Pinocchio's: inverted so that > 1 means faster
+            out.append(
+                Row(
+                    f"{k.upper()} per call, core to core, {robot} (nv = {r['nv']})",
+                    peers.get(k, "Pinocchio"),
+                    1.0 / v["median"] if v.get("median") else None,
+                    _range(1.0 / v["max"], 1.0 / v["min"]) if v.get("min", 0) > 0 and v.get("max", 0) > 0 else "",
+                    target=targets.get(k, ""),
+                    note=f"CPU-time ratio {1.0 / v['cpu_median']:.2f}" if v.get("cpu_median") else "",
+                )
+            )
+    return out
+
+
+def rows_inverted_ratios(res: dict, peer: str) -> list[Row]:
+    """`ratios` whose values are freefloat's cost over a reference (lower is better): reported as they are."""
+    out = rows_generic_ratios(res, peer)
+    for r in out:
+        r.note = "freefloat / reference (lower is better)"
+    return out
+
+
+def rows_sim_mujoco(res: dict) -> list[Row]:
+    rows = []
+    for key, v in (res.get("ratios") or {}).items():
+        lower = "/ table" in key  # the Python-torque rows are a cost ratio, not a speed-up
+        rows.append(
+            Row(
+                key,
+                "MuJoCo 4 (same robot, RK4, 10 s at 1 kHz)" if not lower else "freefloat with table torques",
+                v.get("median"),
+                _range(v.get("min"), v.get("max")),
+                target=v.get("target", ""),
+                note=(f"CPU-time ratio {v['cpu_median']:.2f}" if "cpu_median" in v else "")
+                + ("; freefloat / reference (lower is better)" if lower else ""),
+            )
+        )
+    return rows
+
+
+def rows_basilisk(res: dict) -> list[Row]:
+    p = res["hub_three_wheels"]
+    out = [
+        Row(
+            f"hub + 3 reaction wheels, friction and saturation, {p['t_final']:g} s at {p['dt']:g} s",
+            "Basilisk 2.12 wheel model",
+            p["speedup_median"],
+            freefloat=fmt_s(p["freefloat_s"][0]),
+            peer_value=fmt_s(p["basilisk_s"][0]),
+            target=">= 5",
+            note=f"body rates agree to {p['agreement_body_rate']:.1e} rad/s",
+        )
+    ]
+    for name, r in res.get("seed_robots", {}).items():
+        out.append(
+            Row(
+                f"{name} with wheel models and 2 thrusters",
+                "the same run without them",
+                r["ratio_median"],
+                freefloat=fmt_s(r["with_s"][0]),
+                peer_value=fmt_s(r["without_s"][0]),
+                target="<= 1.5",
+                note="freefloat with / without (lower is better)",
+            )
+        )
+    return out
+
+
+def rows_environment(res: dict) -> list[Row]:
+    out = []
+    for robot, cases in res["results"].items():
+        for c, v in cases.items():
+            if c == "none":
+                continue
+            out.append(
+                Row(
+                    f"{robot} with {c}",
+                    "the same run without an environment",
+                    v["ratio_to_none"],
+                    freefloat=fmt_s(v["median_s"]),
+                    target=f"<= {res.get('target_ratio', 1.5)}",
+                    note="with / without (lower is better)",
+                )
+            )
+    return out
+
+
+def rows_sensors(res: dict) -> list[Row]:
+    lo_f, hi_f = res["spread_s"]["freefloat"]
+    lo_n, hi_n = res["spread_s"]["numpy"]
+    return [
+        Row(
+            f"measure: {res['problem']['samples']:,} samples of {res['problem']['model']}, full sensor set",
+            "numpy/scipy, same error models",
+            res["speedup_vs_numpy"],
+            _range(lo_n / hi_f, hi_n / lo_f),
+            fmt_s(res["median_s"]["freefloat"]),
+            fmt_s(res["median_s"]["numpy"]),
+            note="error statistics agree" if res.get("agreement_passed") else "error statistics DISAGREE",
+        )
+    ]
+
+
+#: name -> (script, full args, fast args, modules needed, extractor[, the JSON file the script writes in --out
+#: when it has no --json option])
 BENCHES = {
     "identify": ("identify_vs_numpy.py", [], ["--quick"], (), rows_identify),
     "identify_1core": ("identify_vs_numpy.py", ["--cores", "1"], ["--quick", "--cores", "1"], (), rows_identify),
@@ -246,18 +355,30 @@ BENCHES = {
     "ddp": ("ddp_vs_crocoddyl.py", [], ["--quick"], ("pinocchio", "crocoddyl"), rows_ddp),
     "campaign": ("campaign_bench.py", [], ["--quick"], ("distributed",), rows_campaign),
     "dq": ("dq_dynamics.py", [], ["--quick"], (), rows_dq),
+    "kernels": (
+        "kernels_vs_pinocchio.py",
+        [],
+        ["--repeats", "3", "--batch", "2000", "--calls", "4000"],
+        ("pinocchio",),
+        rows_kernels,
+        "kernels_vs_pinocchio.json",
+    ),
+    "mujoco": ("sim_vs_mujoco.py", [], ["--repeats", "3"], ("mujoco",), rows_sim_mujoco, "sim_vs_mujoco.json"),
+    "basilisk": ("basilisk_wheels.py", [], ["--repeats", "3"], ("Basilisk",), rows_basilisk, "basilisk_wheels.json"),
+    "environment": ("environment_bench.py", [], ["--repeats", "3"], (), rows_environment, "environment_bench.json"),
+    "sensors": ("sensors_bench.py", [], ["--repeats", "5"], ("scipy",), rows_sensors, "sensors_bench.json"),
 }
 RLS_LINE = re.compile(r"^(\S+)\s+wall\s+([\d.]+) ns/update .*?cpu\s+([\d.]+) ns/update")
 
 
 def run_script(name: str, fast: bool) -> Section:
-    script, full, quick, needs, extract = BENCHES[name]
+    script, full, quick, needs, extract, *own_json = BENCHES[name]
     args = quick if fast else full
     out = RESULTS / name
     out.mkdir(parents=True, exist_ok=True)
-    jf = out / f"{name}.json"
+    jf = out / (own_json[0] if own_json else f"{name}.json")
     jf.unlink(missing_ok=True)
-    cmd = [sys.executable, str(HERE / script), *args, "--out", str(out), "--json", str(jf)]
+    cmd = [sys.executable, str(HERE / script), *args, "--out", str(out)] + ([] if own_json else ["--json", str(jf)])
     sec = Section(name, "python benches/" + " ".join([script, *args]))
     missing = [m for m in needs if importlib.util.find_spec(m) is None]
     if missing:
@@ -403,6 +524,12 @@ def speed_paragraph(sections: list[Section], git: str, fast: bool) -> str:
     for r in rows.get("compare", [])[:6]:
         if r.ratio is not None:
             parts.append(f"{r.what}: {r.ratio:.2f}")
+    for r in rows.get("kernels", []):
+        if r.what.startswith("ABA") and r.ratio is not None:
+            parts.append(f"{r.what}: {r.peer} / freefloat {r.ratio:.2f}")
+    for r in rows.get("mujoco", [])[:1]:
+        if r.ratio is not None:
+            parts.append(f"10 s RK4 simulation, {r.what}: {r.ratio:.2f}")
     for r in rows.get("ddp", []):
         parts.append(f"{r.what}: {r.peer} / freefloat {r.ratio:.2f}")
     for r in rows.get("rls", []):

@@ -101,17 +101,7 @@ pub fn postcapture_simulate<'py>(
     };
     reraise_foreign(py, raised)?;
     let tr = r?;
-    let d = PyDict::new(py);
-    let n = tr.len();
-    d.set_item("t", PyArray1::from_slice(py, &tr.t))?;
-    d.set_item("q", PyArray1::from_slice(py, &tr.q).reshape([n, tr.nq])?)?;
-    d.set_item("v", PyArray1::from_slice(py, &tr.v).reshape([n, tr.nv])?)?;
-    d.set_item("ddq", PyArray1::from_slice(py, &tr.ddq).reshape([n, tr.nv])?)?;
-    d.set_item("tau", PyArray1::from_slice(py, &tr.tau).reshape([n, tr.nv])?)?;
-    d.set_item("momentum", PyArray1::from_slice(py, &tr.momentum).reshape([n, 6])?)?;
-    d.set_item("kinetic_energy", PyArray1::from_slice(py, &tr.kinetic_energy))?;
-    d.set_item("work", PyArray1::from_slice(py, &tr.work))?;
-    Ok(d)
+    crate::simulate::traj_dict(py, &tr)
 }
 
 /// Ordinary recursive least squares with forgetting factor (Rust `estimation::Rls`).

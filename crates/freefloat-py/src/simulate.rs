@@ -341,8 +341,8 @@ pub fn simulate<'py>(
     }
 }
 
-/// The trajectory as the dict of arrays the Python layer turns into a `Trajectory`.
-fn traj_dict<'py>(py: Python<'py>, tr: &sim::Trajectory) -> PyResult<Bound<'py, PyDict>> {
+/// The trajectory as the dict of arrays the Python layer turns into a `Trajectory` (also `simulate_many`'s).
+pub(crate) fn traj_dict<'py>(py: Python<'py>, tr: &sim::Trajectory) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     let n = tr.len();
     d.set_item("t", PyArray1::from_slice(py, &tr.t))?;

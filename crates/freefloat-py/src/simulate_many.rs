@@ -4,9 +4,9 @@
 use crate::batch::{array_arg, model_arg};
 use crate::errors::{guard, input_err, to_py};
 use freefloat_core::sim::{self, BatchSpec, Hold, Method, SimOptions, Stacked};
-use numpy::{PyArray1, PyArrayMethods, PyUntypedArrayMethods};
+use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::PyList;
 
 /// A stacked argument: (data, rows) for an array of shape (width,) [shared] or (B, width...) [one row per member].
 fn stacked(obj: &Bound<'_, PyAny>, name: &str, inner: usize) -> PyResult<(Vec<f64>, usize)> {
@@ -112,20 +112,7 @@ pub fn simulate_many<'py>(
     for (k, r) in results.into_iter().enumerate() {
         match r {
             Ok(tr) => {
-                let d = PyDict::new(py);
-                let n = tr.len();
-                d.set_item("t", PyArray1::from_slice(py, &tr.t))?;
-                d.set_item("q", PyArray1::from_slice(py, &tr.q).reshape([n, tr.nq])?)?;
-                d.set_item("v", PyArray1::from_slice(py, &tr.v).reshape([n, tr.nv])?)?;
-                d.set_item("ddq", PyArray1::from_slice(py, &tr.ddq).reshape([n, tr.nv])?)?;
-                d.set_item("tau", PyArray1::from_slice(py, &tr.tau).reshape([n, tr.nv])?)?;
-                d.set_item("momentum", PyArray1::from_slice(py, &tr.momentum).reshape([n, 6])?)?;
-                d.set_item("kinetic_energy", PyArray1::from_slice(py, &tr.kinetic_energy))?;
-                d.set_item("work", PyArray1::from_slice(py, &tr.work))?;
-                d.set_item("steps", tr.steps)?;
-                d.set_item("rejected", tr.rejected)?;
-                d.set_item("evaluations", tr.evaluations)?;
-                out.append(d)?;
+                out.append(crate::simulate::traj_dict(py, &tr)?)?;
             }
             Err(e) => {
                 out.append(py.None())?;

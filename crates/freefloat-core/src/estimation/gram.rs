@@ -1,6 +1,6 @@
 //! Gram-matrix accumulation: the fast first pass of [`super::identify_momentum`].
 
-use nalgebra::{DMatrix, DVector, Dyn, MatrixView};
+use nalgebra::{DMatrix, DVector};
 
 /// Accumulates `[A y]ᵀ[A y]` ((n+1)², holding AᵀA, Aᵀy and yᵀy) with cache-blocked products.
 #[derive(Debug, Clone)]
@@ -22,13 +22,6 @@ pub struct GramFactor {
     pub kappa_scaled: f64,
 }
 
-/// A `rows × cols` view of `s` with element (i, j) at `s[i·rs + j·cs]`.
-pub(super) fn strided(s: &[f64], rows: usize, cols: usize, rs: usize, cs: usize) -> StridedView<'_> {
-    MatrixView::from_slice_with_strides_generic(s, Dyn(rows), Dyn(cols), Dyn(rs), Dyn(cs))
-}
-
-pub(super) type StridedView<'a> = MatrixView<'a, f64, Dyn, Dyn, Dyn, Dyn>;
-
 impl GramLs {
     /// An empty accumulator for `n` unknowns (plus the right-hand side column).
     pub fn new(n: usize) -> Self {
@@ -42,25 +35,19 @@ impl GramLs {
 
     /// Add the first `rows` rows of `block` = `[A_b | y_b]` (column-major, n+1 columns, weighted).
     pub fn add_augmented(&mut self, block: &DMatrix<f64>, rows: usize) {
-        let cap = block.nrows();
-        let n1 = self.n + 1;
-        let s = block.as_slice();
-        // B (rows × n1) and Bᵀ as strided views of the same buffer: one gemm, no copy
-        let b = strided(s, rows, n1, 1, cap);
-        let bt = strided(s, n1, rows, cap, 1);
-        self.g.gemm(1.0, &bt, &b, 1.0);
-        self.rows += rows;
+        self.add_augmented_range(block, 0, rows);
     }
 
     /// Add rows `start..start + rows` of `block` = `[A_b | y_b]` (column-major, n+1 columns, weighted).
     pub fn add_augmented_range(&mut self, block: &DMatrix<f64>, start: usize, rows: usize) {
         let cap = block.nrows();
         assert!(start + rows <= cap, "rows {start}..{} outside the block of {cap}", start + rows);
-        let n1 = self.n + 1;
-        let s = &block.as_slice()[start..];
-        let b = strided(s, rows, n1, 1, cap);
-        let bt = strided(s, n1, rows, cap, 1);
-        self.g.gemm(1.0, &bt, &b, 1.0);
+        assert_eq!(block.ncols(), self.n + 1, "block columns");
+        // G += BᵀB through nalgebra's transposed product on a plain row range of the block (no copy). A
+        // hand-made transposed view (row stride = the block's height) fed to `gemm` read and wrote out of bounds
+        // inside nalgebra on some block sizes: a segfault on the 16 001-sample external-wrench problem.
+        let b = block.rows(start, rows);
+        self.g.gemm_tr(1.0, &b, &b, 1.0);
         self.rows += rows;
     }
 

@@ -1,7 +1,7 @@
 //! Identification from momentum (Naveen, Shah, Misra, eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
 
 use super::analysis::{check_rank, finish};
-use super::gram::{strided, GramLs};
+use super::gram::GramLs;
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
@@ -297,8 +297,7 @@ fn refine(m: &Model, p: &MomentumProblem, t: usize, r: DMatrix<f64>, x: DVector<
     let n = x.len();
     let make = || Residual { atr: DVector::zeros(n), rss: 0.0, r: DVector::zeros(6 * BLOCK_SAMPLES) };
     let feed = |acc: &mut Residual, b: &mut DMatrix<f64>, rows: usize| {
-        let cap = b.nrows();
-        let a = strided(b.as_slice(), rows, n, 1, cap);
+        let a = b.view((0, 0), (rows, n));
         let mut res = acc.r.rows_mut(0, rows);
         res.copy_from(&b.view((0, n), (rows, 1)));
         res.gemv(-1.0, &a, &x, 1.0);
