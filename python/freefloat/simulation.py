@@ -231,7 +231,7 @@ def simulate(
     max_steps: int = 50_000_000,
     formulation: str = "aba",
     actuators=None,
-    input_timing: str = "step",
+    input_timing: str | None = None,
     max_memory: float | None = None,
     environment: _core.Environment | None = None,
 ) -> Trajectory:
@@ -264,11 +264,12 @@ def simulate(
       equivalent mapping (a YAML `actuators:` block), evaluated in the engine at every step (docs/actuators.md).
       The model's joint limits (effort, velocity) apply in every run: the commanded force is clipped to
       ±effort and a command that would drive a joint further past its velocity limit becomes zero.
-    input_timing: "step" (default): the torque table or function, the controller-free command, the joint
-      limits and the wheel saturation are read once per step at its start and held through its stages, so a
-      zero-order-hold switch on a step boundary acts from exactly there (rk45 lands on every table time);
-      "stage": read at every Runge-Kutta stage time (keeps RK4's order for a smooth torque function of the
-      state; a held switch on a step boundary then leaks 1/6 of a step into the step before). A table with
+    input_timing: when the torques are read within a step. "step": once, at the step's start, and held through
+      its stages, with the joint limits and the wheel saturation applied to that held command; a zero-order-hold
+      switch on a step boundary then acts from exactly there (rk45 lands on every table time). "stage": at every
+      Runge-Kutta stage time (keeps RK4's fourth order for a smooth torque function; a held table switch on a step
+      boundary then leaks 1/6 of a step into the step before). Default (None): "stage" for a torque function
+      f(t, q, v) (a control law acts continuously) and "step" for a table or no torques. A table with
       hold="linear" is read at every stage in both cases.
     environment: a `freefloat.Environment` (orbit with gravity gradient, J2, a constant disturbance); its forces
       reach every body as external wrenches, and the returned trajectory's `orbit` holds the inertial state of
@@ -308,6 +309,8 @@ def simulate(
                 f"argument `actuators`: expected a freefloat.Actuators or a mapping, got {type(actuators).__name__}"
             )
         acts = actuators.to_dict()
+    if input_timing is None:
+        input_timing = "stage" if callable(torques) else "step"
     _warn_silent_ends(t_final, dt, method, torques, tt, hold)
     limit = memory_limit() if max_memory is None else float(max_memory)
     try:

@@ -63,9 +63,9 @@ from ._common import load_model, out_paths, parse_vector, print_summary, summari
 @click.option(
     "--input-timing",
     type=click.Choice(["step", "stage"]),
-    default="step",
-    show_default=True,
-    help="Read --torques once per step and hold it (step), or at every Runge-Kutta stage (stage).",
+    default=None,
+    help="Read --torques once per step and hold it (step), or at every Runge-Kutta stage (stage). Default: step "
+    "for a table file, stage for the built-in torque functions (sine).",
 )
 @click.option(
     "--environment",
