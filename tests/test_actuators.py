@@ -346,3 +346,23 @@ def test_cli_simulate_reads_an_actuators_file(tmp_path):
         timeout=300,
     )
     assert r.returncode != 0 and "frition" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_propellant_and_base_parameters_survive_the_trajectory_files(tmp_path):
+    """A run with a draining tank keeps its propellant and base-parameter columns in Parquet and CSV."""
+    m = point_body()
+    tank = ff.Tank("main", mass=0.5, position=(0.1, 0.0, 0.0))
+    th = ff.Thruster(direction=(1, 0, 0), max_thrust=2.0, isp=200.0, tank="main", firings=[(0.1, 0.5)])
+    tr = ff.simulate(m, m.neutral(), np.zeros(6), 1.0, 0.01, actuators=ff.Actuators(thrusters=[th], tanks=[tank]))
+    assert tr.propellant[-1, 0] < tr.propellant[0, 0]  # the tank really drained
+    tr.to_parquet(tmp_path / "run.parquet")
+    back = ff.Trajectory.from_parquet(tmp_path / "run.parquet")
+    np.testing.assert_array_equal(back.propellant, tr.propellant)
+    np.testing.assert_array_equal(back.base_parameters, tr.base_parameters)
+    tr.to_csv(tmp_path / "run.csv")
+    header = (tmp_path / "run.csv").read_text().splitlines()[1].split(",")
+    assert "propellant.0" in header and "base_parameters.m" in header and "base_parameters.Izz" in header
+    # a run without tanks writes none of these columns
+    plain = ff.simulate(m, m.neutral(), np.zeros(6), 0.1, 0.01)
+    plain.to_parquet(tmp_path / "plain.parquet")
+    assert ff.Trajectory.from_parquet(tmp_path / "plain.parquet").propellant is None

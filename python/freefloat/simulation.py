@@ -21,6 +21,10 @@ from ._core import InputError
 from .model import Model
 
 MOMENTUM_NAMES = ["px", "py", "pz", "Lx", "Ly", "Lz"]
+#: the standard inertial parameters of a body, in `Model.parameters()` order (the `base_parameters` columns)
+PARAMETER_NAMES = ["m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz"]
+#: inertial position and velocity of the simulation frame's origin (the `orbit` columns)
+ORBIT_NAMES = ["x", "y", "z", "vx", "vy", "vz"]
 
 
 @dataclass
@@ -105,6 +109,16 @@ class Trajectory:
             cols[f"momentum.{n}"] = self.momentum[:, j]
         cols["kinetic_energy"] = self.kinetic_energy
         cols["work"] = self.work
+        # what only some runs record: propellant left per tank, the base's inertial parameters (they change as a
+        # tank drains), the orbit of the frame origin (with an environment)
+        for prefix, arr, names in (
+            ("propellant", self.propellant, None),
+            ("base_parameters", self.base_parameters, PARAMETER_NAMES),
+            ("orbit", self.orbit, ORBIT_NAMES),
+        ):
+            if arr is not None and np.size(arr) and np.shape(arr)[0] == len(self.t):
+                for j in range(np.shape(arr)[1]):
+                    cols[f"{prefix}.{names[j] if names else j}"] = np.asarray(arr)[:, j]
         return cols
 
     def to_numpy(self) -> dict:
@@ -149,20 +163,12 @@ class Trajectory:
     # -- files ----------------------------------------------------------------------------------------
     def to_parquet(self, path) -> None:
         """Write to a Parquet file: one row per sample, columns t, q.<joint>[.k], v.…, ddq.…, tau.…,
-        momentum.<px…Lz>, kinetic_energy, work; the model name and run statistics in the metadata."""
+        momentum.<px…Lz>, kinetic_energy, work (and, when the run has them, propellant.<tank index>,
+        base_parameters.<m…Izz>, orbit.<x…vz>); the model name and run statistics in the metadata."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        cols = {"t": self.t}
-        ql = self.q_labels or [str(j) for j in range(self.q.shape[1])]
-        vl = self.v_labels or [str(j) for j in range(self.v.shape[1])]
-        for prefix, arr, labels in (("q", self.q, ql), ("v", self.v, vl), ("ddq", self.ddq, vl), ("tau", self.tau, vl)):
-            for j in range(arr.shape[1]):
-                cols[f"{prefix}.{labels[j]}"] = arr[:, j]
-        for j, n in enumerate(MOMENTUM_NAMES):
-            cols[f"momentum.{n}"] = self.momentum[:, j]
-        cols["kinetic_energy"] = self.kinetic_energy
-        cols["work"] = self.work
+        cols = self._columns()
         meta = {"freefloat": json.dumps({"model": self.model_name, "stats": self.stats})}
         table = pa.table(cols).replace_schema_metadata(meta)
         pq.write_table(table, str(path))
@@ -205,6 +211,9 @@ class Trajectory:
             q_labels=labels("q"),
             v_labels=labels("v"),
             stats=meta.get("stats", {}),
+            propellant=block("propellant") if labels("propellant") else None,
+            base_parameters=block("base_parameters") if labels("base_parameters") else None,
+            orbit=block("orbit") if labels("orbit") else None,
         )
 
 
