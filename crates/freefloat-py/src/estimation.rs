@@ -2,8 +2,8 @@
 //! in Rust with the GIL released; the tall regressor is never formed.
 
 use crate::batch::{model_arg, Batch};
-use crate::errors::{guard, input_err};
-use freefloat_core::estimation::{identify_momentum_with, momentum_regressor_pass, Method, MomentumProblem};
+use crate::errors::{guard, input_err, reraise_foreign, signal_hook};
+use freefloat_core::estimation::{identify_momentum_interruptible, momentum_regressor_pass, Method, MomentumProblem};
 use numpy::{IntoPyArray, PyArrayMethods};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -40,7 +40,19 @@ pub fn identify_momentum<'py>(
     };
     let a = Args::new(m, q, v, h, known_params, weights)?;
     let problem = a.problem(&columns);
-    let res = py.detach(|| guard(|| identify_momentum_with(m, &problem, force_qr)))?;
+    // Ctrl-C stops the passes over the samples (the hook re-takes the GIL only to check for signals) and raises
+    // `Interrupted`; any other exception a signal handler raises comes back unchanged.
+    let mut raised: Option<PyErr> = None;
+    let res = {
+        let raised = &mut raised;
+        let problem = &problem;
+        py.detach(move || {
+            let mut hook = signal_hook(raised);
+            guard(|| identify_momentum_interruptible(m, problem, force_qr, Some(&mut hook)))
+        })
+    };
+    reraise_foreign(py, raised)?;
+    let res = res?;
     let n = res.x.len();
     let d = PyDict::new(py);
     d.set_item("x", res.x.as_slice().to_vec().into_pyarray(py))?;

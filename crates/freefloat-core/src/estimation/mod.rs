@@ -33,8 +33,8 @@ pub use analysis::{unexcited_directions, Direction, RANK_RTOL};
 pub use gram::GramLs;
 pub use modified_rls::{CoupledSample, Coupling, ModifiedRls};
 pub use momentum::{
-    identify_momentum, identify_momentum_with, momentum_regressor_pass, Method, MomentumProblem, GRAM_DIRECT_KAPPA_MAX,
-    GRAM_KAPPA_MAX,
+    identify_momentum, identify_momentum_interruptible, identify_momentum_with, momentum_regressor_pass, Method,
+    MomentumProblem, GRAM_DIRECT_KAPPA_MAX, GRAM_KAPPA_MAX,
 };
 pub use rls::Rls;
 pub use streaming::StreamingLs;

@@ -5,10 +5,12 @@ use super::gram::GramLs;
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
+use crate::interrupt::{Hook, POLL_INTERVAL};
 use crate::kinematics::forward_velocities_unchecked;
 use crate::model::Model;
 use crate::regressors::momentum_regressor_from_data_unchecked;
 use nalgebra::{DMatrix, DVector};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Samples per block: 64 samples = 384 rows × (n+1) columns (≈160 kB for n = 52), big enough for
 /// the blocked Gram product to run at full speed, small enough to stay in L2.
@@ -160,9 +162,17 @@ impl<'a> BlockBuilder<'a> {
     }
 
     /// Stream samples `range` block by block into `feed(block, rows)`.
-    fn run(&mut self, range: std::ops::Range<usize>, mut feed: impl FnMut(&mut DMatrix<f64>, usize)) -> Result<()> {
+    fn run(
+        &mut self,
+        range: std::ops::Range<usize>,
+        stop: &AtomicBool,
+        mut feed: impl FnMut(&mut DMatrix<f64>, usize),
+    ) -> Result<()> {
         let mut s = range.start;
         while s < range.end {
+            if stop.load(Ordering::Relaxed) {
+                return Err(FfError::interrupted(format!("identification stopped after {s} samples of a pass")));
+            }
             let cnt = BLOCK_SAMPLES.min(range.end - s);
             for slot in 0..cnt {
                 self.fill(s + slot, slot, cnt)?;
@@ -228,21 +238,35 @@ fn par_pass<A: Send>(
     t: usize,
     make: impl Fn() -> A + Sync,
     feed: impl Fn(&mut A, &mut DMatrix<f64>, usize) + Sync,
+    hook: &mut Option<Hook>,
 ) -> Result<Vec<A>> {
     let threads =
         if t < PARALLEL_MIN_SAMPLES { 1 } else { std::thread::available_parallelism().map_or(1, |x| x.get()).min(8) };
     let chunk = t.div_ceil(threads);
+    let stop = AtomicBool::new(false);
     let work = |range: std::ops::Range<usize>| -> Result<A> {
         let mut acc = make();
-        BlockBuilder::new(m, p).run(range, |b, rows| feed(&mut acc, b, rows))?;
+        BlockBuilder::new(m, p).run(range, &stop, |b, rows| feed(&mut acc, b, rows))?;
         Ok(acc)
     };
-    if threads == 1 {
+    if threads == 1 && hook.is_none() {
         return Ok(vec![work(0..t)?]);
     }
+    // The workers stream their samples; the calling thread (which may hold the interrupt hook, e.g. a Ctrl-C
+    // check that needs the Python interpreter) polls the hook every POLL_INTERVAL and raises the stop flag that
+    // the workers read before each block.
     std::thread::scope(|sc| {
         let handles: Vec<_> =
-            (0..threads).map(|i| (i * chunk)..((i + 1) * chunk).min(t)).map(|r| sc.spawn(move || work(r))).collect();
+            (0..threads).map(|i| (i * chunk)..((i + 1) * chunk).min(t)).map(|r| sc.spawn(|| work(r))).collect();
+        if let Some(h) = hook.as_mut() {
+            while !handles.iter().all(|j| j.is_finished()) {
+                std::thread::sleep(POLL_INTERVAL.min(std::time::Duration::from_millis(5)));
+                if !h(0.0) {
+                    stop.store(true, Ordering::Relaxed);
+                    break;
+                }
+            }
+        }
         handles.into_iter().map(|h| h.join().expect("estimation worker panicked")).collect()
     })
 }
@@ -261,11 +285,25 @@ pub fn identify_momentum(m: &Model, p: &MomentumProblem) -> Result<LsResult> {
 
 /// As [`identify_momentum`]; `force_qr` skips the normal equations (for testing and comparison).
 pub fn identify_momentum_with(m: &Model, p: &MomentumProblem, force_qr: bool) -> Result<LsResult> {
+    identify_momentum_interruptible(m, p, force_qr, None)
+}
+
+/// As [`identify_momentum_with`], stoppable: `hook` is called by the calling thread every few milliseconds
+/// while the worker threads stream the samples (at most ~20 ms apart in practice); its `false` stops every
+/// pass before its next block of samples and returns `FfError::Interrupted`.
+pub fn identify_momentum_interruptible(
+    m: &Model,
+    p: &MomentumProblem,
+    force_qr: bool,
+    mut hook: Option<Hook>,
+) -> Result<LsResult> {
+    let hook = &mut hook;
     let t = p.samples(m)?;
     let n = p.unknown_cols.len();
     if !force_qr {
-        let mut grams =
-            par_pass(m, p, t, || SplitGram::new(p), |g, b, rows| g.add(b, rows))?.into_iter().map(SplitGram::finish);
+        let mut grams = par_pass(m, p, t, || SplitGram::new(p), |g, b, rows| g.add(b, rows), hook)?
+            .into_iter()
+            .map(SplitGram::finish);
         let mut g = grams.next().expect("one thread");
         grams.for_each(|o| g.merge(&o));
         if let Some(f) = g.factor().filter(|f| f.kappa_scaled <= GRAM_KAPPA_MAX) {
@@ -276,10 +314,10 @@ pub fn identify_momentum_with(m: &Model, p: &MomentumProblem, force_qr: bool) ->
                     return Ok(finish(&f.r, f.x, rss, 6 * t, Method::Gram));
                 }
             }
-            return refine(m, p, t, f.r, f.x);
+            return refine(m, p, t, f.r, f.x, hook);
         }
     }
-    let mut qrs = par_pass(m, p, t, || StreamingLs::new(n), |q, b, rows| q.add_augmented(b, rows))?.into_iter();
+    let mut qrs = par_pass(m, p, t, || StreamingLs::new(n), |q, b, rows| q.add_augmented(b, rows), hook)?.into_iter();
     let mut qr = qrs.next().expect("one thread");
     qrs.for_each(|o| qr.merge(&o));
     qr.solve()
@@ -293,7 +331,14 @@ struct Residual {
 }
 
 /// One step of iterative refinement: x ← x + (RᵀR)⁻¹ Aᵀ(y − A x), and the RSS at the new x.
-fn refine(m: &Model, p: &MomentumProblem, t: usize, r: DMatrix<f64>, x: DVector<f64>) -> Result<LsResult> {
+fn refine(
+    m: &Model,
+    p: &MomentumProblem,
+    t: usize,
+    r: DMatrix<f64>,
+    x: DVector<f64>,
+    hook: &mut Option<Hook>,
+) -> Result<LsResult> {
     let n = x.len();
     let make = || Residual { atr: DVector::zeros(n), rss: 0.0, r: DVector::zeros(6 * BLOCK_SAMPLES) };
     let feed = |acc: &mut Residual, b: &mut DMatrix<f64>, rows: usize| {
@@ -304,7 +349,7 @@ fn refine(m: &Model, p: &MomentumProblem, t: usize, r: DMatrix<f64>, x: DVector<
         acc.rss += res.norm_squared();
         acc.atr.gemv_tr(1.0, &a, &res, 1.0);
     };
-    let mut parts = par_pass(m, p, t, make, feed)?.into_iter();
+    let mut parts = par_pass(m, p, t, make, feed, hook)?.into_iter();
     let mut acc = parts.next().expect("one thread");
     for o in parts {
         acc.atr += o.atr;
@@ -324,6 +369,6 @@ fn refine(m: &Model, p: &MomentumProblem, t: usize, r: DMatrix<f64>, x: DVector<
 pub fn momentum_regressor_pass(m: &Model, p: &MomentumProblem) -> Result<f64> {
     let t = p.samples(m)?;
     let n = p.unknown_cols.len();
-    let parts = par_pass(m, p, t, || 0.0, |acc: &mut f64, b, rows| *acc += b.view((0, n), (rows, 1)).sum())?;
+    let parts = par_pass(m, p, t, || 0.0, |acc: &mut f64, b, rows| *acc += b.view((0, n), (rows, 1)).sum(), &mut None)?;
     Ok(parts.into_iter().sum())
 }
