@@ -198,9 +198,11 @@ def measured(request):
 
 
 def _close(new, old, what):
+    # round-off only: the impulse blocks are running sums over every step (6 s at the 3D scenario's 0.5 ms:
+    # 12 000 terms, N·ε ≈ 2.7e-12), so the bound is 1e-11; a formula error shows at 1e-6 and above
     scale = np.abs(old).max(axis=tuple(range(1, old.ndim)), keepdims=True) + 1e-300
     err = (np.abs(new - old) / scale).max()
-    assert err < 1e-12, f"{what}: {err:.2e}"
+    assert err < 1e-11, f"{what}: {err:.2e}"
 
 
 @pytest.mark.parametrize("form", ["momentum", "force"])
