@@ -259,11 +259,19 @@ fn par_pass<A: Send>(
         let handles: Vec<_> =
             (0..threads).map(|i| (i * chunk)..((i + 1) * chunk).min(t)).map(|r| sc.spawn(|| work(r))).collect();
         if let Some(h) = hook.as_mut() {
+            // naps that start short (a small problem finishes in a millisecond and must not wait for a long nap)
+            // and grow to 5 ms; the hook itself is called at most every POLL_INTERVAL
+            let mut nap = std::time::Duration::from_micros(50);
+            let mut last = std::time::Instant::now();
             while !handles.iter().all(|j| j.is_finished()) {
-                std::thread::sleep(POLL_INTERVAL.min(std::time::Duration::from_millis(5)));
-                if !h(0.0) {
-                    stop.store(true, Ordering::Relaxed);
-                    break;
+                std::thread::sleep(nap);
+                nap = (nap * 2).min(std::time::Duration::from_millis(5));
+                if last.elapsed() >= POLL_INTERVAL {
+                    last = std::time::Instant::now();
+                    if !h(0.0) {
+                        stop.store(true, Ordering::Relaxed);
+                        break;
+                    }
                 }
             }
         }
