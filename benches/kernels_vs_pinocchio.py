@@ -43,7 +43,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 
-from compare_pinocchio import _clock, environment  # noqa: E402
+from compare_pinocchio import environment, run_interleaved  # noqa: E402
 
 SEED_ROBOT = "seed001_dual_arm_consistent"
 TARGETS = {"aba": 0.5, "rnea": 0.7, "crba": 0.7}
@@ -162,18 +162,6 @@ def check_agreement(m, ps, rng, n=5):
 # ---------------------------------------------------------------------------------------------------------------
 
 
-def interleaved(cases: dict, per: dict, repeats: int):
-    for f in cases.values():
-        f()
-    res = {k: {"wall": [], "cpu": []} for k in cases}
-    for _ in range(repeats):
-        for k, f in cases.items():
-            w, c, _ = _clock(f)
-            res[k]["wall"].append(w / per[k])
-            res[k]["cpu"].append(c / per[k])
-    return res
-
-
 def stats(s):
     return {
         "median": statistics.median(s["wall"]),
@@ -250,7 +238,7 @@ def bench_core(m, ps, args, rng):
     }
     per = {k: N for k in cases}
     per.update({"ff crba": n_crba, "pin crba loop": n_crba, "pin crba loop, 1-body model": n_crba})
-    res = interleaved(cases, per, R)
+    res = run_interleaved(cases, R, per)
     # Pinocchio's CRBA in C++ alone: the loop minus the same loop on a one-body model (binding + loop cost)
     res["pin crba (C++ estimate)"] = {
         k: [a - b for a, b in zip(res["pin crba loop"][k], res["pin crba loop, 1-body model"][k])]
@@ -290,7 +278,7 @@ def bench_single(m, ps, args, rng):
         "ff momentum": loop(lambda: ff.momentum(m, q, v)),
         "pin computeCentroidalMomentum": loop(lambda: pin.computeCentroidalMomentum(pm, pd, qp, vp)),
     }
-    res = interleaved(cases, {k: C for k in cases}, R)
+    res = run_interleaved(cases, R, {k: C for k in cases})
     rows = {
         "aba": ratio_stats(res["ff aba"], res["pin aba"]),
         "crba": ratio_stats(res["ff crba"], res["pin crba"]),
