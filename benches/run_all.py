@@ -516,30 +516,50 @@ def render(sections: list[Section], fast: bool, git: str, total: float) -> str:
     return "\n".join(lines) + "\n"
 
 
+def _faster(r: Row) -> str:
+    """'1.9× faster than PEER' / '0.7× the speed of PEER' for a peer-time / freefloat-time ratio."""
+    if r.ratio is None:
+        return f"no result against {r.peer}"
+    word = "faster than" if r.ratio >= 1 else "the speed of"
+    return f"{r.ratio:.2f}× {word} {r.peer}"
+
+
 def speed_paragraph(sections: list[Section], git: str, fast: bool) -> str:
+    """The README's speed paragraph: one sentence per capability, each number a row of this run's summary
+    table (never a number from an older run), each with its target when the issue set one."""
     rows = {s.name: s.rows for s in sections}
     parts = []
-    for r in rows.get("identify", []):
-        parts.append(f"{r.what.split(' (')[0]}: {r.ratio:.1f}× the numpy/scipy peer")
-    for r in rows.get("compare", [])[:6]:
-        if r.ratio is not None:
-            parts.append(f"{r.what}: {r.ratio:.2f}")
+
+    def add(r: Row, label: str) -> None:
+        if r.ratio is None:
+            return
+        if r.note.startswith("freefloat / reference") or "lower is better" in r.note:
+            text = f"{label}: {r.ratio:.2f}× the time of {r.peer}"
+        else:
+            text = f"{label}: {_faster(r)}"
+        parts.append(text + (f" (target {r.target})" if r.target else ""))
+
     for r in rows.get("kernels", []):
-        if r.what.startswith("ABA") and r.ratio is not None:
-            parts.append(f"{r.what}: {r.peer} / freefloat {r.ratio:.2f}")
+        if "naveen" in r.what or "seed001" in r.what:
+            add(r, r.what.split(",")[0].replace(" per call", "") + " on the Naveen robot")
     for r in rows.get("mujoco", [])[:1]:
-        if r.ratio is not None:
-            parts.append(f"10 s RK4 simulation, {r.what}: {r.ratio:.2f}")
-    for r in rows.get("ddp", []):
-        parts.append(f"{r.what}: {r.peer} / freefloat {r.ratio:.2f}")
+        add(r, "10 s 1 kHz RK4 simulation")
+    for r in rows.get("identify", []):
+        add(r, "identification " + r.what.split(" (")[0])
     for r in rows.get("rls", []):
-        parts.append(f"{r.what.split(' (')[0].replace('online estimator update ', 'estimator ')}: {r.freefloat}")
-    mode = " (fast mode: quick problem sizes)" if fast else ""
+        if r.what.startswith("modified_rls_3d") or "modified" in r.what:
+            tgt = f" (target {r.target})" if r.target else ""
+            parts.append(f"online 3D post-capture estimator: {r.freefloat} in wall / CPU time{tgt}")
+    for r in rows.get("ddp", []):
+        add(r, "DDP on the ch. 8 tracking problem")
+    for r in rows.get("basilisk", [])[:1]:
+        add(r, "hub with three reaction wheels")
+    mode = " in fast mode (quick problem sizes, indicative only)" if fast else ""
     body = "; ".join(parts) if parts else "no rows"
     return (
-        f"{SPEED_BEGIN}\nMeasured by `python benches/run_all.py`{mode} at git `{git}` "
-        f"(every number below is a row of [BENCHMARKS.md](BENCHMARKS.md), ratios > 1 mean freefloat is "
-        f"faster): {body}.\n{SPEED_END}"
+        f"{SPEED_BEGIN}\nSpeed, measured by `python benches/run_all.py`{mode} at git `{git}` against the strongest "
+        f"peer in the same run (every number is a row of [BENCHMARKS.md](BENCHMARKS.md), with its spread and the "
+        f"machine load there): {body}.\n{SPEED_END}"
     )
 
 
