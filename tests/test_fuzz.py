@@ -44,7 +44,9 @@ def test_a_finding_is_not_swallowed():
         R.check_with(lambda data: 1 / 0, b"")
 
 
-@pytest.mark.parametrize("target,runs", [("yaml_model", 3000), ("urdf_model", 3000), ("telemetry", 150), ("scenario", 60)])
+@pytest.mark.parametrize(
+    "target,runs", [("yaml_model", 3000), ("urdf_model", 3000), ("telemetry", 150), ("scenario", 60)]
+)
 def test_short_fuzz_run_finds_no_crash(target, runs, tmp_path):
     pytest.importorskip("atheris", reason="atheris is a test extra (pip install '.[test]')")
     r = subprocess.run(
