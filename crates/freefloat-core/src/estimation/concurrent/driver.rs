@@ -13,7 +13,8 @@ use crate::config::{dexpinv_unchecked as dexpinv, retract_unchecked as retract, 
 use crate::data::Data;
 use crate::dqdynamics::solve_system_unchecked;
 use crate::dynamics::hybrid_aba_unchecked;
-use crate::error::{FfError, Result};
+use crate::error::{FfError, Partial, Result};
+use crate::interrupt::{Hook, Poller};
 use crate::model::{JointType, Model};
 
 /// The joint actuation of (9.28): `amplitude · sin(frequency · t + phase)` on every joint DOF (N for a
@@ -296,6 +297,24 @@ pub fn estimate_recorded(
     f: &[super::V8],
     out: &mut [f64],
 ) -> Result<()> {
+    estimate_recorded_interruptible(nbodies, params, m0, dt, r, f, out, None)
+}
+
+/// [`estimate_recorded`], stoppable: `hook` is polled (at most every `POLL_INTERVAL`, with the fraction of
+/// samples done) after each sample; its `false` ends the run with `FfError::Interrupted` carrying
+/// `Partial::Samples(k)`: the first k rows of `out` hold the estimates at t_0 … t_{k−1}, the same numbers an
+/// uninterrupted call gives there (the estimator is causal).
+#[allow(clippy::too_many_arguments)]
+pub fn estimate_recorded_interruptible(
+    nbodies: usize,
+    params: ClParams,
+    m0: &[f64],
+    dt: f64,
+    r: &[super::M87],
+    f: &[super::V8],
+    out: &mut [f64],
+    hook: Option<Hook>,
+) -> Result<()> {
     let mut est = ConcurrentEstimator::new(nbodies, params, m0)?;
     if r.len() != f.len() || !r.len().is_multiple_of(nbodies) || r.is_empty() {
         return Err(FfError::arg(
@@ -306,11 +325,17 @@ pub fn estimate_recorded(
     let n = r.len() / nbodies;
     crate::check::check_len("out", out.len(), n * NP * nbodies)?;
     let np = NP * nbodies;
+    let mut poller = Poller::new(hook);
     for k in 0..n {
         est.set_time(k as f64 * dt);
         est.add_sample(&r[k * nbodies..(k + 1) * nbodies], &f[k * nbodies..(k + 1) * nbodies])?;
         est.estimate_into(&mut out[k * np..(k + 1) * np]);
         if k + 1 < n {
+            if let Err(FfError::Interrupted { msg, .. }) = poller.poll((k + 1) as f64 / n as f64, || {
+                format!("ch. 9 estimator stopped after sample {} of {n} (t = {} s)", k + 1, k as f64 * dt)
+            }) {
+                return Err(FfError::Interrupted { msg, partial: Some(Partial::Samples(k + 1)) });
+            }
             est.step(dt)?;
         }
     }
