@@ -455,3 +455,27 @@ def test_a_postcapture_run_stopped_late_keeps_the_motion_without_running_the_est
     part = exc.partial
     assert part.histories == {} and "estimators not run" in part.interrupted
     assert len(part.simulation["t"]) >= 2 and part.simulation["t"][-1] == part.t_end
+
+
+def test_ctrl_c_stops_simulate_many_and_keeps_every_member_so_far(robot):
+    m = robot
+    rng = np.random.default_rng(1)
+    v0 = 0.1 * rng.normal(size=(4, m.nv))
+    exc, latency = _run_interrupted(
+        lambda: ff.simulate_many(m, m.neutral(), v0, 1e4, 1e-3, record_every=100, threads=2), delay=0.5
+    )
+    assert isinstance(exc, ff.Interrupted), type(exc)
+    assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
+    runs = exc.partial
+    assert len(runs) == 4
+    cut = [k for k in range(4) if runs[k] is not None]
+    assert cut, runs
+    for k in cut:
+        tr = runs[k]
+        assert "interrupted" in tr.stats and 0 < tr.t[-1] < 1e4
+        # the member's samples are those of a plain simulation of the same member up to its stop
+        ref = ff.simulate(m, m.neutral(), v0[k], tr.t[-1], 1e-3, record_every=100)
+        n = min(len(ref), len(tr))
+        np.testing.assert_array_equal(tr.q[:n], ref.q[:n])
+    for k, e in runs.failures.items():  # members that had not started
+        assert isinstance(e, ff.Interrupted) and "before it started" in str(e)

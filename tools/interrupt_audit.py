@@ -54,19 +54,16 @@ def _run_file(tmp: Path) -> str:
         check=True,
         capture_output=True,
     )
-    return str(out / "trajectory.parquet")
+    return str(out)
 
 
 def commands(tmp: Path) -> list[tuple[str, list[str]]]:
     o = lambda name: str(tmp / f"out_{name}")  # noqa: E731
-    ddp = _scenario(
-        tmp, "valverde_ch8_tracking", lambda d: d.setdefault("ddp", {}).update(max_iter=100000)
-    )
     return [
         ("simulate", ["simulate", "naveen_dual_arm", "--t-final", "1e6", "--record-every", "100000", "--out", o("sim")]),
-        ("reactions", ["reactions", "naveen_dual_arm", "--t-final", "1e5", "--record-every", "1000", "--out", o("re")]),
-        ("demo", ["demo", "--t-final", "1e5", "--out", o("demo")]),
-        ("identify minimal", ["identify", "minimal", "naveen_dual_arm", "--simulate", "20000", "--out", o("idm")]),
+        ("reactions", ["reactions", "naveen_dual_arm", "--t-final", "4e4", "--record-every", "1000", "--out", o("re")]),
+        ("demo", ["demo", "--t-final", "4e4", "--out", o("demo")]),
+        ("identify minimal", ["identify", "minimal", "naveen_dual_arm", "--simulate", "256", "--out", o("idm")]),
         (
             "identify postcapture",
             [
@@ -100,7 +97,7 @@ def commands(tmp: Path) -> list[tuple[str, list[str]]]:
                 o("ad"),
             ],
         ),
-        ("control ddp", ["control", "ddp", ddp, "--no-plots", "--out", o("ddp")]),
+        ("control ddp", ["control", "ddp", "valverde_ch8_tracking", "--max-iter", "100000", "--no-plots", "--out", o("ddp")]),
         ("campaign", ["campaign", _campaign(tmp), "--out", o("camp"), "--workers", "1"]),
         ("measure", ["measure", _run_file(tmp), "--out", o("meas")]),
     ]
@@ -116,6 +113,9 @@ def audit_one(name: str, argv: list[str], cwd: Path, delay: float, fallback: flo
         stderr=subprocess.PIPE,
         text=True,
         env=env,
+        # a command started from a background job inherits an ignored SIGINT (and Python then keeps it
+        # ignored): give it the default disposition, as an interactive shell does
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
     )
     err: list[str] = []
     started = threading.Event()

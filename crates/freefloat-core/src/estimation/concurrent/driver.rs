@@ -14,7 +14,7 @@ use crate::data::Data;
 use crate::dqdynamics::solve_system_unchecked;
 use crate::dynamics::hybrid_aba_unchecked;
 use crate::error::{FfError, Partial, Result};
-use crate::interrupt::{Hook, Poller};
+use crate::interrupt::{Hook, Poller, POLL_INTERVAL};
 use crate::model::{JointType, Model};
 
 /// The joint actuation of (9.28): `amplitude · sin(frequency · t + phase)` on every joint DOF (N for a
@@ -194,6 +194,7 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
     const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
     const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
     let report_every = (steps / 200).max(1);
+    let mut last_report = std::time::Instant::now();
 
     for k in 0..=steps {
         let t = k as f64 * sc.dt;
@@ -222,9 +223,14 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
         out.block_singular_values.extend_from_slice(est.stack().block_singular_values());
         out.offers.push(offer);
         if let Some(p) = progress.as_mut() {
-            if (k % report_every == 0 || k == steps) && !p(t) {
-                out.interrupted = true;
-                break;
+            // at every 1/200 of the run and at least every POLL_INTERVAL (Ctrl-C within ~20 ms on a long run)
+            let due = k % report_every == 0 || k == steps || last_report.elapsed() >= POLL_INTERVAL;
+            if due {
+                last_report = std::time::Instant::now();
+                if !p(t) {
+                    out.interrupted = true;
+                    break;
+                }
             }
         }
         if k == steps {
