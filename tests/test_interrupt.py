@@ -309,7 +309,7 @@ def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
     again = d.evaluate(x, part.directions)  # one path on two threads: the same value up to rounding
     assert again["objective"][0] == pytest.approx(part.best.objective, rel=1e-12)
     start = d.evaluate(d.feasible_start(part.directions), part.directions)
-    assert part.best.objective <= start["objective"][0]
+    assert part.best.objective <= start["objective"][0] * (1 + 1e-12)  # (the start itself, up to rounding)
     assert part.to_dict()["interrupted"] is True
 
 
@@ -477,5 +477,5 @@ def test_ctrl_c_stops_simulate_many_and_keeps_every_member_so_far(robot):
         ref = ff.simulate(m, m.neutral(), v0[k], tr.t[-1], 1e-3, record_every=100)
         n = min(len(ref), len(tr))
         np.testing.assert_array_equal(tr.q[:n], ref.q[:n])
-    for k, e in runs.failures.items():  # members that had not started
+    for e in runs.failures.values():  # members that had not started
         assert isinstance(e, ff.Interrupted) and "before it started" in str(e)

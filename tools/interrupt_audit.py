@@ -40,7 +40,12 @@ def _scenario(tmp: Path, name: str, edit) -> str:
 
 def _campaign(tmp: Path) -> str:
     sc = _scenario(tmp, "zhang2020_2d_medium", lambda d: d.update(duration=600.0))
-    spec = {"name": "audit", "kind": "postcapture", "scenario": sc, "grid": {"initial.base_velocity.0": list(range(50))}}
+    spec = {
+        "name": "audit",
+        "kind": "postcapture",
+        "scenario": sc,
+        "grid": {"initial.base_velocity.0": list(range(50))},
+    }
     p = tmp / "campaign.yaml"
     p.write_text(yaml.safe_dump(spec))
     return str(p)
@@ -50,17 +55,26 @@ def _run_file(tmp: Path) -> str:
     """A long simulated run for `freefloat measure`."""
     out = tmp / "run"
     subprocess.run(
-        [sys.executable, "-m", "freefloat.cli", "simulate", "naveen_dual_arm", "--t-final", "100", "--out", str(out)],
+        [sys.executable, "-m", "freefloat.cli", "simulate", "naveen_dual_arm", "--t-final", "300", "--out", str(out)],
         check=True,
         capture_output=True,
     )
     return str(out)
 
 
+def _sensors(tmp: Path) -> str:
+    p = tmp / "sensors.yaml"
+    p.write_text("sensors:\n  - type: gyro\n    noise_density: 1.0e-5\n")
+    return str(p)
+
+
 def commands(tmp: Path) -> list[tuple[str, list[str]]]:
     o = lambda name: str(tmp / f"out_{name}")  # noqa: E731
     return [
-        ("simulate", ["simulate", "naveen_dual_arm", "--t-final", "1e6", "--record-every", "100000", "--out", o("sim")]),
+        (
+            "simulate",
+            ["simulate", "naveen_dual_arm", "--t-final", "1e6", "--record-every", "100000", "--out", o("sim")],
+        ),
         ("reactions", ["reactions", "naveen_dual_arm", "--t-final", "4e4", "--record-every", "1000", "--out", o("re")]),
         ("demo", ["demo", "--t-final", "4e4", "--out", o("demo")]),
         ("identify minimal", ["identify", "minimal", "naveen_dual_arm", "--simulate", "256", "--out", o("idm")]),
@@ -97,9 +111,12 @@ def commands(tmp: Path) -> list[tuple[str, list[str]]]:
                 o("ad"),
             ],
         ),
-        ("control ddp", ["control", "ddp", "valverde_ch8_tracking", "--max-iter", "100000", "--no-plots", "--out", o("ddp")]),
+        (
+            "control ddp",
+            ["control", "ddp", "valverde_ch8_tracking", "--max-iter", "100000", "--no-plots", "--out", o("ddp")],
+        ),
         ("campaign", ["campaign", _campaign(tmp), "--out", o("camp"), "--workers", "1"]),
-        ("measure", ["measure", _run_file(tmp), "--out", o("meas")]),
+        ("measure", ["measure", _run_file(tmp), "--sensors", _sensors(tmp), "--out", o("meas")]),
     ]
 
 
@@ -135,8 +152,12 @@ def audit_one(name: str, argv: list[str], cwd: Path, delay: float, fallback: flo
     time.sleep(delay)
     if p.poll() is not None:
         te.join(2)
-        return {"command": name, "result": f"ended before the signal (exit {p.returncode})", "ok": None,
-                "stderr": "".join(err)[-800:]}
+        return {
+            "command": name,
+            "result": f"ended before the signal (exit {p.returncode})",
+            "ok": None,
+            "stderr": "".join(err)[-800:],
+        }
     sent = time.monotonic()
     p.send_signal(signal.SIGINT)
     try:

@@ -73,8 +73,9 @@ def simulate_many(
     tq = None if torques is None else as_f64(torques, "torques")
     tt = None if torque_times is None else as_f64(torque_times, "torque_times")
     try:
-        dicts, failures = _simulate_many(model, q0, v0, t_final, dt, method, rtol, atol, max_step, record_every,
-                                         tq, tt, hold, P, threads, max_steps)
+        dicts, failures = _simulate_many(
+            model, q0, v0, t_final, dt, method, rtol, atol, max_step, record_every, tq, tt, hold, P, threads, max_steps
+        )
     except _core.Interrupted as e:
         # Ctrl-C: `partial` becomes the Trajectories so far (finished members whole, running ones cut short with
         # stats["interrupted"], members not started in `failures`)
@@ -84,8 +85,9 @@ def simulate_many(
     return _trajectories(model, dicts, failures, method, dt, t_final)
 
 
-def _simulate_many(model, q0, v0, t_final, dt, method, rtol, atol, max_step, record_every, tq, tt, hold, P, threads,
-                   max_steps):
+def _simulate_many(
+    model, q0, v0, t_final, dt, method, rtol, atol, max_step, record_every, tq, tt, hold, P, threads, max_steps
+):
     return _core.simulate_many(
         model._core,
         q0,

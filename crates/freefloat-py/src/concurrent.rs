@@ -4,11 +4,11 @@
 
 use crate::batch::model_arg;
 use crate::errors::{guard, guard_raw, input_err, interrupted_with, reraise_foreign, signal_hook, to_py};
-use freefloat_core::error::{FfError, Partial};
 use freefloat_core::dqdynamics::dq_dynamics;
+use freefloat_core::error::{FfError, Partial};
 use freefloat_core::estimation::concurrent::{
-    estimate_recorded_interruptible, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer, SampleBuilder,
-    SplitMix, M87, NP, V8,
+    estimate_recorded_interruptible, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer,
+    SampleBuilder, SplitMix, M87, NP, V8,
 };
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::PyKeyboardInterrupt;

@@ -3,8 +3,8 @@
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
 use crate::errors::{guard, guard_raw, input_err, interrupted_with, reraise_foreign, signal_hook, to_py};
-use freefloat_core::error::{FfError, Partial};
 use crate::model::PyModel;
+use freefloat_core::error::{FfError, Partial};
 use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
 use freefloat_core::postcapture::{simulate_postcapture, PostcaptureControl};
 use freefloat_core::spatial::V3;

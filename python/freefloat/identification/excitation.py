@@ -500,7 +500,7 @@ def _interrupted(design: ExcitationDesign, stage: dict, timings: dict, exc: Base
     where = (
         f"κ = {best.condition_number:.4g} on {len(dirs)} intervals" if best is not None else "no design evaluated yet"
     )
-    e = Interrupted(f"excitation design stopped in {stage['name']} ({exc or 'Ctrl-C'}); best so far: {where}")
+    e = Interrupted(f"excitation design stopped in {stage['name']} ({str(exc) or 'Ctrl-C'}); best so far: {where}")
     e.partial = partial
     return e
 

@@ -24,7 +24,6 @@ from .results import PostcaptureResult
 from .scenario import DEFAULT_NOISE, Scenario, load_scenario
 from .simulation import measure, simulate
 
-
 #: after a Ctrl-C in the simulation, the measurements and estimators over the partial motion run only if they are
 #: expected to take at most POST_BUDGET_S; expected cost = POST_COST_RATIO × the simulation's wall time
 #: (measured: 0.045-0.055 for the 2D scenarios, 0.032 for 3D; the ratio is kept conservative)

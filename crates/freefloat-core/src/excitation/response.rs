@@ -3,12 +3,12 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
+use crate::interrupt::stopped;
 use crate::kinematics::{base_twist_for_momentum, forward_velocities_unchecked};
 use crate::model::{JointType, Model};
 use crate::regressors::momentum_regressor_from_data_unchecked;
 use crate::sim::{integrate_base_poses, Steps};
 use crate::spatial::{rot_from_quat, Motion, Se3, V3};
-use crate::interrupt::stopped;
 use nalgebra::{DMatrix, Vector6};
 use std::sync::atomic::AtomicBool;
 

@@ -166,7 +166,13 @@ pub fn simulate_many_interruptible(
     Ok((results?, !finished))
 }
 
-fn run_member(m: &Model, spec: &BatchSpec, opts: &SimOptions, k: usize, stop: Option<&AtomicBool>) -> Result<Trajectory> {
+fn run_member(
+    m: &Model,
+    spec: &BatchSpec,
+    opts: &SimOptions,
+    k: usize,
+    stop: Option<&AtomicBool>,
+) -> Result<Trajectory> {
     // A panic inside one member must not take the batch (or the thread pool) down with it.
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let own;
