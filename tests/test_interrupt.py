@@ -159,13 +159,18 @@ def _start_cli(args, cwd):
 def _wait_running(p, seconds=120):
     """Wait (generously: a loaded machine imports slowly) until the simulation is under way: its progress bar
     appears on stderr."""
+    return _wait_for(p, "simulated", seconds)
+
+
+def _wait_for(p, marker, seconds=120):
+    """Wait until `marker` appears on the command's stderr (its progress bar: the work is under way)."""
     buf = []
     done = threading.Event()
 
     def reader():
         for line in iter(lambda: p.stderr.read(1), ""):
             buf.append(line)
-            if "simulated" in "".join(buf[-400:]):
+            if marker in "".join(buf[-400:]):
                 done.set()
         done.set()
 
@@ -225,3 +230,252 @@ def test_ctrl_c_stops_an_identification_solve_within_a_second(robot):
     res = least_squares(robot, q, v, h, mp)
     truth = mp.from_standard(robot.parameters())
     np.testing.assert_allclose(res.estimate, truth, rtol=1e-8, atol=1e-8)
+
+
+# -- the excitation objective batch and the excitation design --------------------------------------------------
+@pytest.fixture(scope="module")
+def design():
+    from freefloat.identification.excitation import ExcitationDesign
+
+    return ExcitationDesign(ff.models.load("naveen_dual_arm_offset"))
+
+
+def test_ctrl_c_stops_one_excitation_objective_batch_within_a_second(design):
+    """One engine call evaluating 300 candidate trajectories (the whole 256-interval path each, ~50 ms: about
+    15 s of work) is stopped by the calling thread's Ctrl-C check: the workers stop before their next grid
+    point."""
+    d = design
+    x = d.feasible_start(d.all_directions)
+    t = d._grid(len(d.all_directions))
+    q, qd, _ = d.cycloid(x, d.all_directions).evaluate(t)
+    Q = np.ascontiguousarray(np.broadcast_to(q, (300, *q.shape)))
+    QD = np.ascontiguousarray(np.broadcast_to(qd, (300, *qd.shape)))
+    exc, latency = _run_interrupted(lambda: d._objective(Q, QD), 0.5)
+    assert isinstance(exc, ff.Interrupted), type(exc)
+    assert "excitation objective stopped after" in str(exc) and "of 300" in str(exc), str(exc)
+    assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
+    # the same call, small, still completes and agrees with the one-path evaluation
+    one = d._objective(q[None], qd[None])
+    two = d._objective(np.stack([q, q]), np.stack([qd, qd]))
+    # (one path gets both threads, two paths one each: the Gram sums differ in rounding only)
+    np.testing.assert_allclose(two["objective"], np.repeat(one["objective"], 2), rtol=1e-12)
+
+
+def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
+    """Ctrl-C during step 1 of the design: `Interrupted.partial` is the best feasible design evaluated; its
+    objective, recomputed independently, is what it reports and no worse than the feasible start's."""
+    from freefloat.identification.excitation import PartialDesign
+
+    d = design
+    first = threading.Event()
+    evaluate = d.evaluate
+
+    def counted(X, dirs=None):  # the signal goes once the optimiser has finished its first evaluation
+        r = evaluate(X, dirs)
+        first.set()
+        return r
+
+    def run():
+        d.evaluate = counted
+        try:
+            return d.design(maxiter=1000, progress=False)
+        finally:
+            del d.evaluate
+
+    sent = []
+
+    def fire():
+        if first.wait(120):
+            time.sleep(0.3)
+            sent.append(time.monotonic())
+            os.kill(os.getpid(), signal.SIGINT)
+
+    th = threading.Thread(target=fire, daemon=True)
+    th.start()
+    with pytest.raises(KeyboardInterrupt) as info:
+        run()
+    latency = time.monotonic() - sent[0]
+    exc = info.value
+    assert isinstance(exc, ff.Interrupted), type(exc)
+    assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
+    part = exc.partial
+    assert isinstance(part, PartialDesign) and part.stopped_in == "step 1/3", part
+    assert part.best is not None and part.best.evaluations > 0
+    x = part.best.x
+    A, b = d.linear_constraints(part.directions)
+    assert np.all(A @ x >= b - 1e-9)
+    lo, hi = np.array(d.bounds()).T
+    assert np.all((lo <= x) & (x <= hi))
+    again = d.evaluate(x, part.directions)  # one path on two threads: the same value up to rounding
+    assert again["objective"][0] == pytest.approx(part.best.objective, rel=1e-12)
+    start = d.evaluate(d.feasible_start(part.directions), part.directions)
+    assert part.best.objective <= start["objective"][0] * (1 + 1e-12)  # (the start itself, up to rounding)
+    assert part.to_dict()["interrupted"] is True
+
+
+def test_sigint_to_freefloat_excite_keeps_the_best_trajectory(tmp_path):
+    out = tmp_path / "ex"
+    p = _start_cli(["excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--out", str(out)], tmp_path)
+    try:
+        buf, th = _wait_for(p, "C=")  # the first SQP iteration is done: there is a design to keep
+        time.sleep(0.5)
+        sent = time.monotonic()
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=60)
+        took = time.monotonic() - sent
+        th.join(5)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    err = "".join(buf)
+    assert p.returncode == 130, (p.returncode, err[-2000:])
+    assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
+    res = json.loads((out / "results.json").read_text())
+    assert res["interrupted"] is True and res["stopped_in"] == "step 1/3"
+    from freefloat.identification.excitation import load_trajectory
+
+    traj = load_trajectory(out / "trajectory.json")
+    assert traj is not None
+
+
+# -- ch. 9 estimate_recorded ------------------------------------------------------------------------------------
+def _cl_data(n):
+    from freefloat.identification import concurrent as cl
+
+    m = ff.models.load("valverde_ch9_two_arm")
+    rng = np.random.default_rng(3)
+    R, F = [], []
+    for _ in range(8):
+        q = m.random_configuration(rng)
+        r, f, _, _ = cl.sample(m, q, rng.normal(size=m.nv), rng.normal(size=m.nv))
+        R.append(r)
+        F.append(f)
+    reps = -(-n // 8)
+    R = np.ascontiguousarray(np.tile(np.array(R), (reps, 1, 1, 1))[:n])
+    F = np.ascontiguousarray(np.tile(np.array(F), (reps, 1, 1))[:n])
+    m0 = np.tile([0.1, 0.0, 0.0, 0.1, 0.0, 0.1, 1.0], m.nbodies)
+    return R, F, m0
+
+
+def test_ctrl_c_stops_ch9_estimate_recorded_and_keeps_the_estimates_so_far():
+    from freefloat import _core
+
+    R, F, m0 = _cl_data(120_000)  # ~30 µs a sample for 11 bodies: seconds of work (and 0.8 GB of data)
+    exc, latency = _run_interrupted(lambda: _core.cl_estimate(R, F, 1e-3, m0), delay=0.5)
+    assert isinstance(exc, ff.Interrupted), type(exc)
+    assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
+    part = exc.partial
+    k = len(part)
+    assert 10 <= k < len(R) and part.shape[1] == m0.size
+    assert f"after sample {k} of {len(R)}" in str(exc), str(exc)
+    # the estimator is causal: an uninterrupted call on the first k samples gives the same estimates, bit for bit
+    full = _core.cl_estimate(np.ascontiguousarray(R[:k]), np.ascontiguousarray(F[:k]), 1e-3, m0)
+    assert np.array_equal(part, full)
+
+
+# -- post-capture runs ------------------------------------------------------------------------------------------
+def _long_postcapture(duration=2000.0):
+    import copy
+
+    from freefloat import postcapture as pc
+
+    sc = copy.deepcopy(pc.load_scenario("zhang2020_2d_medium"))
+    sc.duration = duration
+    return sc
+
+
+def test_ctrl_c_in_a_postcapture_run_keeps_the_motion_and_the_estimates_so_far():
+    """The partial motion is the first part of an uninterrupted run of the same scenario, bit for bit, and the
+    estimator histories are those of the uninterrupted run up to the stop."""
+    from freefloat import postcapture as pc
+
+    sc = _long_postcapture()
+    exc, latency = _run_interrupted(lambda: pc.run(sc), delay=1.0)
+    assert isinstance(exc, ff.Interrupted), type(exc)
+    assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
+    part = exc.partial
+    assert part.interrupted and 1.0 < part.t_end < sc.duration
+    sim = part.simulation
+    assert sim["t"][-1] == part.t_end and len(sim["t"]) == round(part.t_end / sc.dt) + 1
+    short = _long_postcapture(part.t_end)
+    ref = pc.simulate(short)
+    for k in ("t", "q", "v", "ddq", "tau"):
+        assert np.array_equal(sim[k], ref[k]), k
+    done = pc.run(short)
+    assert set(part.histories) == set(done.histories) and len(part.histories) == 4
+    for key, (t, h) in done.histories.items():
+        assert np.array_equal(part.histories[key][0], t) and np.array_equal(part.histories[key][1], h), key
+    d = part.to_dict()
+    assert d["interrupted"] is True and d["t_end"] == part.t_end
+
+
+def test_sigint_to_freefloat_identify_postcapture_writes_the_partial_run(tmp_path):
+    import yaml
+
+    from freefloat.io import data as shipped
+
+    spec = yaml.safe_load(shipped.read_text("scenarios", "zhang2020_2d_medium.yaml"))
+    spec["duration"] = 2000.0
+    path = tmp_path / "long.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    out = tmp_path / "pc"
+    p = _start_cli(["identify", "postcapture", str(path), "--out", str(out), "--no-sweep"], tmp_path)
+    try:
+        buf, th = _wait_for(p, "stage")
+        time.sleep(1.0)
+        sent = time.monotonic()
+        p.send_signal(signal.SIGINT)
+        p.wait(timeout=60)
+        took = time.monotonic() - sent
+        th.join(5)
+    finally:
+        if p.poll() is None:
+            p.kill()
+    err = "".join(buf)
+    assert p.returncode == 130, (p.returncode, err[-2000:])
+    assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
+    res = json.loads((out / "results.json").read_text())
+    assert res["interrupted"] is True and 0 < res["t_end"] < 2000.0
+    sim = np.load(out / "simulation.npz")
+    assert sim["t"][-1] == pytest.approx(res["t_end"])
+    hist = np.load(out / "histories.npz")
+    assert hist["momentum_modified_rls"].shape[0] == len(hist["momentum_modified_rls_t"]) > 3
+
+
+def test_a_postcapture_run_stopped_late_keeps_the_motion_without_running_the_estimators(monkeypatch):
+    """When the estimators over the partial motion would delay the exit past the budget, only the motion is kept
+    (and the message says so): forced here with a zero budget."""
+    from freefloat import postcapture as pc
+    from freefloat.postcapture import pipeline
+
+    monkeypatch.setattr(pipeline, "POST_BUDGET_S", 0.0)
+    sc = _long_postcapture()
+    exc, latency = _run_interrupted(lambda: pc.run(sc), delay=0.5)
+    assert isinstance(exc, ff.Interrupted) and latency < STOP_WITHIN
+    part = exc.partial
+    assert part.histories == {} and "estimators not run" in part.interrupted
+    assert len(part.simulation["t"]) >= 2 and part.simulation["t"][-1] == part.t_end
+
+
+def test_ctrl_c_stops_simulate_many_and_keeps_every_member_so_far(robot):
+    m = robot
+    rng = np.random.default_rng(1)
+    v0 = 0.1 * rng.normal(size=(4, m.nv))
+    exc, latency = _run_interrupted(
+        lambda: ff.simulate_many(m, m.neutral(), v0, 1e4, 1e-3, record_every=100, threads=2), delay=0.5
+    )
+    assert isinstance(exc, ff.Interrupted), type(exc)
+    assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
+    runs = exc.partial
+    assert len(runs) == 4
+    cut = [k for k in range(4) if runs[k] is not None]
+    assert cut, runs
+    for k in cut:
+        tr = runs[k]
+        assert "interrupted" in tr.stats and 0 < tr.t[-1] < 1e4
+        # the member's samples are those of a plain simulation of the same member up to its stop
+        ref = ff.simulate(m, m.neutral(), v0[k], tr.t[-1], 1e-3, record_every=100)
+        n = min(len(ref), len(tr))
+        np.testing.assert_array_equal(tr.q[:n], ref.q[:n])
+    for e in runs.failures.values():  # members that had not started
+        assert isinstance(e, ff.Interrupted) and "before it started" in str(e)

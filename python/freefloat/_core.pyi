@@ -403,6 +403,8 @@ def check_sensors(sensors: ArrayLike) -> Any:
 def cl_estimate(r: ArrayLike, f: ArrayLike, dt: float, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1) -> Any:
     """The ch. 9 estimator alone over recorded data points: R (n, B, 8, 7), F (n, B, 8) taken every `dt` from
 t = 0; the same sequence as `cl_run` (offer, record, step) without the robot. Returns the estimates (n, 7B).
+Ctrl-C stops it within ~20 ms: `Interrupted.partial` holds the estimates finished, (k, 7B), equal to the
+first k rows of an uninterrupted call.
     """
 
 def cl_run(model: Model, q0: ArrayLike, v0: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1, dt: float = 0.01, t_final: float = 10.0, amplitude: ArrayLike = 0.5, frequency: ArrayLike = 1.0, phase: ArrayLike = 0.0, t_start: ArrayLike = 2.0, t_end: ArrayLike = 3.0, wrench_noise: ArrayLike = 0.0, rate_noise: ArrayLike = 0.0, noise_seed: ArrayLike = 7, progress: Callable[[float], Any] | None = None) -> Any:
@@ -532,7 +534,8 @@ Misra's Eq. 10, projected on every joint between the body and the root.
     """
 
 def excitation_objective(model: Model, q0: ArrayLike, iq: ArrayLike, iv: ArrayLike, step: float, q: ArrayLike, qd: ArrayLike, stride: int, offset: int, columns: ArrayLike, weight: float, n_signal: int, threads: int = 2) -> Any:
-    """Evaluate Naveen, Shah, Misra's eq. (32) for B joint paths at once (worker threads, GIL released).
+    """Evaluate Naveen, Shah, Misra's eq. (32) for B joint paths at once (worker threads, GIL released; Ctrl-C
+stops them within ~20 ms and raises `Interrupted`, partial None).
 q (B, S, n) / qd: driven joints' angles and rates on a grid of `step` seconds; iq, iv: their q and v
 indices; q0 (nq,): start configuration (base pose, other joints); rows at grid points offset + k·stride;
 columns: minimal-regressor columns (indices into 10·nbodies); n_signal: how many of the driven joints (the

@@ -61,14 +61,34 @@ def simulate_many(
     (B, T, nv), read at torque_times (default k·dt) with hold "zoh" or "linear". Arguments stacked on a batch
     axis must agree on B; an empty batch (B = 0) or mismatched sizes raise InputError naming the argument. A
     member that fails (e.g. non-physical parameters, a singular state) does not stop the others: see
-    `Trajectories.failures`. Torque functions of the state are not batched; use `simulate` for those."""
+    `Trajectories.failures`. Torque functions of the state are not batched; use `simulate` for those.
+
+    Ctrl-C stops every member within ~20 ms and raises `freefloat.Interrupted` whose `partial` is the
+    Trajectories so far: finished members whole, running ones up to the stop (`stats["interrupted"]`), members
+    not started in `failures`."""
     if not isinstance(model, Model):
         raise TypeError(f"expected a freefloat.Model, got {type(model).__name__}")
     q0, v0 = as_f64(q0, "q0"), as_f64(v0, "v0")
     P = None if params is None else as_f64(params, "params")
     tq = None if torques is None else as_f64(torques, "torques")
     tt = None if torque_times is None else as_f64(torque_times, "torque_times")
-    dicts, failures = _core.simulate_many(
+    try:
+        dicts, failures = _simulate_many(
+            model, q0, v0, t_final, dt, method, rtol, atol, max_step, record_every, tq, tt, hold, P, threads, max_steps
+        )
+    except _core.Interrupted as e:
+        # Ctrl-C: `partial` becomes the Trajectories so far (finished members whole, running ones cut short with
+        # stats["interrupted"], members not started in `failures`)
+        if isinstance(getattr(e, "partial", None), tuple):
+            e.partial = _trajectories(model, *e.partial, method, dt, t_final)
+        raise
+    return _trajectories(model, dicts, failures, method, dt, t_final)
+
+
+def _simulate_many(
+    model, q0, v0, t_final, dt, method, rtol, atol, max_step, record_every, tq, tt, hold, P, threads, max_steps
+):
+    return _core.simulate_many(
         model._core,
         q0,
         v0,
@@ -86,12 +106,17 @@ def simulate_many(
         int(threads),
         int(max_steps),
     )
+
+
+def _trajectories(model, dicts, failures, method, dt, t_final) -> Trajectories:
     out = []
     for d in dicts:
         if d is None:
             out.append(None)
             continue
         stats = {k: d.pop(k) for k in ("steps", "rejected", "evaluations")}
+        if "interrupted" in d:
+            stats["interrupted"] = d.pop("interrupted")
         stats.update(method=method, formulation="aba", dt=dt, t_final=t_final, total_mass=model.total_mass)
         out.append(
             Trajectory(**d, model_name=model.name, q_labels=model.q_labels(), v_labels=model.v_labels(), stats=stats)

@@ -59,6 +59,9 @@ pub enum FfError {
 pub enum Partial {
     /// A simulation's samples up to the interrupt.
     Trajectory(Box<crate::sim::Trajectory>),
+    /// The first `n` samples of a per-sample output (e.g. the estimates of
+    /// `estimation::concurrent::estimate_recorded_interruptible`) are finished.
+    Samples(usize),
 }
 
 /// `Result` with the engine's error.

@@ -8,6 +8,7 @@
 //! reported as [`FfError::Interrupted`], never as a numerical failure.
 
 use crate::error::{FfError, Result};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 /// Optional progress/interrupt hook: called with the fraction done (0..1), returns false to stop.
@@ -66,4 +67,41 @@ impl<'a> Poller<'a> {
             None => true,
         }
     }
+}
+
+/// Watch worker threads from the calling thread: while any of `handles` runs, call the hook at most every
+/// [`POLL_INTERVAL`] (with `fraction()`); on its `false` raise `stop`, which the workers read between units
+/// of work, and return `false` at once (the caller joins the workers, which then end within one unit).
+/// Without a hook this returns `true` immediately and the caller just joins.
+///
+/// The naps start short (a small job finishes in a millisecond and must not wait out a long nap) and grow
+/// to 5 ms. The calling thread is the one that may hold what the hook needs (e.g. the Python interpreter
+/// for a Ctrl-C check), which is why the hook is never called from a worker.
+pub fn supervise<T>(
+    hook: &mut Option<Hook>,
+    stop: &AtomicBool,
+    handles: &[std::thread::ScopedJoinHandle<'_, T>],
+    mut fraction: impl FnMut() -> f64,
+) -> bool {
+    let Some(h) = hook.as_mut() else { return true };
+    let mut nap = Duration::from_micros(50);
+    let mut last = Instant::now();
+    while !handles.iter().all(|j| j.is_finished()) {
+        std::thread::sleep(nap);
+        nap = (nap * 2).min(Duration::from_millis(5));
+        if last.elapsed() >= POLL_INTERVAL {
+            last = Instant::now();
+            if !h(fraction()) {
+                stop.store(true, Ordering::Relaxed);
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether a worker should stop before its next unit of work (see [`supervise`]).
+#[inline]
+pub fn stopped(stop: Option<&AtomicBool>) -> bool {
+    stop.is_some_and(|s| s.load(Ordering::Relaxed))
 }

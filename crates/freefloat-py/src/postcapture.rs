@@ -2,8 +2,9 @@
 //! estimators (ordinary RLS with forgetting; the paper's modified RLS, eqs. 34-38) as Python objects
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
-use crate::errors::{guard, input_err, reraise_foreign, signal_hook};
+use crate::errors::{guard, guard_raw, input_err, interrupted_with, reraise_foreign, signal_hook, to_py};
 use crate::model::PyModel;
+use freefloat_core::error::{FfError, Partial};
 use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
 use freefloat_core::postcapture::{simulate_postcapture, PostcaptureControl};
 use freefloat_core::spatial::V3;
@@ -96,12 +97,22 @@ pub fn postcapture_simulate<'py>(
         let raised = &mut raised;
         py.detach(move || {
             let mut hook = signal_hook(raised);
-            guard(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, Some(&mut hook)))
+            guard_raw(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, Some(&mut hook)))
         })
     };
     reraise_foreign(py, raised)?;
-    let tr = r?;
-    crate::simulate::traj_dict(py, &tr)
+    match r? {
+        Ok(tr) => crate::simulate::traj_dict(py, &tr),
+        // the samples recorded up to the stop become `Interrupted.partial` (a dict like the full result's)
+        Err(FfError::Interrupted { msg, partial }) => {
+            let partial = match partial {
+                Some(Partial::Trajectory(tr)) => Some(crate::simulate::traj_dict(py, &tr)?.into_any().unbind()),
+                _ => None,
+            };
+            Err(interrupted_with(py, &msg, partial))
+        }
+        Err(e) => Err(to_py(e)),
+    }
 }
 
 /// Ordinary recursive least squares with forgetting factor (Rust `estimation::Rls`).

@@ -323,7 +323,7 @@ pub fn simulate<'py>(
             let msg = if returned_false { format!("{msg} (the progress callback returned False)") } else { msg };
             let partial = match partial {
                 Some(freefloat_core::error::Partial::Trajectory(tr)) => Some(traj_dict(py, &tr)?.into_any().unbind()),
-                None => None,
+                _ => None,
             };
             Err(interrupted_with(py, &msg, partial))
         }

@@ -2,11 +2,12 @@
 //! cores with the GIL released (`freefloat_core::sim::simulate_many`).
 
 use crate::batch::{array_arg, model_arg};
-use crate::errors::{guard, input_err, to_py};
+use crate::errors::{guard, input_err, interrupted_with, reraise_foreign, signal_hook, to_py};
+use freefloat_core::error::{FfError, Partial};
 use freefloat_core::sim::{self, BatchSpec, Hold, Method, SimOptions, Stacked};
 use numpy::PyUntypedArrayMethods;
 use pyo3::prelude::*;
-use pyo3::types::PyList;
+use pyo3::types::{PyList, PyTuple};
 
 /// A stacked argument: (data, rows) for an array of shape (width,) [shared] or (B, width...) [one row per member].
 fn stacked(obj: &Bound<'_, PyAny>, name: &str, inner: usize) -> PyResult<(Vec<f64>, usize)> {
@@ -106,19 +107,44 @@ pub fn simulate_many<'py>(
         torque_times: times.as_deref(),
         hold,
     };
-    let results = py.detach(|| guard(|| sim::simulate_many(&m, &spec, &opts, threads, None)))?;
+    // Ctrl-C: the calling thread polls the hook (GIL re-taken for the signal check only) and stops every member
+    let mut raised: Option<PyErr> = None;
+    let r = {
+        let raised = &mut raised;
+        py.detach(move || {
+            let mut hook = signal_hook(raised);
+            guard(|| sim::simulate_many_interruptible(&m, &spec, &opts, threads, Some(&mut hook)))
+        })
+    };
+    reraise_foreign(py, raised)?;
+    let (results, stopped) = r?;
     let out = PyList::empty(py);
     let failures = PyList::empty(py);
+    let mut finished = 0;
     for (k, r) in results.into_iter().enumerate() {
         match r {
             Ok(tr) => {
+                finished += 1;
                 out.append(crate::simulate::traj_dict(py, &tr)?)?;
+            }
+            // stopped by Ctrl-C: the member's samples so far, marked as such
+            Err(FfError::Interrupted { msg, partial: Some(Partial::Trajectory(tr)) }) if stopped => {
+                let d = crate::simulate::traj_dict(py, &tr)?;
+                d.set_item("interrupted", msg)?;
+                out.append(d)?;
             }
             Err(e) => {
                 out.append(py.None())?;
                 failures.append((k, to_py(e).into_value(py)))?;
             }
         }
+    }
+    if stopped {
+        // `partial` is (members, failures) as the normal return: finished members whole, running ones cut
+        let n = out.len();
+        let msg = format!("simulate_many stopped by Ctrl-C: {finished} of {n} members finished");
+        let partial = PyTuple::new(py, [out.into_any(), failures.into_any()])?.into_any().unbind();
+        return Err(interrupted_with(py, &msg, Some(partial)));
     }
     Ok((out, failures))
 }

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import sys
+
 import click
 
 
@@ -61,6 +63,11 @@ def adaptive_cmd(scenario, out, baseline, alpha, no_compare):
     stopped = [k for k, r in res.runs.items() if r.data["interrupted"]]
     if stopped:
         click.echo(f"interrupted: {stopped[0]} stopped at t = {res.runs[stopped[0]].t[-1]:.2f} s; results so far kept")
+    if stopped:  # Ctrl-C: the results so far, without the figures (plotting would delay the exit by seconds)
+        if out:
+            path = res.save(out, figures=False)
+            click.echo(f"wrote {path} (interrupted; no figures)", err=True)
+        sys.exit(130)
     if out:
         path = res.save(out)
         click.echo(f"wrote {path} and figures in {out}")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import click
@@ -128,6 +129,14 @@ def identify_cl_cmd(scenario, out, ns, sweep, repeats, wrench_noise, rate_noise,
                 f"{lvl['rate_noise']:10.2e}   {lvl['ls_max_rel_error']:15.3e}   "
                 f"{lvl['cl_max_rel_error_on_combinations']:35.3e}   {lvl['ls_condition_number']:.3e}"
             )
+    if res.interrupted:  # Ctrl-C: the results up to it, without the figures (plotting would delay the exit)
+        if out:
+            o = Path(out)
+            o.mkdir(parents=True, exist_ok=True)
+            res.save(o, figures=False)
+            (o / "table.txt").write_text(table + "\n")
+            click.echo(f"wrote {o / 'results.json'} and {o / 'table.txt'} (interrupted; no figures)", err=True)
+        sys.exit(130)
     if out:
         o = Path(out)
         o.mkdir(parents=True, exist_ok=True)

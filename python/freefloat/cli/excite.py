@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import click
 import numpy as np
 
+from .._core import Interrupted
 from ._common import load_model, tqdm_bar
 
 
@@ -79,13 +81,37 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
         f"designing an exciting trajectory for {m.name} (guess: {g.name}): {design.n_arm} arm joints, "
         f"{len(design.wheels)} wheels, {design.n_intervals} direction combinations, {design.n_min} minimal parameters"
     )
-    res = design.design(maxiter=maxiter, progress=True, **({} if min_gain is None else {"min_gain": min_gain}))
+    try:
+        res = design.design(maxiter=maxiter, progress=True, **({} if min_gain is None else {"min_gain": min_gain}))
+    except Interrupted as e:  # Ctrl-C: keep the best design found so far
+        _save_partial(e, out)
+        sys.exit(130)
     click.echo(res.summary())
     click.echo(res.table3())
     click.echo("time: " + ", ".join(f"{k} {v:.1f} s" for k, v in res.timings.items()))
     res.save(out)
     summary = res.to_dict()
     extra = {}
+    try:
+        _after_design(design, res, summary, extra, m, g, out, maxiter, fourier, compare)
+    except KeyboardInterrupt:  # Ctrl-C in the Fourier baseline or the comparison: the design is already saved
+        during = "the Fourier baseline" if fourier and "fourier" not in summary else "the comparison"
+        summary["interrupted"] = f"after the design, in {during}"
+        Path(out, "results.json").write_text(json.dumps(summary, indent=2))
+        click.echo(
+            f"interrupted: {summary['interrupted']}; the design is complete and saved in {out} "
+            "(trajectory.json, results.json with `interrupted`)",
+            err=True,
+        )
+        sys.exit(130)
+    o = Path(out)
+    click.echo(f"wrote {o / 'trajectory.json'}, {o / 'results.json'} and {o / 'fig4.png'}")
+
+
+def _after_design(design, res, summary, extra, m, g, out, maxiter, fourier, compare):
+    """The optional Fourier baseline and comparison, after the design is saved."""
+    from ..identification import excitation as exc
+
     if fourier:
         bar = tqdm_bar(maxiter, "Fourier baseline: SQP over 11 coefficients per joint")
         try:
@@ -115,5 +141,16 @@ def excite_cmd(model, guess, weight, min_gain, maxiter, q_limit, rate_limit, acc
         summary["comparison"] = exc.compare(m, res, progress=True, extra=extra)
         click.echo(exc.comparison_table(summary["comparison"]))
         Path(out, "results.json").write_text(json.dumps(summary, indent=2))
+
+
+def _save_partial(e, out) -> None:
+    """After Ctrl-C during the design: say where it stopped and write the best design so far (trajectory.json,
+    results.json with `interrupted: true`)."""
+    part = getattr(e, "partial", None)
+    click.echo(f"interrupted: {e}", err=True)
+    if part is None:
+        return
+    part.save(out)
     o = Path(out)
-    click.echo(f"wrote {o / 'trajectory.json'}, {o / 'results.json'} and {o / 'fig4.png'}")
+    kept = f"{o / 'trajectory.json'} (the best design so far) and " if part.best is not None else ""
+    click.echo(f"  wrote {kept}{o / 'results.json'} (interrupted: true; no figure)", err=True)

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import click
+
+from .._core import Interrupted
 
 
 @click.command("postcapture")
@@ -74,8 +77,12 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
     if impulses:
         sc.measurement["impulses"] = impulses
     t0 = _time.perf_counter()
-    with tqdm(total=2, desc=f"{sc.name}", unit="stage", leave=False) as bar:
-        res = pc.run(sc, seed=seed, progress=lambda what: (bar.set_postfix_str(what), bar.update(1)))
+    try:
+        with tqdm(total=2, desc=f"{sc.name}", unit="stage", leave=False) as bar:
+            res = pc.run(sc, seed=seed, progress=lambda what: (bar.set_postfix_str(what), bar.update(1)))
+    except Interrupted as e:  # Ctrl-C: keep the simulated part and the estimator histories up to the stop
+        _save_partial(e, out)
+        sys.exit(130)
     wall = _time.perf_counter() - t0
     click.echo(res.table())
     for w in res.warnings():  # also in results.json ("warnings")
@@ -94,8 +101,13 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
     sw = None
     if sweep and sc.sweep:
         vels = sc.sweep["velocities"]
-        with tqdm(total=len(vels), desc="velocity sweep", unit="run", leave=False) as bar:
-            sw = pc.sweep(sc, progress=lambda k, n: bar.update(1))
+        try:
+            with tqdm(total=len(vels), desc="velocity sweep", unit="run", leave=False) as bar:
+                sw = pc.sweep(sc, progress=lambda k, n: bar.update(1))
+        except KeyboardInterrupt:  # the main run is complete: keep it, without the sweep
+            res.interrupted, res.t_end = "stopped in the velocity sweep (the main run is complete)", sc.duration
+            _save_partial(Interrupted(res.interrupted), out, res)
+            sys.exit(130)
         click.echo(pc.sweep_table(sw, paper=sc.paper_sweep))
     if out:
         path = res.save(out)
@@ -105,6 +117,22 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
             path.write_text(json.dumps(data, indent=1))
             pc.plot_sweep(sw, Path(out))
         click.echo(f"wrote {path} and figures in {out}")
+
+
+def _save_partial(e, out, res=None) -> None:
+    """After Ctrl-C: say where the run stopped and, with --out, write what was finished (results.json with
+    `interrupted: true`, table.txt, simulation.npz, histories.npz; no figures)."""
+    res = getattr(e, "partial", None) if res is None else res
+    click.echo(f"interrupted: {e}", err=True)
+    if res is None:
+        return
+    if res.histories:
+        click.echo(res.table())
+    if not out:
+        click.echo("  (give --out to keep the part simulated and the estimator histories)", err=True)
+        return
+    path = res.save(out)
+    click.echo(f"  wrote {path}, table.txt, simulation.npz and histories.npz in {out} (no figures)", err=True)
 
 
 @click.command("scenarios")

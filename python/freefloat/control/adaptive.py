@@ -435,8 +435,8 @@ class AdaptiveResult:
             lines.append("  thesis: " + ", ".join(f"{k} = {v}" for k, v in self.scenario.paper.items()))
         return "\n".join(lines)
 
-    def save(self, out: str | Path) -> Path:
-        """Write results.json and the figures into `out`; returns the results.json path."""
+    def save(self, out: str | Path, figures: bool = True) -> Path:
+        """Write results.json and (with `figures`) the figures into `out`; returns the results.json path."""
         import json
 
         from .adaptive_plots import plot_all
@@ -445,7 +445,7 @@ class AdaptiveResult:
         out.mkdir(parents=True, exist_ok=True)
         p = out / "results.json"
         d = self.to_dict()
-        d["figures"] = [f.name for f in plot_all(self, out)]
+        d["figures"] = [f.name for f in plot_all(self, out)] if figures else []
         p.write_text(json.dumps(d, indent=1, default=_json_default))
         return p
 

@@ -35,13 +35,13 @@ from __future__ import annotations
 import numpy as np
 
 from .. import _core
-from .._core import InputError, NumericalError
+from .._core import InputError, Interrupted, NumericalError
 from ..constants import DELTA, PAPER_KAPPA, PAPER_KEPT, PAPER_RATE_NOISE, U_MAX, WHEEL_RANGE, WHEEL_START
 from ..io.trajectory_files import load_trajectory, save_trajectory
 from ..trajectories import Cycloidal, Fourier, direction_combinations
 from .comparison import compare, comparison_table
 from .estimation import absolute_columns
-from .excitation_results import DesignResult, Limits, StepResult
+from .excitation_results import DesignResult, Limits, PartialDesign, StepResult
 from .minimal import minimal_parameters
 from .pruning import MIN_GAIN, PruneResult, plot_fig4, prune_intervals, significant
 
@@ -56,6 +56,7 @@ __all__ = [
     "WEIGHT",
     "DesignResult",
     "ExcitationDesign",
+    "PartialDesign",
     "Limits",
     "PruneResult",
     "StepResult",
@@ -240,12 +241,13 @@ class ExcitationDesign:
         return x
 
     # -- the three steps ----------------------------------------------------------------------------------
-    def optimize(self, directions, x0=None, maxiter: int = 100, progress=None) -> StepResult:
-        """SLSQP over the 2n seeds on log C with forward-difference gradients (one batched Rust call each)."""
+    def optimize(self, directions, x0=None, maxiter: int = 100, progress=None, best: _Best | None = None) -> StepResult:
+        """SLSQP over the 2n seeds on log C with forward-difference gradients (one batched Rust call each).
+        best: a `_Best` that keeps the best feasible point evaluated so far (what a Ctrl-C keeps)."""
         dirs = np.asarray(directions)
         x0 = self.feasible_start(dirs, x0)
         A, b = self.linear_constraints(dirs)
-        res, count = _slsqp(lambda X: self.evaluate(X, dirs), x0, A, b, self.bounds(), maxiter, progress)
+        res, count = _slsqp(lambda X: self.evaluate(X, dirs), x0, A, b, self.bounds(), maxiter, progress, best)
         x = np.asarray(res.x, dtype=float)
         # SLSQP may end a hair outside a bound: put the result back inside before reporting it.
         lo, hi = np.array(self.bounds()).T
@@ -261,32 +263,49 @@ class ExcitationDesign:
         return prune_intervals(blocks, u_max, delta, min_gain)
 
     def design(self, x0=None, maxiter: int = 100, progress: bool = True, min_gain: float = MIN_GAIN) -> DesignResult:
-        """The three steps. progress: a tqdm bar per step."""
+        """The three steps. progress: a tqdm bar per step.
+
+        Ctrl-C stops the design within a second (the objective batch polls for it in the engine) and raises
+        `freefloat.Interrupted` whose `partial` is a `PartialDesign`: the best feasible design evaluated so far
+        (in step 3 on the kept intervals; in step 1, or before step 3 has evaluated a point, on all intervals)."""
         import time
 
         timings = {}
-        t0 = time.perf_counter()
-        s1 = self._run_step("step 1/3: SQP on all intervals", self.all_directions, x0, maxiter, progress)
-        timings["step1"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
-        bar = None
-        if progress:
-            from tqdm.auto import tqdm
-
-            bar = tqdm(total=len(self.all_directions), desc="step 2/3: Algorithm 1 on the intervals", leave=False)
+        stage = {"name": "step 1/3", "best": _Best(), "dirs": self.all_directions, "s1": None, "prune": None}
         try:
-            pr = self.prune(s1.x, min_gain=min_gain)
-            if bar is not None:
-                bar.update(bar.total)
-                bar.set_postfix(kept=len(pr.kept))
-        finally:
-            if bar is not None:
-                bar.close()
-        timings["step2"] = time.perf_counter() - t0
-        kept_dirs = self.all_directions[pr.kept]
-        t0 = time.perf_counter()
-        s3 = self._run_step("step 3/3: SQP on the kept intervals", kept_dirs, s1.x, maxiter, progress)
-        timings["step3"] = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            s1 = self._run_step(
+                "step 1/3: SQP on all intervals", self.all_directions, x0, maxiter, progress, stage["best"]
+            )
+            stage["s1"] = s1
+            timings["step1"] = time.perf_counter() - t0
+            stage["name"] = "step 2/3"
+            t0 = time.perf_counter()
+            bar = None
+            if progress:
+                from tqdm.auto import tqdm
+
+                bar = tqdm(total=len(self.all_directions), desc="step 2/3: Algorithm 1 on the intervals", leave=False)
+            try:
+                pr = self.prune(s1.x, min_gain=min_gain)
+                if bar is not None:
+                    bar.update(bar.total)
+                    bar.set_postfix(kept=len(pr.kept))
+            finally:
+                if bar is not None:
+                    bar.close()
+            stage["prune"] = pr
+            timings["step2"] = time.perf_counter() - t0
+            kept_dirs = self.all_directions[pr.kept]
+            stage.update(name="step 3/3", best=_Best(), dirs=kept_dirs)
+            t0 = time.perf_counter()
+            s3 = self._run_step(
+                "step 3/3: SQP on the kept intervals", kept_dirs, s1.x, maxiter, progress, stage["best"]
+            )
+            timings["step3"] = time.perf_counter() - t0
+        except KeyboardInterrupt as e:
+            timings["interrupted_after"] = sum(timings.values()) + time.perf_counter() - t0
+            raise _interrupted(self, stage, timings, e) from None
         if not s3.condition_number < KAPPA_UNEXCITED:
             raise NumericalError(
                 f"the designed trajectory does not excite every minimal parameter of '{self.guess.name}' "
@@ -371,7 +390,7 @@ class ExcitationDesign:
         step = _step_result(x, evaluate(x[None]), res, count)
         return step, self.fourier(x, dirs, n_terms)
 
-    def _run_step(self, desc, dirs, x0, maxiter, progress):
+    def _run_step(self, desc, dirs, x0, maxiter, progress, best=None):
         bar = None
         if progress:
             from tqdm.auto import tqdm
@@ -384,7 +403,7 @@ class ExcitationDesign:
                 bar.set_postfix(C=f"{c:.4g}")
 
         try:
-            res = self.optimize(dirs, x0, maxiter, cb)
+            res = self.optimize(dirs, x0, maxiter, cb, best)
             if bar is not None:  # converged before maxiter: the step is done, so its bar is full
                 bar.update(bar.total - bar.n)
                 bar.refresh()
@@ -394,10 +413,37 @@ class ExcitationDesign:
                 bar.close()
 
 
-def _slsqp(evaluate, x0, A, b, bounds, maxiter: int, progress):
+class _Best:
+    """The best point an optimisation has evaluated that satisfies its constraints: what a Ctrl-C keeps."""
+
+    def __init__(self):
+        self.x, self.f, self.row, self.evaluations, self.iterations = None, np.inf, None, 0, 0
+
+    def offer(self, x, f, r, A, b, bounds) -> None:
+        if not f < self.f or np.any(A @ x < b - 1e-9):
+            return
+        if bounds is not None and any(not lo - 1e-12 <= xi <= hi + 1e-12 for xi, (lo, hi) in zip(x, bounds)):
+            return
+        self.x, self.f = x.copy(), f
+        self.row = {k: np.asarray(v)[:1] for k, v in r.items()}
+
+    def step_result(self) -> StepResult | None:
+        if self.x is None:
+            return None
+        msg = "interrupted (Ctrl-C): the best feasible point evaluated so far"
+        return _step_result(self.x, self.row, _Report(self.iterations, msg), self.evaluations)
+
+
+class _Report:
+    def __init__(self, nit, message):
+        self.nit, self.message = nit, message
+
+
+def _slsqp(evaluate, x0, A, b, bounds, maxiter: int, progress, best: _Best | None = None):
     """SLSQP on log C (eq. 32) under A x >= b and `bounds`. `evaluate(X)` takes a batch of points; the value and
     its forward-difference gradient (steps 1e-6 relative) come from one batched call per point, cached so
-    SLSQP's separate value and gradient requests cost one call. Returns (scipy result, evaluations)."""
+    SLSQP's separate value and gradient requests cost one call. Returns (scipy result, evaluations).
+    best: kept up to date with the best feasible point evaluated (for a Ctrl-C)."""
     from scipy.optimize import minimize
 
     cache, count, it = {}, [0], [0]
@@ -407,10 +453,14 @@ def _slsqp(evaluate, x0, A, b, bounds, maxiter: int, progress):
         if key not in cache:
             h = 1e-6 * np.maximum(1.0, np.abs(x))
             X = np.vstack([x, x + np.diag(h)])
-            f = _log_objective(evaluate(X)["objective"])
+            r = evaluate(X)
+            f = _log_objective(r["objective"])
             count[0] += len(X)
             cache.clear()
             cache[key] = (f[0], (f[1:] - f[0]) / h)
+            if best is not None:
+                best.evaluations, best.iterations = count[0], it[0]
+                best.offer(x, f[0], r, A, b, bounds)
         return cache[key]
 
     def callback(xk):
@@ -429,6 +479,30 @@ def _slsqp(evaluate, x0, A, b, bounds, maxiter: int, progress):
         callback=callback,
     )
     return res, count[0]
+
+
+def _interrupted(design: ExcitationDesign, stage: dict, timings: dict, exc: BaseException):
+    """The `Interrupted` a Ctrl-C during `design` becomes: partial = the best design so far."""
+    best = stage["best"].step_result()
+    dirs = stage["dirs"]
+    s1 = stage["s1"]
+    if best is None and s1 is not None:  # step 3 had not evaluated a point yet: the finished step 1
+        best, dirs = s1, design.all_directions
+    partial = PartialDesign(
+        design=design,
+        stopped_in=stage["name"],
+        best=best,
+        directions=dirs,
+        step1=s1,
+        prune=stage["prune"],
+        timings=timings,
+    )
+    where = (
+        f"κ = {best.condition_number:.4g} on {len(dirs)} intervals" if best is not None else "no design evaluated yet"
+    )
+    e = Interrupted(f"excitation design stopped in {stage['name']} ({str(exc) or 'Ctrl-C'}); best so far: {where}")
+    e.partial = partial
+    return e
 
 
 def _log_objective(c):

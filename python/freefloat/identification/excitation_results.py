@@ -159,3 +159,64 @@ def _step_dict(s: StepResult, n: int) -> dict:
         "evaluations": s.evaluations,
         "message": s.message,
     }
+
+
+@dataclass
+class PartialDesign:
+    """What an interrupted `ExcitationDesign.design` keeps (`freefloat.Interrupted.partial`): the best feasible
+    design evaluated before the Ctrl-C, on `directions` (the kept intervals once step 3 has evaluated a point,
+    else all intervals), and the steps that had finished."""
+
+    design: ExcitationDesign
+    stopped_in: str  # "step 1/3", "step 2/3" or "step 3/3"
+    best: StepResult | None  # None: stopped before the first evaluation
+    directions: np.ndarray
+    step1: StepResult | None = None
+    prune: PruneResult | None = None
+    timings: dict = field(default_factory=dict)
+
+    def trajectory(self) -> Cycloidal | None:
+        """The best trajectory so far (arm joints then wheels), or None."""
+        return None if self.best is None else self.design.cycloid(self.best.x, self.directions)
+
+    def summary(self) -> str:
+        if self.best is None:
+            return f"interrupted in {self.stopped_in} before any design was evaluated"
+        return (
+            f"interrupted in {self.stopped_in}; best design so far: κ = {self.best.condition_number:.4g}, "
+            f"C = {self.best.objective:.4g} on {len(self.directions)} intervals "
+            f"({len(self.directions) * self.design.interval:g} s), {self.best.evaluations} evaluations"
+        )
+
+    def to_dict(self) -> dict:
+        d = self.design
+        out = {
+            "interrupted": True,
+            "stopped_in": self.stopped_in,
+            "model": d.guess.name,
+            "arm_joints": d.arm,
+            "wheels": d.wheels,
+            "interval": d.interval,
+            "best": None if self.best is None else _step_dict(self.best, d.n_arm),
+            "n_intervals": int(len(self.directions)),
+            "n_candidates": d.n_intervals,
+            "n_min": d.n_min,
+            "weight": d.weight,
+            "timings_s": self.timings,
+        }
+        if self.step1 is not None:
+            out["step1"] = _step_dict(self.step1, d.n_arm)
+        if self.prune is not None:
+            out["kept_intervals"] = self.prune.kept.tolist()
+        return out
+
+    def save(self, directory) -> Path:
+        """DIR/trajectory.json (the best design so far, when there is one) and results.json (with
+        `interrupted: true`); no figure, so that the exit after Ctrl-C is not delayed by plotting."""
+        out = Path(directory)
+        out.mkdir(parents=True, exist_ok=True)
+        tr = self.trajectory()
+        if tr is not None:
+            save_trajectory(out / "trajectory.json", tr, self.design.joints, self.design.guess.name)
+        (out / "results.json").write_text(json.dumps(self.to_dict(), indent=2))
+        return out

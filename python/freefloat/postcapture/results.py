@@ -37,6 +37,11 @@ class PostcaptureResult:
     histories: dict  # (method, solver) -> (t (N,), params (N, P))
     timings: dict
     residuals: dict = field(default_factory=dict)
+    #: set when the run was stopped (Ctrl-C): where; the histories then cover t = 0 .. t_end only
+    interrupted: str | None = None
+    t_end: float | None = None
+    #: the simulated samples (the engine's dict: t, q, v, ddq, tau, ...), when the run made them
+    simulation: dict | None = None
 
     def final(self, method, solver):
         return self.histories[(method, solver)][1][-1]
@@ -85,6 +90,8 @@ class PostcaptureResult:
             "measurement": self.scenario.measurement,
             "methods": {},
         }
+        if self.interrupted is not None:
+            out.update(interrupted=True, stopped=self.interrupted, t_end=self.t_end)
         for (method, solver), (_t, h) in self.histories.items():
             tt = self.transits(method, solver)
             err = self.rel_error(method, solver)
@@ -106,7 +113,9 @@ class PostcaptureResult:
         """Our final estimates (transit time to the scenario's tolerance, 'stays' reading) beside the paper's."""
         tol = self.scenario.tolerance
         lines = [
-            f"{self.scenario.name}: final estimates at t = {self.scenario.duration:g} s, "
+            (f"INTERRUPTED ({self.interrupted}): " if self.interrupted else "")
+            + f"{self.scenario.name}: final estimates at t = "
+            + f"{self.scenario.duration if self.t_end is None else self.t_end:g} s, "
             f"(transit time to {tol * 100:g} %, after which the estimate stays within)"
         ]
         for method in METHODS:
@@ -143,10 +152,22 @@ class PostcaptureResult:
         return "\n".join(lines)
 
     def save(self, out) -> Path:
+        """results.json, table.txt and the figures; for an interrupted run also simulation.npz (the samples
+        simulated) and histories.npz (each estimator's t and estimates), and no figures (plotting would delay
+        the exit after Ctrl-C)."""
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         (out / "results.json").write_text(json.dumps(self.to_dict(), indent=1))
         (out / "table.txt").write_text(self.table() + "\n")
+        if self.interrupted is not None:
+            if self.simulation is not None:
+                arrays = {k: v for k, v in self.simulation.items() if isinstance(v, np.ndarray)}
+                np.savez(out / "simulation.npz", **arrays)
+            hist = {}
+            for (method, solver), (t, h) in self.histories.items():
+                hist[f"{method}_{solver}_t"], hist[f"{method}_{solver}"] = np.asarray(t), np.asarray(h)
+            np.savez(out / "histories.npz", names=np.array(self.names, dtype=str), **hist)
+            return out / "results.json"
         from .plots import plot_histories
 
         plot_histories(self, out)

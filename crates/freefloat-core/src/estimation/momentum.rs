@@ -5,7 +5,7 @@ use super::gram::GramLs;
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
-use crate::interrupt::{Hook, POLL_INTERVAL};
+use crate::interrupt::{supervise, Hook};
 use crate::kinematics::forward_velocities_unchecked;
 use crate::model::Model;
 use crate::regressors::momentum_regressor_from_data_unchecked;
@@ -258,23 +258,7 @@ fn par_pass<A: Send>(
     std::thread::scope(|sc| {
         let handles: Vec<_> =
             (0..threads).map(|i| (i * chunk)..((i + 1) * chunk).min(t)).map(|r| sc.spawn(|| work(r))).collect();
-        if let Some(h) = hook.as_mut() {
-            // naps that start short (a small problem finishes in a millisecond and must not wait for a long nap)
-            // and grow to 5 ms; the hook itself is called at most every POLL_INTERVAL
-            let mut nap = std::time::Duration::from_micros(50);
-            let mut last = std::time::Instant::now();
-            while !handles.iter().all(|j| j.is_finished()) {
-                std::thread::sleep(nap);
-                nap = (nap * 2).min(std::time::Duration::from_millis(5));
-                if last.elapsed() >= POLL_INTERVAL {
-                    last = std::time::Instant::now();
-                    if !h(0.0) {
-                        stop.store(true, Ordering::Relaxed);
-                        break;
-                    }
-                }
-            }
-        }
+        supervise(hook, &stop, &handles, || 0.0);
         handles.into_iter().map(|h| h.join().expect("estimation worker panicked")).collect()
     })
 }

@@ -10,5 +10,5 @@
 mod objective;
 mod response;
 
-pub use objective::{evaluate, evaluate_batch, Evaluation, ObjectiveSpec};
+pub use objective::{evaluate, evaluate_batch, evaluate_batch_interruptible, Evaluation, ObjectiveSpec};
 pub use response::{base_twist_zero_momentum, excitation_rows, ExcitationRows, JointPath};

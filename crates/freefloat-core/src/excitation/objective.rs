@@ -5,9 +5,11 @@
 //! components and the rates of the designed (arm) joints at the sampled points — `ObjectiveSpec::n_signal`.
 
 use super::response::{sample_blocks, JointPath};
-use crate::error::Result;
+use crate::error::{FfError, Result};
+use crate::interrupt::{stopped, supervise, Hook};
 use crate::model::Model;
 use nalgebra::DMatrix;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Everything about an evaluation except the joint path.
 pub struct ObjectiveSpec<'a> {
@@ -43,7 +45,13 @@ pub struct Evaluation {
 
 /// Evaluate eq. (32) for one joint path, on `spec.threads` worker threads.
 pub fn evaluate(m: &Model, spec: &ObjectiveSpec, path: &JointPath) -> Result<Evaluation> {
-    let ex = sample_blocks(m, spec.q0, path, spec.stride, spec.offset, spec.columns, spec.n_signal, spec.threads)?;
+    evaluate_until(m, spec, path, None)
+}
+
+/// [`evaluate`], ending with `FfError::Interrupted` once `stop` is raised (read before every grid point).
+fn evaluate_until(m: &Model, spec: &ObjectiveSpec, path: &JointPath, stop: Option<&AtomicBool>) -> Result<Evaluation> {
+    let ex =
+        sample_blocks(m, spec.q0, path, spec.stride, spec.offset, spec.columns, spec.n_signal, spec.threads, stop)?;
     let gram = gram(&ex.blocks, spec.columns.len());
     let mut lam: Vec<f64> = gram.symmetric_eigenvalues().iter().map(|&l| l.max(0.0)).collect();
     lam.sort_by(|a, b| b.total_cmp(a));
@@ -64,17 +72,61 @@ pub fn evaluate(m: &Model, spec: &ObjectiveSpec, path: &JointPath) -> Result<Eva
 /// Evaluate many joint paths, split over `threads` worker threads (finite-difference gradients); with fewer
 /// paths than threads, each evaluation gets the spare threads.
 pub fn evaluate_batch(m: &Model, spec: &ObjectiveSpec, paths: &[JointPath], threads: usize) -> Vec<Result<Evaluation>> {
+    match evaluate_batch_interruptible(m, spec, paths, threads, None) {
+        Ok(all) => all,
+        Err(e) => vec![Err(e)], // unreachable without a hook: nothing else stops the batch as a whole
+    }
+}
+
+/// [`evaluate_batch`], stoppable: the calling thread polls `hook` (at most every `POLL_INTERVAL`, with the
+/// fraction of paths evaluated) while the workers evaluate; its `false` stops every worker before its next
+/// grid point and the batch returns `FfError::Interrupted` (no partial result: the caller keeps its own
+/// best point, e.g. the design loop's best design so far). The values are those of [`evaluate_batch`].
+pub fn evaluate_batch_interruptible(
+    m: &Model,
+    spec: &ObjectiveSpec,
+    paths: &[JointPath],
+    threads: usize,
+    mut hook: Option<Hook>,
+) -> Result<Vec<Result<Evaluation>>> {
     let inner = (threads / paths.len().max(1)).max(1);
     let spec = &ObjectiveSpec { threads: inner, ..*spec };
     let outer = threads.clamp(1, paths.len().max(1));
     let chunk = paths.len().div_ceil(outer).max(1);
-    std::thread::scope(|s| {
+    let stop = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let (stop, done) = (&stop, &done);
+    let watch = hook.is_some().then_some(stop);
+    let (all, finished) = std::thread::scope(|s| {
         let handles: Vec<_> = paths
             .chunks(chunk)
-            .map(|part| s.spawn(move || part.iter().map(|p| evaluate(m, spec, p)).collect::<Vec<_>>()))
+            .map(|part| {
+                s.spawn(move || {
+                    let mut out = Vec::with_capacity(part.len());
+                    for p in part {
+                        if stopped(watch) {
+                            break;
+                        }
+                        out.push(evaluate_until(m, spec, p, watch));
+                        done.fetch_add(1, Ordering::Relaxed);
+                    }
+                    out
+                })
+            })
             .collect();
-        handles.into_iter().flat_map(|h| h.join().expect("excitation worker panicked")).collect()
-    })
+        let total = paths.len().max(1) as f64;
+        let finished = supervise(&mut hook, stop, &handles, || done.load(Ordering::Relaxed) as f64 / total);
+        let all: Vec<_> = handles.into_iter().flat_map(|h| h.join().expect("excitation worker panicked")).collect();
+        (all, finished)
+    });
+    if !finished {
+        return Err(FfError::interrupted(format!(
+            "excitation objective stopped after {} of {} evaluations",
+            done.load(Ordering::Relaxed).min(paths.len()),
+            paths.len()
+        )));
+    }
+    Ok(all)
 }
 
 /// GᵀG summed over the row blocks, each block's product in parallel: nalgebra hands `Bᵀ · B` of dynamic

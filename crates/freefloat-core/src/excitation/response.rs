@@ -3,12 +3,14 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
+use crate::interrupt::stopped;
 use crate::kinematics::{base_twist_for_momentum, forward_velocities_unchecked};
 use crate::model::{JointType, Model};
 use crate::regressors::momentum_regressor_from_data_unchecked;
 use crate::sim::{integrate_base_poses, Steps};
 use crate::spatial::{rot_from_quat, Motion, Se3, V3};
 use nalgebra::{DMatrix, Vector6};
+use std::sync::atomic::AtomicBool;
 
 /// Joint angles and rates of the driven joints on a uniform time grid: `q`, `qd` are (samples × n)
 /// row-major; `iq`/`iv` are the driven joints' indices into the model's q and v.
@@ -116,7 +118,7 @@ pub fn excitation_rows(
     n_signal: usize,
     threads: usize,
 ) -> Result<ExcitationRows> {
-    let s = sample_blocks(m, q0, path, stride, offset, columns, n_signal, threads)?;
+    let s = sample_blocks(m, q0, path, stride, offset, columns, n_signal, threads, None)?;
     let total: usize = s.blocks.iter().map(|b| b.nrows()).sum();
     let mut rows = DMatrix::zeros(total, columns.len());
     let mut r0 = 0;
@@ -139,7 +141,8 @@ pub(crate) struct SampleBlocks {
 /// Three phases, so that the expensive ones run in parallel: (1) the zero-momentum twist at every grid
 /// point depends on the joints only (not on the base pose), so the points are split over threads; (2) the
 /// base pose is integrated sequentially (a quaternion product per point); (3) the regressor rows at the
-/// sampled points, again split over threads.
+/// sampled points, again split over threads. Every worker reads `stop` (see `interrupt::supervise`) before
+/// each grid point and ends with `FfError::Interrupted` once it is raised.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn sample_blocks(
     m: &Model,
@@ -150,7 +153,9 @@ pub(crate) fn sample_blocks(
     columns: &[usize],
     n_signal: usize,
     threads: usize,
+    stop: Option<&AtomicBool>,
 ) -> Result<SampleBlocks> {
+    let halt = || FfError::interrupted("excitation objective stopped");
     if m.joint_types[0] != JointType::Free {
         return Err(FfError::arg("model", "exciting-trajectory design needs a free-floating base"));
     }
@@ -189,6 +194,9 @@ pub(crate) fn sample_blocks(
                     let (mut q, mut v) = (q0.to_vec(), vec![0.0; m.nv]);
                     (i0..(i0 + chunk).min(samples))
                         .map(|i| {
+                            if stopped(stop) {
+                                return Err(halt());
+                            }
                             set_joints(i, &mut q, &mut v);
                             base_twist_zero_momentum(m, &mut d, &mut q, &mut v)
                         })
@@ -218,7 +226,7 @@ pub(crate) fn sample_blocks(
         let handles: Vec<_> = picked
             .chunks(pchunk)
             .map(|idx| {
-                s.spawn(move || {
+                s.spawn(move || -> Result<(DMatrix<f64>, f64)> {
                     let mut d = Data::new(m);
                     let (mut q, mut v) = (q0.to_vec(), vec![0.0; m.nv]);
                     q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
@@ -226,6 +234,9 @@ pub(crate) fn sample_blocks(
                     let mut rows = DMatrix::zeros(6 * idx.len(), columns.len());
                     let mut sumsq = 0.0;
                     for (r, &i) in idx.iter().enumerate() {
+                        if stopped(stop) {
+                            return Err(halt());
+                        }
                         set_joints(i, &mut q, &mut v);
                         forward_velocities_unchecked(m, &mut d, &q, &v); // identity base, joint-only twists
                         place_base(m, &mut d, &twists[i], &poses[i]);
@@ -238,12 +249,12 @@ pub(crate) fn sample_blocks(
                         sumsq +=
                             twists[i].norm_squared() + (0..n_signal).map(|k| path.qd[i * n + k].powi(2)).sum::<f64>();
                     }
-                    (rows, sumsq)
+                    Ok((rows, sumsq))
                 })
             })
             .collect();
-        handles.into_iter().map(|h| h.join().expect("excitation worker panicked")).collect()
-    });
+        handles.into_iter().map(|h| h.join().expect("excitation worker panicked")).collect::<Result<Vec<_>>>()
+    })?;
 
     let mut q_end = q0.to_vec();
     for k in 0..n {

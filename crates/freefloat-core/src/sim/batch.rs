@@ -5,6 +5,7 @@
 
 use super::{simulate, Hold, Inputs, SimOptions, TorqueSource, Trajectory};
 use crate::error::{FfError, Result};
+use crate::interrupt::{supervise, Hook};
 use crate::model::Model;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -94,8 +95,9 @@ pub fn batch_size(m: &Model, spec: &BatchSpec) -> Result<usize> {
 
 /// Simulate every member of `spec` with `opts` on up to `threads` threads (0: one per core). The outer `Err` is a
 /// problem with the batch itself (sizes, empty batch); member k's own failure is the k-th entry's `Err`, with "member
-/// k" in its message, and does not stop the others. `stop` (e.g. set by a Ctrl-C handler) makes the members that
-/// have not started yet return an error instead of running.
+/// k" in its message, and does not stop the others. `stop` (e.g. raised by [`simulate_many_interruptible`] on
+/// Ctrl-C) ends the running members within ~20 ms (each `Err(Interrupted)` with its samples so far as the partial
+/// trajectory) and makes the members that have not started return `Err(Interrupted)` without one.
 pub fn simulate_many(
     m: &Model,
     spec: &BatchSpec,
@@ -114,9 +116,9 @@ pub fn simulate_many(
             break;
         }
         let r = if stop.is_some_and(|s| s.load(Ordering::Relaxed)) {
-            Err(FfError::Numerical("interrupted before it started".into()))
+            Err(FfError::interrupted(format!("member {k}: stopped before it started")))
         } else {
-            run_member(m, spec, opts, k)
+            run_member(m, spec, opts, k, stop)
         };
         let r = r.map_err(|e| in_member(e, k));
         *slots[k].lock().unwrap_or_else(|p| p.into_inner()) = Some(r);
@@ -141,7 +143,36 @@ pub fn simulate_many(
         .collect())
 }
 
-fn run_member(m: &Model, spec: &BatchSpec, opts: &SimOptions, k: usize) -> Result<Trajectory> {
+/// [`simulate_many`] with Ctrl-C: the calling thread polls `hook` (at most every `POLL_INTERVAL`) while the
+/// members run; its `false` stops them all (see `stop` above). Returns the members' results and whether the batch
+/// was stopped.
+pub fn simulate_many_interruptible(
+    m: &Model,
+    spec: &BatchSpec,
+    opts: &SimOptions,
+    threads: usize,
+    mut hook: Option<Hook>,
+) -> Result<(Vec<Result<Trajectory>>, bool)> {
+    if hook.is_none() {
+        return Ok((simulate_many(m, spec, opts, threads, None)?, false));
+    }
+    batch_size(m, spec)?;
+    let stop = AtomicBool::new(false);
+    let (results, finished) = std::thread::scope(|s| {
+        let h = s.spawn(|| simulate_many(m, spec, opts, threads, Some(&stop)));
+        let finished = supervise(&mut hook, &stop, std::slice::from_ref(&h), || 0.0);
+        (h.join().expect("batch simulation panicked"), finished)
+    });
+    Ok((results?, !finished))
+}
+
+fn run_member(
+    m: &Model,
+    spec: &BatchSpec,
+    opts: &SimOptions,
+    k: usize,
+    stop: Option<&AtomicBool>,
+) -> Result<Trajectory> {
     // A panic inside one member must not take the batch (or the thread pool) down with it.
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         let own;
@@ -156,7 +187,10 @@ fn run_member(m: &Model, spec: &BatchSpec, opts: &SimOptions, k: usize) -> Resul
             (Some(t), Some(times)) => TorqueSource::table(times.to_vec(), t.row(k).to_vec(), m.nv, spec.hold)?,
             _ => TorqueSource::Zero,
         };
-        simulate(model, spec.q0.row(k), spec.v0.row(k), opts, Inputs { torques, ..Default::default() }, None)
+        // the member polls the batch's stop flag like a Ctrl-C hook (at most every 20 ms)
+        let mut watch = |_: f64| !stop.is_some_and(|s| s.load(Ordering::Relaxed));
+        let hook: Option<Hook> = if stop.is_some() { Some(&mut watch) } else { None };
+        simulate(model, spec.q0.row(k), spec.v0.row(k), opts, Inputs { torques, ..Default::default() }, hook)
     }))
     .unwrap_or_else(|p| {
         let what = p
@@ -174,6 +208,11 @@ fn in_member(e: FfError, k: usize) -> FfError {
         FfError::Argument { name, msg } => FfError::Argument { name, msg: format!("member {k}: {msg}") },
         FfError::Numerical(msg) => FfError::Numerical(format!("member {k}: {msg}")),
         FfError::Model(msg) => FfError::Model(format!("member {k}: {msg}")),
+        // a stop keeps its partial trajectory (and already names the member when it had not started)
+        FfError::Interrupted { msg, partial } if !msg.starts_with("member ") => {
+            FfError::Interrupted { msg: format!("member {k}: {msg}"), partial }
+        }
+        e @ FfError::Interrupted { .. } => e,
         other => FfError::Numerical(format!("member {k}: {other}")),
     }
 }

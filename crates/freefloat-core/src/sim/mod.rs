@@ -11,7 +11,7 @@ mod trajectory;
 
 pub use actuators::{Actuators, Tank, Thruster, Wheel};
 pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
-pub use batch::{batch_size, simulate_many, BatchSpec, Stacked};
+pub use batch::{batch_size, simulate_many, simulate_many_interruptible, BatchSpec, Stacked};
 pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 

@@ -13,7 +13,8 @@ use crate::config::{dexpinv_unchecked as dexpinv, retract_unchecked as retract, 
 use crate::data::Data;
 use crate::dqdynamics::solve_system_unchecked;
 use crate::dynamics::hybrid_aba_unchecked;
-use crate::error::{FfError, Result};
+use crate::error::{FfError, Partial, Result};
+use crate::interrupt::{Hook, Poller, POLL_INTERVAL};
 use crate::model::{JointType, Model};
 
 /// The joint actuation of (9.28): `amplitude · sin(frequency · t + phase)` on every joint DOF (N for a
@@ -193,6 +194,7 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
     const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
     const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
     let report_every = (steps / 200).max(1);
+    let mut last_report = std::time::Instant::now();
 
     for k in 0..=steps {
         let t = k as f64 * sc.dt;
@@ -221,9 +223,14 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
         out.block_singular_values.extend_from_slice(est.stack().block_singular_values());
         out.offers.push(offer);
         if let Some(p) = progress.as_mut() {
-            if (k % report_every == 0 || k == steps) && !p(t) {
-                out.interrupted = true;
-                break;
+            // at every 1/200 of the run and at least every POLL_INTERVAL (Ctrl-C within ~20 ms on a long run)
+            let due = k % report_every == 0 || k == steps || last_report.elapsed() >= POLL_INTERVAL;
+            if due {
+                last_report = std::time::Instant::now();
+                if !p(t) {
+                    out.interrupted = true;
+                    break;
+                }
             }
         }
         if k == steps {
@@ -296,6 +303,24 @@ pub fn estimate_recorded(
     f: &[super::V8],
     out: &mut [f64],
 ) -> Result<()> {
+    estimate_recorded_interruptible(nbodies, params, m0, dt, r, f, out, None)
+}
+
+/// [`estimate_recorded`], stoppable: `hook` is polled (at most every `POLL_INTERVAL`, with the fraction of
+/// samples done) after each sample; its `false` ends the run with `FfError::Interrupted` carrying
+/// `Partial::Samples(k)`: the first k rows of `out` hold the estimates at t_0 … t_{k−1}, the same numbers an
+/// uninterrupted call gives there (the estimator is causal).
+#[allow(clippy::too_many_arguments)]
+pub fn estimate_recorded_interruptible(
+    nbodies: usize,
+    params: ClParams,
+    m0: &[f64],
+    dt: f64,
+    r: &[super::M87],
+    f: &[super::V8],
+    out: &mut [f64],
+    hook: Option<Hook>,
+) -> Result<()> {
     let mut est = ConcurrentEstimator::new(nbodies, params, m0)?;
     if r.len() != f.len() || !r.len().is_multiple_of(nbodies) || r.is_empty() {
         return Err(FfError::arg(
@@ -306,11 +331,17 @@ pub fn estimate_recorded(
     let n = r.len() / nbodies;
     crate::check::check_len("out", out.len(), n * NP * nbodies)?;
     let np = NP * nbodies;
+    let mut poller = Poller::new(hook);
     for k in 0..n {
         est.set_time(k as f64 * dt);
         est.add_sample(&r[k * nbodies..(k + 1) * nbodies], &f[k * nbodies..(k + 1) * nbodies])?;
         est.estimate_into(&mut out[k * np..(k + 1) * np]);
         if k + 1 < n {
+            if let Err(FfError::Interrupted { msg, .. }) = poller.poll((k + 1) as f64 / n as f64, || {
+                format!("ch. 9 estimator stopped after sample {} of {n} (t = {} s)", k + 1, k as f64 * dt)
+            }) {
+                return Err(FfError::Interrupted { msg, partial: Some(Partial::Samples(k + 1)) });
+            }
             est.step(dt)?;
         }
     }

@@ -14,7 +14,9 @@ mod law;
 mod samples;
 mod stack;
 
-pub use driver::{estimate_recorded, run_cl, ClRun, ClScenario, Excitation, ProgressFn};
+pub use driver::{
+    estimate_recorded, estimate_recorded_interruptible, run_cl, ClRun, ClScenario, Excitation, ProgressFn,
+};
 pub use law::{block_rate, rk4_step, svd_gain, ZERO_RTOL};
 pub use samples::{Noise, SampleBuilder};
 pub use stack::{block_singular_values, DataStack, Offer, SplitMix};
