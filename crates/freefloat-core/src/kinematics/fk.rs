@@ -54,7 +54,7 @@ pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motio
 /// Column `c` of joint i's motion subspace in inertial coordinates (about the inertial origin), after
 /// `forward_kinematics`. A revolute joint's child-frame column is [0; a], so it is `[p × R a; R a]`, and a
 /// prismatic one's [a; 0] gives `[R a; 0]`: one 3×3 product instead of the general motion transform.
-#[inline]
+#[inline(always)]
 pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> Motion {
     let o = &d.o_mi[i];
     let s = &d.s[i];
