@@ -420,7 +420,8 @@ pub fn crba<'py>(py: Python<'py>, model: &Bound<'py, PyAny>, q: Arr<'_, 'py>) ->
     let out = run_rows(py, model, rows, st, nv * nv, |m, d, k, o| {
         let q = qb.row(k);
         dynamics::crba(m, d, q)?;
-        write_rowmajor(&d.mass_matrix, o);
+        // symmetric: its column-major storage is numpy's row-major layout already (one copy, no index arithmetic)
+        o.copy_from_slice(d.mass_matrix.as_slice());
         Ok(())
     })?;
     output(py, out, rows, st, &[nv, nv])

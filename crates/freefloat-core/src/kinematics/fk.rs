@@ -2,7 +2,7 @@ use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::{universal_bias, universal_first_axis, JointType, Model};
-use crate::spatial::{Motion, V3};
+use crate::spatial::{rotation_about_axis, Motion, Se3, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
 /// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
@@ -18,7 +18,14 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     for i in 0..m.nbodies() {
         let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
         let jt = m.joint_types[i];
-        d.li_mi[i] = m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi));
+        d.li_mi[i] = match jt {
+            // a rotation about the joint origin leaves the placement's translation as it is: one 3×3 product
+            JointType::Revolute => {
+                let p = &m.placements[i];
+                Se3::new(p.rot * rotation_about_axis(&m.axes[i], qi[0]), p.trans)
+            }
+            _ => m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi)),
+        };
         if jt == JointType::Universal {
             let s1 = universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]);
             d.s[i].fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
@@ -54,7 +61,7 @@ pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motio
 /// Column `c` of joint i's motion subspace in inertial coordinates (about the inertial origin), after
 /// `forward_kinematics`. A revolute joint's child-frame column is [0; a], so it is `[p × R a; R a]`, and a
 /// prismatic one's [a; 0] gives `[R a; 0]`: one 3×3 product instead of the general motion transform.
-#[inline]
+#[inline(always)]
 pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> Motion {
     let o = &d.o_mi[i];
     let s = &d.s[i];

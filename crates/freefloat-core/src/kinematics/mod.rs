@@ -19,6 +19,4 @@ pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,
     world_composite_inertias, world_motion_subspaces,
 };
-pub(crate) use momentum::{
-    momentum_from_data_unchecked, world_composite_inertias_unchecked, world_motion_subspaces_unchecked,
-};
+pub(crate) use momentum::{momentum_from_data_unchecked, world_motion_subspaces_unchecked};
