@@ -20,7 +20,7 @@ use crate::config::{
     tangent_rate_unchecked as tangent_rate,
 };
 use crate::data::Data;
-use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
+use crate::dynamics::{hybrid_aba_placed_unchecked, hybrid_aba_unchecked, Prescribed};
 use crate::environment::{EnvWorkspace, Environment};
 use crate::error::{check_vec, FfError, Partial, Result};
 use crate::interrupt::Poller;
@@ -249,11 +249,14 @@ impl<'m, 'i> Stepper<'m, 'i> {
             self.act.deplete(vm, &self.mps);
         }
         let ma: &Model = self.var_model.as_ref().unwrap_or(m);
-        // The environment's per-body wrenches at this stage (they need the placements: one extra forward
-        // pass), added to the actuators' external wrenches; both in ABA's `fext` convention.
+        // The environment's per-body wrenches at this stage (from the placements, computed here once and shared
+        // with ABA), added to the actuators' external wrenches; both in ABA's `fext` convention.
         let mut any_fext = self.act.uses_fext;
+        let mut placed = false;
         if let (Some(ws), Some(env)) = (self.env.as_mut(), self.inputs.environment) {
+            // ABA below reuses these placements instead of repeating the pass (they depend on q alone).
             forward_kinematics_unchecked(ma, &mut self.d, &qs);
+            placed = true;
             ws.eval(env, ma, &self.d, t);
             if any_fext {
                 for (a, b) in self.fext.iter_mut().zip(&ws.fext) {
@@ -268,6 +271,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
         match self.formulation {
+            Formulation::Aba if placed => hybrid_aba_placed_unchecked(ma, &mut self.d, &vs, &self.tau, fext, presc)?,
             Formulation::Aba => hybrid_aba_unchecked(ma, &mut self.d, &qs, &vs, &self.tau, fext, presc)?,
             Formulation::DualQuaternion => {
                 // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
