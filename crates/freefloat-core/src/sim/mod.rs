@@ -304,8 +304,12 @@ impl<'m, 'i> Stepper<'m, 'i> {
             // Power of the external wrenches: each one's inertial-frame image on its body's twist
             // (ABA leaves the placements and the twists at the inertial origin in `d`).
             let d = &self.d;
-            for i in 0..m.nbodies() {
-                let f = crate::spatial::Force::from_slice(&self.fext[6 * i..6 * i + 6]);
+            for (i, fe) in self.fext.chunks_exact(6).enumerate() {
+                // most bodies carry none (a thruster on the base): skip their frame change
+                if fe.iter().all(|&x| x == 0.0) {
+                    continue;
+                }
+                let f = crate::spatial::Force::from_slice(fe);
                 self.kw[s] += d.ov[i].dot(&d.o_mi[i].act_force(&f));
             }
         }
