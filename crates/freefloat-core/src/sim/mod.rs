@@ -337,14 +337,22 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let m = self.m;
         let nv = m.nv;
         for s in 1..tab.stages() {
-            for k in 0..nv {
-                let (mut sq, mut sv) = (0.0, 0.0);
-                for (j, a) in tab.a[s].iter().enumerate() {
-                    sq += a * self.kq[j][k];
-                    sv += a * self.kv[j][k];
+            // Column-wise over the stages, skipping the tableau's zeros (RK4 has one non-zero a per stage):
+            // the same sums in the same order as the full inner product (adding the skipped ±0 terms to the
+            // running sum, which starts at +0, changes nothing), bit for bit.
+            self.dq.fill(0.0);
+            self.dv.fill(0.0);
+            for (j, &a) in tab.a[s].iter().enumerate().filter(|(_, a)| **a != 0.0) {
+                for ((dq, dv), (kq, kv)) in
+                    self.dq.iter_mut().zip(self.dv.iter_mut()).zip(self.kq[j].iter().zip(&self.kv[j]))
+                {
+                    *dq += a * kq;
+                    *dv += a * kv;
                 }
-                self.dq[k] = h * sq;
-                self.dv[k] = h * sv;
+            }
+            for (dq, dv) in self.dq.iter_mut().zip(self.dv.iter_mut()) {
+                *dq *= h;
+                *dv *= h;
             }
             retract(m, q0, &self.dq, &mut self.qs);
             for k in 0..nv {
