@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import time
 from pathlib import Path
@@ -46,6 +47,8 @@ def main() -> int:
         "gravity_gradient_j2": ff.Environment(altitude=500e3, inclination=0.9, gravity_gradient=True, j2=True),
     }
     results, agreement = {}, {}
+    load0 = [round(x, 2) for x in os.getloadavg()]
+    print(f"{t_final} s at dt = {dt} s, {repeats} interleaved repeats, load average {load0} (1/5/15 min)")
     for name in MODELS:
         m = ff.models.load(name)
         tt, tau = _torques(m, t_final, dt)
@@ -58,25 +61,36 @@ def main() -> int:
         a, b = run(None), run(ff.Environment())
         agreement[name] = {"off_bitwise_equal": bool(np.array_equal(a.q, b.q) and np.array_equal(a.v, b.v))}
         times = {c: [] for c in cases}
-        for _ in range(repeats):
-            for c, env in cases.items():  # interleaved: each repeat runs every case once
+        order = list(cases)
+        for r in range(repeats):
+            # interleaved: each repeat runs every case once, the order rotated from repeat to repeat
+            for c in order[r % len(order) :] + order[: r % len(order)]:
                 t0 = time.perf_counter()
-                run(env)
+                run(cases[c])
                 times[c].append(time.perf_counter() - t0)
         base = statistics.median(times["none"])
-        results[name] = {
-            c: {
+        results[name] = {}
+        for c, v in times.items():
+            ratios = [a / b for a, b in zip(v, times["none"])]  # per repeat, against that repeat's run without
+            results[name][c] = {
                 "median_s": statistics.median(v),
                 "min_s": min(v),
                 "max_s": max(v),
-                "ratio_to_none": statistics.median(v) / base,
+                "ratio_to_none": statistics.median(ratios),
+                "ratio_min": min(ratios),
+                "ratio_max": max(ratios),
             }
-            for c, v in times.items()
-        }
         print(
             f"{name:24s} none {base * 1e3:8.1f} ms   "
-            + "   ".join(f"{c} x{results[name][c]['ratio_to_none']:.3f}" for c in cases if c != "none")
+            + "   ".join(
+                f"{c} x{results[name][c]['ratio_to_none']:.3f} "
+                f"({results[name][c]['ratio_min']:.3f}..{results[name][c]['ratio_max']:.3f})"
+                for c in cases
+                if c != "none"
+            ),
+            flush=True,
         )
+    load1 = [round(x, 2) for x in os.getloadavg()]
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     doc = {
@@ -87,23 +101,30 @@ def main() -> int:
         "results": results,
         "agreement": agreement,
         "target_ratio": 1.5,
+        "load_before": load0,
+        "load_after": load1,
+        "date_utc": time.strftime("%Y-%m-%d %H:%M", time.gmtime()),
     }
     (out / "environment_bench.json").write_text(json.dumps(doc, indent=2))
     lines = [
         "# Orbital environment cost (ratio to the same run without it)",
         "",
-        f"{t_final} s simulated at dt = {dt} s (RK4), {repeats} interleaved repeats, medians (min-max).",
+        f"{doc['date_utc']} UTC, load average {load0} before, {load1} after (1/5/15 min).",
+        f"{t_final} s simulated at dt = {dt} s (RK4), {repeats} interleaved repeats: median of the per-repeat ratio "
+        "to the run without (its min..max), and the run's median time.",
         "",
         "| model | none (ms) | gravity gradient | gravity gradient + J2 |",
         "|---|---|---|---|",
     ]
     for name, r in results.items():
         cells = [
-            f"x{r[c]['ratio_to_none']:.3f} ({r[c]['min_s'] * 1e3:.0f}-{r[c]['max_s'] * 1e3:.0f} ms)"
+            f"x{r[c]['ratio_to_none']:.3f} ({r[c]['ratio_min']:.3f}..{r[c]['ratio_max']:.3f}), "
+            f"{r[c]['median_s'] * 1e3:.0f} ms"
             for c in ("gravity_gradient", "gravity_gradient_j2")
         ]
         lines.append(f"| {name} | {r['none']['median_s'] * 1e3:.1f} | {cells[0]} | {cells[1]} |")
     (out / "environment_bench.md").write_text("\n".join(lines) + "\n")
+    print("\n".join(lines))
     if not all(a["off_bitwise_equal"] for a in agreement.values()):
         print("an environment that is off changed the run")
         return 1

@@ -87,9 +87,10 @@ def freefloat_run(t_final, dt, friction=True, limits=True, record_every=1):
     ), n
 
 
-def basilisk_run(t_final, dt, friction=True, limits=True):
+def basilisk_run(t_final, dt, friction=True, limits=True, log_momentum=True):
     """Basilisk 2.12: Spacecraft hub + ReactionWheelStateEffector (BalancedWheels), RK4 at the task rate,
-    constant motor-torque message. Returns (t, sigma_BN, omega_BN_B, wheel speeds, H about C in N)."""
+    constant motor-torque message. Returns (t, sigma_BN, omega_BN_B, wheel speeds, H about C in N); H is None
+    with `log_momentum=False` (its logger is a Python callback at every step, which a timing run leaves out)."""
     from Basilisk.architecture import messaging
     from Basilisk.simulation import reactionWheelStateEffector, spacecraft
     from Basilisk.utilities import SimulationBaseClass, macros, simIncludeRW
@@ -137,8 +138,8 @@ def basilisk_run(t_final, dt, friction=True, limits=True):
     sc.hub.v_CN_NInit = [[0.0], [0.0], [0.0]]
     log = sc.scStateOutMsg.recorder()
     speeds = rwe.rwSpeedOutMsg.recorder()
-    hlog = sc.logger(["totRotAngMomPntC_N"])
-    for r in (log, speeds, hlog):
+    hlog = sc.logger(["totRotAngMomPntC_N"]) if log_momentum else None
+    for r in (log, speeds, hlog) if log_momentum else (log, speeds):
         sim.AddModelToTask("task", r)
     sim.InitializeSimulation()
     sim.ConfigureStopTime(macros.sec2nano(t_final))
@@ -149,7 +150,7 @@ def basilisk_run(t_final, dt, friction=True, limits=True):
         np.array(log.sigma_BN),
         np.array(log.omega_BN_B),
         np.array(speeds.wheelSpeeds)[:, :3],
-        np.array(hlog.totRotAngMomPntC_N),
+        np.array(hlog.totRotAngMomPntC_N) if log_momentum else None,
     )
 
 

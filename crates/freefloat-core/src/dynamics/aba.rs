@@ -59,9 +59,22 @@ pub(crate) fn hybrid_aba_unchecked(
     fext: Option<&[f64]>,
     presc: Option<Prescribed>,
 ) -> Result<()> {
+    forward_kinematics_unchecked(m, d, q);
+    hybrid_aba_placed_unchecked(m, d, v, tau, fext, presc)
+}
+
+/// `hybrid_aba_unchecked` after `forward_kinematics_unchecked(m, d, q)` was already run for this q (the
+/// simulator's environment needs the same placements first; the pass is not repeated).
+pub(crate) fn hybrid_aba_placed_unchecked(
+    m: &Model,
+    d: &mut Data,
+    v: &[f64],
+    tau: &[f64],
+    fext: Option<&[f64]>,
+    presc: Option<Prescribed>,
+) -> Result<()> {
     let n = m.nbodies();
     let is_presc = |i: usize| presc.map(|p| p.mask[i]).unwrap_or(false);
-    forward_kinematics_unchecked(m, d, q);
 
     // Pass 1: subspaces, twists, velocity-product accelerations and bias forces, inertial frame.
     // Each body's momentum oIᵢ vᵢ is formed here anyway, so the totals come for free.

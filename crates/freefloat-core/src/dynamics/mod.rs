@@ -6,8 +6,8 @@ mod crba;
 pub mod derivatives;
 mod rnea;
 
-pub(crate) use aba::hybrid_aba_unchecked;
 pub use aba::{aba, hybrid_aba, Prescribed};
+pub(crate) use aba::{hybrid_aba_placed_unchecked, hybrid_aba_unchecked};
 pub use crba::crba;
 pub(crate) use crba::crba_unchecked;
 pub use rnea::rnea;

@@ -20,7 +20,7 @@ use crate::config::{
     tangent_rate_unchecked as tangent_rate,
 };
 use crate::data::Data;
-use crate::dynamics::{hybrid_aba_unchecked, Prescribed};
+use crate::dynamics::{hybrid_aba_placed_unchecked, hybrid_aba_unchecked, Prescribed};
 use crate::environment::{EnvWorkspace, Environment};
 use crate::error::{check_vec, FfError, Partial, Result};
 use crate::interrupt::Poller;
@@ -249,11 +249,14 @@ impl<'m, 'i> Stepper<'m, 'i> {
             self.act.deplete(vm, &self.mps);
         }
         let ma: &Model = self.var_model.as_ref().unwrap_or(m);
-        // The environment's per-body wrenches at this stage (they need the placements: one extra forward
-        // pass), added to the actuators' external wrenches; both in ABA's `fext` convention.
+        // The environment's per-body wrenches at this stage (from the placements, computed here once and shared
+        // with ABA), added to the actuators' external wrenches; both in ABA's `fext` convention.
         let mut any_fext = self.act.uses_fext;
+        let mut placed = false;
         if let (Some(ws), Some(env)) = (self.env.as_mut(), self.inputs.environment) {
+            // ABA below reuses these placements instead of repeating the pass (they depend on q alone).
             forward_kinematics_unchecked(ma, &mut self.d, &qs);
+            placed = true;
             ws.eval(env, ma, &self.d, t);
             if any_fext {
                 for (a, b) in self.fext.iter_mut().zip(&ws.fext) {
@@ -268,6 +271,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
         match self.formulation {
+            Formulation::Aba if placed => hybrid_aba_placed_unchecked(ma, &mut self.d, &vs, &self.tau, fext, presc)?,
             Formulation::Aba => hybrid_aba_unchecked(ma, &mut self.d, &qs, &vs, &self.tau, fext, presc)?,
             Formulation::DualQuaternion => {
                 // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
@@ -300,8 +304,12 @@ impl<'m, 'i> Stepper<'m, 'i> {
             // Power of the external wrenches: each one's inertial-frame image on its body's twist
             // (ABA leaves the placements and the twists at the inertial origin in `d`).
             let d = &self.d;
-            for i in 0..m.nbodies() {
-                let f = crate::spatial::Force::from_slice(&self.fext[6 * i..6 * i + 6]);
+            for (i, fe) in self.fext.chunks_exact(6).enumerate() {
+                // most bodies carry none (a thruster on the base): skip their frame change
+                if fe.iter().all(|&x| x == 0.0) {
+                    continue;
+                }
+                let f = crate::spatial::Force::from_slice(fe);
                 self.kw[s] += d.ov[i].dot(&d.o_mi[i].act_force(&f));
             }
         }
@@ -329,14 +337,22 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let m = self.m;
         let nv = m.nv;
         for s in 1..tab.stages() {
-            for k in 0..nv {
-                let (mut sq, mut sv) = (0.0, 0.0);
-                for (j, a) in tab.a[s].iter().enumerate() {
-                    sq += a * self.kq[j][k];
-                    sv += a * self.kv[j][k];
+            // Column-wise over the stages, skipping the tableau's zeros (RK4 has one non-zero a per stage):
+            // the same sums in the same order as the full inner product (adding the skipped ±0 terms to the
+            // running sum, which starts at +0, changes nothing), bit for bit.
+            self.dq.fill(0.0);
+            self.dv.fill(0.0);
+            for (j, &a) in tab.a[s].iter().enumerate().filter(|(_, a)| **a != 0.0) {
+                for ((dq, dv), (kq, kv)) in
+                    self.dq.iter_mut().zip(self.dv.iter_mut()).zip(self.kq[j].iter().zip(&self.kv[j]))
+                {
+                    *dq += a * kq;
+                    *dv += a * kv;
                 }
-                self.dq[k] = h * sq;
-                self.dv[k] = h * sv;
+            }
+            for (dq, dv) in self.dq.iter_mut().zip(self.dv.iter_mut()) {
+                *dq *= h;
+                *dv *= h;
             }
             retract(m, q0, &self.dq, &mut self.qs);
             for k in 0..nv {
