@@ -55,9 +55,9 @@ pub fn backward_pass(
         dense::mul_nn(ws.px.as_mut_slice(), vxxn, fx, ndx, ndx, ndx, false);
         dense::mul_nn(ws.pu.as_mut_slice(), vxxn, fu, ndx, ndx, nu, false);
         ws.qxx.copy_from(&d.lxx);
-        dense::mul_tn(ws.qxx.as_mut_slice(), fx, ws.px.as_slice(), ndx, ndx, ndx, true);
+        dense::mul_tn_sym(ws.qxx.as_mut_slice(), fx, ws.px.as_slice(), ndx, ndx, true);
         ws.quu.copy_from(&d.luu);
-        dense::mul_tn(ws.quu.as_mut_slice(), fu, ws.pu.as_slice(), ndx, nu, nu, true);
+        dense::mul_tn_sym(ws.quu.as_mut_slice(), fu, ws.pu.as_slice(), ndx, nu, true);
         ws.qux.tr_copy_from(&d.lxu);
         dense::mul_tn(ws.qux.as_mut_slice(), fu, ws.px.as_slice(), ndx, nu, ndx, true);
         if full {
@@ -115,8 +115,8 @@ pub fn backward_pass(
         }
         let vxx = &mut vxx_now[k];
         vxx.copy_from(&ws.qxx);
-        dense::mul_tn(vxx.as_mut_slice(), ws.z1.as_slice(), ws.z2.as_slice(), 2 * nu, ndx, ndx, true);
-        symmetrise(vxx);
+        // (symmetric in exact arithmetic: the upper triangle is kept and mirrored)
+        dense::mul_tn_sym(vxx.as_mut_slice(), ws.z1.as_slice(), ws.z2.as_slice(), 2 * nu, ndx, true);
         if !vx.iter().all(|v| v.is_finite()) || !vxx.iter().all(|v| v.is_finite()) {
             // Gains too aggressive for the local model (tiny λ on an ill-conditioned Q_uu): treat it like a
             // failed factorisation so that the caller raises λ instead of stopping.
@@ -124,17 +124,6 @@ pub fn backward_pass(
         }
     }
     Ok(Backward::Done)
-}
-
-fn symmetrise(a: &mut DMatrix<f64>) {
-    let n = a.nrows();
-    for i in 0..n {
-        for j in i + 1..n {
-            let m = 0.5 * (a[(i, j)] + a[(j, i)]);
-            a[(i, j)] = m;
-            a[(j, i)] = m;
-        }
-    }
 }
 
 /// Coefficients of the cost change the local LQ model predicts for step α: `ΔJ(α) = α d1 + ½ α² d2`.

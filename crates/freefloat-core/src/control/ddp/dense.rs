@@ -16,7 +16,12 @@ pub(crate) fn mul_nn(c: &mut [f64], a: &[f64], b: &[f64], m: usize, k: usize, n:
     debug_assert!(a.len() >= m * k && b.len() >= k * n && c.len() >= m * n);
     let mut j = 0;
     while j + 4 <= n {
-        let bj = [&b[j * k..(j + 1) * k], &b[(j + 1) * k..(j + 2) * k], &b[(j + 2) * k..(j + 3) * k], &b[(j + 3) * k..(j + 4) * k]];
+        let bj = [
+            &b[j * k..(j + 1) * k],
+            &b[(j + 1) * k..(j + 2) * k],
+            &b[(j + 2) * k..(j + 3) * k],
+            &b[(j + 3) * k..(j + 4) * k],
+        ];
         let mut i = 0;
         while i + 8 <= m {
             let mut s = [[0.0_f64; 8]; 4];
@@ -107,13 +112,36 @@ pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
 
 /// `c (+)= aᵀ b` with `a` k × m, `b` k × n, `c` m × n, all column-major and contiguous.
 pub(crate) fn mul_tn(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, n: usize, acc: bool) {
+    mul_tn_impl(c, a, b, k, m, n, acc, false);
+}
+
+/// `mul_tn` for a product known to be symmetric (m × m; with `acc`, `c` symmetric too): the upper triangle
+/// is computed, the lower one copied from it.
+pub(crate) fn mul_tn_sym(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, acc: bool) {
+    mul_tn_impl(c, a, b, k, m, m, acc, true);
+    for j in 0..m {
+        for i in j + 1..m {
+            c[j * m + i] = c[i * m + j];
+        }
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn mul_tn_impl(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, n: usize, acc: bool, upper: bool) {
     debug_assert!(a.len() >= m * k && b.len() >= k * n && c.len() >= m * n);
     let k4 = k - k % 4;
     for j in 0..n {
         let bj = &b[j * k..(j + 1) * k];
+        let lim = if upper { (j + 1).min(m) } else { m };
         let mut i = 0;
-        while i + 4 <= m {
-            let ac = [&a[i * k..(i + 1) * k], &a[(i + 1) * k..(i + 2) * k], &a[(i + 2) * k..(i + 3) * k], &a[(i + 3) * k..(i + 4) * k]];
+        while i + 4 <= m && i < lim {
+            let ac = [
+                &a[i * k..(i + 1) * k],
+                &a[(i + 1) * k..(i + 2) * k],
+                &a[(i + 2) * k..(i + 3) * k],
+                &a[(i + 3) * k..(i + 4) * k],
+            ];
             let mut s = [[0.0_f64; 4]; 4];
             let mut p = 0;
             while p < k4 {
@@ -136,7 +164,7 @@ pub(crate) fn mul_tn(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, n:
             }
             i += 4;
         }
-        for ii in i..m {
+        for ii in i..lim {
             let t = dot(&a[ii * k..(ii + 1) * k], bj);
             let cij = &mut c[j * m + ii];
             *cij = if acc { *cij + t } else { t };
@@ -188,6 +216,16 @@ mod tests {
             assert!((&c - (&c0 + at.transpose() * &b)).amax() < 1e-12, "mul_tn acc {m}x{k}x{n}");
             mul_tn(c.as_mut_slice(), at.as_slice(), b.as_slice(), k, m, n, false);
             assert!((&c - at.transpose() * &b).amax() < 1e-12, "mul_tn {m}x{k}x{n}");
+            // a symmetric product: aᵀ a (+ a symmetric c)
+            let s0 = &c0.rows(0, m.min(n)).columns(0, m.min(n)).into_owned();
+            let s0 = s0 + s0.transpose();
+            let mm = s0.nrows();
+            let a2 = filled(k, mm, 0.9);
+            let mut s = s0.clone();
+            mul_tn_sym(s.as_mut_slice(), a2.as_slice(), a2.as_slice(), k, mm, true);
+            assert!((&s - (&s0 + a2.transpose() * &a2)).amax() < 1e-12, "mul_tn_sym acc {mm}x{k}");
+            mul_tn_sym(s.as_mut_slice(), a2.as_slice(), a2.as_slice(), k, mm, false);
+            assert!((&s - a2.transpose() * &a2).amax() < 1e-12, "mul_tn_sym {mm}x{k}");
             let x = filled(k, 1, 2.0);
             let mut y = filled(m, 1, 0.2);
             let y0 = y.clone();
