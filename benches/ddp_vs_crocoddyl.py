@@ -213,9 +213,12 @@ def main(argv=None) -> int:
     prob = truncate(prob, 80 if a.quick else prob.horizon)
     n = prob.horizon
     ff_t, cr_t, ff_it, cr_it, ff_cost, cr_cost, ff_blocks = [], [], [], [], [], [], []
+    ff_cpu, cr_cpu = [], []  # process CPU time of each solve: less sensitive than wall time to a loaded machine
     cr_solver = None
     for r in range(reps):
+        c0 = time.process_time()
         sol = ddp.solve(prob, **OPTIONS)
+        ff_cpu.append(time.process_time() - c0)
         ff_t.append(sol["solve_time_s"])
         ff_it.append(sol["iterations"])
         ff_cost.append(sol["cost"])
@@ -228,9 +231,10 @@ def main(argv=None) -> int:
             }
         )
         shooting = build_crocoddyl_problem(prob)
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         cr_solver, it, c = solve_crocoddyl(shooting, prob.us0, OPTIONS["max_iter"])
         cr_t.append(time.perf_counter() - t0)
+        cr_cpu.append(time.process_time() - c0)
         cr_it.append(it)
         cr_cost.append(c)
         print(
@@ -261,6 +265,8 @@ def main(argv=None) -> int:
             "final_cost": ff_cost[-1],
             "solve_s_median": med(ff_t),
             "solve_s_spread": spread(ff_t),
+            "solve_cpu_s_median": med(ff_cpu),
+            "solve_cpu_s_spread": spread(ff_cpu),
             "per_iteration_ms_median": 1e3 * med(ff_t) / ff_it[-1],
             "blocks_us_per_node": ffb,
         },
@@ -269,12 +275,16 @@ def main(argv=None) -> int:
             "final_cost": cr_cost[-1],
             "solve_s_median": med(cr_t),
             "solve_s_spread": spread(cr_t),
+            "solve_cpu_s_median": med(cr_cpu),
+            "solve_cpu_s_spread": spread(cr_cpu),
             "per_iteration_ms_median": 1e3 * med(cr_t) / cr_it[-1],
             "blocks_us_per_node": cb,
         },
         "agreement": {"final_cost_rel": rel, "iterations_freefloat_le_crocoddyl": ff_it[-1] <= cr_it[-1]},
         "ratios_freefloat_over_crocoddyl": {
             "total": med(ff_t) / med(cr_t),
+            "total_cpu": med(ff_cpu) / med(cr_cpu),
+            "per_repeat_wall": [f / c for f, c in zip(ff_t, cr_t)],
             "per_iteration": (med(ff_t) / ff_it[-1]) / (med(cr_t) / cr_it[-1]),
             **{f"block_{k}": ffb[k] / cb[k] for k in cb},
         },
@@ -290,21 +300,25 @@ def main(argv=None) -> int:
         "",
         f"N = {n}, dt = {prob.dt} s, {reps} interleaved repeats, single thread; times: median (min-max).",
         "",
-        "| solver | iterations | final cost | solve [s] | per iteration [ms] "
+        "| solver | iterations | final cost | solve [s] | solve CPU [s] | per iteration [ms] "
         "| calcDiff / backward / forward [µs per node] |",
-        "|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|",
     ]
     for name, key in (("freefloat DDP", "freefloat"), ("Crocoddyl FDDP", "crocoddyl")):
         s = res[key]
         b = s["blocks_us_per_node"]
         md.append(
             f"| {name} | {s['iterations']} | {s['final_cost']:.10g} | {s['solve_s_median']:.3f} "
-            f"({s['solve_s_spread'][0]:.3f}-{s['solve_s_spread'][1]:.3f}) | {s['per_iteration_ms_median']:.1f} | "
+            f"({s['solve_s_spread'][0]:.3f}-{s['solve_s_spread'][1]:.3f}) | {s['solve_cpu_s_median']:.3f} "
+            f"({s['solve_cpu_s_spread'][0]:.3f}-{s['solve_cpu_s_spread'][1]:.3f}) | "
+            f"{s['per_iteration_ms_median']:.1f} | "
             f"{b['calc_diff']:.1f} / {b['backward']:.1f} / {b['forward']:.1f} |"
         )
     md += [
         "",
-        f"Final-cost agreement {rel:.2e} relative. Ratios freefloat/Crocoddyl: total {ra['total']:.2f}, per "
+        f"Final-cost agreement {rel:.2e} relative. Ratios freefloat/Crocoddyl: total {ra['total']:.2f} "
+        f"(CPU time {ra['total_cpu']:.2f}; per repeat {min(ra['per_repeat_wall']):.2f}-"
+        f"{max(ra['per_repeat_wall']):.2f}), per "
         f"iteration {ra['per_iteration']:.2f}, calcDiff {ra['block_calc_diff']:.2f}, backward "
         f"{ra['block_backward']:.2f}, forward {ra['block_forward']:.2f}.",
     ]

@@ -56,7 +56,15 @@ pub fn frame_jacobian(
     Ok(())
 }
 
-fn jacobian_from_data(m: &Model, d: &Data, body: usize, placement: &Se3, reference: Reference, out: &mut DMatrix<f64>) {
+/// `frame_jacobian` from the kinematics already in `d` (forward kinematics at the q of interest has run).
+pub(crate) fn jacobian_from_data(
+    m: &Model,
+    d: &Data,
+    body: usize,
+    placement: &Se3,
+    reference: Reference,
+    out: &mut DMatrix<f64>,
+) {
     out.fill(0.0);
     let o_mf = frame_placement_unchecked(d, body, placement);
     let mut j = Some(body);

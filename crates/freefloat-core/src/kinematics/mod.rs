@@ -14,6 +14,7 @@ pub(crate) use fk::{
     forward_accelerations_unchecked, forward_kinematics_unchecked, forward_velocities_unchecked, joint_bias,
     joint_velocity, world_subspace_column,
 };
+pub(crate) use jacobian::jacobian_from_data;
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};
 pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,

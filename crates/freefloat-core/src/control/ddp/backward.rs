@@ -3,54 +3,12 @@
 //! variant (a defect f̄ between the rollout of a node and the next nominal state shifts the value
 //! gradient to `V_x' + V_xx' f̄'`).
 
+use super::dense;
 use super::problem::ActionModel;
 use super::workspace::Workspace;
+use crate::dynamics::derivatives::cholesky_inverse;
 use crate::error::{FfError, Result};
 use nalgebra::{DMatrix, DVector};
-
-/// In-place Cholesky `A = L Lᵀ` of a symmetric matrix (lower triangle written, upper left as is).
-/// Returns false if A is not positive definite (or not finite).
-pub(crate) fn cholesky_in_place(a: &mut DMatrix<f64>) -> bool {
-    let n = a.nrows();
-    for j in 0..n {
-        let mut d = a[(j, j)];
-        for k in 0..j {
-            d -= a[(j, k)] * a[(j, k)];
-        }
-        if !(d > 0.0) || !d.is_finite() {
-            return false;
-        }
-        let d = d.sqrt();
-        a[(j, j)] = d;
-        for i in j + 1..n {
-            let mut s = a[(i, j)];
-            for k in 0..j {
-                s -= a[(i, k)] * a[(j, k)];
-            }
-            a[(i, j)] = s / d;
-        }
-    }
-    true
-}
-
-/// Solve `L Lᵀ x = b` in place with the factor of `cholesky_in_place`.
-pub(crate) fn cholesky_solve_in_place(l: &DMatrix<f64>, b: &mut [f64]) {
-    let n = l.nrows();
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= l[(i, k)] * b[k];
-        }
-        b[i] = s / l[(i, i)];
-    }
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for k in i + 1..n {
-            s -= l[(k, i)] * b[k];
-        }
-        b[i] = s / l[(i, i)];
-    }
-}
 
 /// What the backward pass found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,35 +30,36 @@ pub fn backward_pass(
     full: bool,
     gaps: bool,
 ) -> Result<Backward> {
-    let n = ws.n;
+    let (n, ndx, nu) = (ws.n, ws.ndx, ws.nu);
     // V_N = terminal cost.
     ws.vx[n].copy_from(&ws.diffs[n].lx);
     ws.vxx[n].copy_from(&ws.diffs[n].lxx);
     for k in (0..n).rev() {
         let (vx_now, vx_next) = ws.vx.split_at_mut(k + 1);
         let (vxx_now, vxx_next) = ws.vxx.split_at_mut(k + 1);
-        let (vxn, vxxn) = (&vx_next[0], &vxx_next[0]);
+        let (vxn, vxxn) = (vx_next[0].as_slice(), vxx_next[0].as_slice());
         // Gap-corrected gradient of the next node.
-        ws.vx_plus.copy_from(vxn);
+        ws.vx_plus.as_mut_slice().copy_from_slice(vxn);
         if gaps {
-            ws.vx_plus.gemv(1.0, vxxn, &ws.gaps[k + 1], 1.0);
+            dense::gemv_n_add(ws.vx_plus.as_mut_slice(), vxxn, ws.gaps[k + 1].as_slice(), ndx, ndx);
         }
         let d = &ws.diffs[k];
+        let (fx, fu) = (d.fx.as_slice(), d.fu.as_slice());
         // Eqs. (8.20)–(8.26): Q_x = L_x + Fxᵀ V_x', Q_u = L_u + Fuᵀ V_x',
-        // Q_xx = L_xx + Fxᵀ V_xx' Fx, Q_uu = L_uu + Fuᵀ V_xx' Fu, Q_ux = L_ux + Fuᵀ V_xx' Fx.
+        // Q_xx = L_xx + Fxᵀ V_xx' Fx, Q_uu = L_uu + Fuᵀ V_xx' Fu, Q_ux = L_ux + Fuᵀ V_xx' Fx,
+        // through P_x = V_xx' Fx and P_u = V_xx' Fu (V_xx' is symmetric).
         ws.qx.copy_from(&d.lx);
-        ws.qx.gemv_tr(1.0, &d.fx, &ws.vx_plus, 1.0);
+        dense::gemv_t(ws.qx.as_mut_slice(), fx, ws.vx_plus.as_slice(), ndx, ndx, true);
         ws.qu.copy_from(&d.lu);
-        ws.qu.gemv_tr(1.0, &d.fu, &ws.vx_plus, 1.0);
-        // (tr_mul_to, not gemm_tr: nalgebra's gemm_tr allocates a temporary.)
-        d.fx.tr_mul_to(vxxn, &mut ws.fxt_v);
+        dense::gemv_t(ws.qu.as_mut_slice(), fu, ws.vx_plus.as_slice(), ndx, nu, true);
+        dense::mul_nn(ws.px.as_mut_slice(), vxxn, fx, ndx, ndx, ndx, false);
+        dense::mul_nn(ws.pu.as_mut_slice(), vxxn, fu, ndx, ndx, nu, false);
         ws.qxx.copy_from(&d.lxx);
-        mul_add(&mut ws.qxx, &ws.fxt_v, &d.fx);
-        d.fu.tr_mul_to(vxxn, &mut ws.fut_v);
+        dense::mul_tn_sym(ws.qxx.as_mut_slice(), fx, ws.px.as_slice(), ndx, ndx, true);
         ws.quu.copy_from(&d.luu);
-        mul_add(&mut ws.quu, &ws.fut_v, &d.fu);
+        dense::mul_tn_sym(ws.quu.as_mut_slice(), fu, ws.pu.as_slice(), ndx, nu, true);
         ws.qux.tr_copy_from(&d.lxu);
-        mul_add(&mut ws.qux, &ws.fut_v, &d.fx);
+        dense::mul_tn(ws.qux.as_mut_slice(), fu, ws.px.as_slice(), ndx, nu, ndx, true);
         if full {
             // Full DDP (eqs. (8.39)–(8.41)): + Σ_j V_x'[j] ∂²F^j.
             let (xk, uk) = (ws.xs[k].as_slice(), ws.us[k].as_slice());
@@ -115,44 +74,49 @@ pub fn backward_pass(
             ws.quu += &ws.hess.huu;
             ws.qux += &ws.hess.hux;
         }
-        // Regularised factorisation, Q̃_uu = Q_uu + λI (eq. (8.27) asks for Q_uu > 0).
-        ws.quu_chol.copy_from(&ws.quu);
-        for i in 0..ws.nu {
-            ws.quu_chol[(i, i)] += lambda;
+        // Regularised factorisation, Q̃_uu = Q_uu + λI (eq. (8.27) asks for Q_uu > 0), and its inverse.
+        ws.quu_reg.copy_from(&ws.quu);
+        for i in 0..nu {
+            ws.quu_reg[(i, i)] += lambda;
         }
-        if !cholesky_in_place(&mut ws.quu_chol) {
+        if !cholesky_inverse(&ws.quu_reg, &mut ws.quu_chol, &mut ws.quu_inv) {
             return Ok(Backward::NotPositiveDefinite(k));
         }
         // Gains (eqs. (8.29)–(8.30)): l = −Q̃_uu⁻¹ Q_u, L = −Q̃_uu⁻¹ Q_ux.
         let kff = &mut ws.kff[k];
-        kff.copy_from(&ws.qu);
-        cholesky_solve_in_place(&ws.quu_chol, kff.as_mut_slice());
+        kff.fill(0.0);
+        dense::gemv_n_add(kff.as_mut_slice(), ws.quu_inv.as_slice(), ws.qu.as_slice(), nu, nu);
         kff.neg_mut();
         let kfb = &mut ws.kfb[k];
-        kfb.copy_from(&ws.qux);
-        for c in 0..ws.ndx {
-            cholesky_solve_in_place(&ws.quu_chol, kfb.column_mut(c).as_mut_slice());
-        }
+        dense::mul_nn(kfb.as_mut_slice(), ws.quu_inv.as_slice(), ws.qux.as_slice(), nu, nu, ndx, false);
         kfb.neg_mut();
         // Value update in the form of Tassa's code, valid for any gains:
-        // V_x = Q_x + Lᵀ Q_uu l + Lᵀ Q_u + Q_uxᵀ l, V_xx = Q_xx + Lᵀ Q_uu L + Lᵀ Q_ux + Q_uxᵀ L.
-        // With λ = 0 it equals eqs. (8.32)–(8.33).
+        // V_x = Q_x + Lᵀ (Q_u + Q_uu l) + Q_uxᵀ l, V_xx = Q_xx + Lᵀ (Q_ux + Q_uu L) + Q_uxᵀ L.
+        // With λ = 0 it equals eqs. (8.32)–(8.33). The two products of V_xx are one: [L; Q_ux]ᵀ [Q_ux + Q_uu L; L].
         let (kff, kfb) = (&ws.kff[k], &ws.kfb[k]);
         ws.tmp_u.copy_from(&ws.qu);
-        ws.tmp_u.gemv(1.0, &ws.quu, kff, 1.0);
+        dense::gemv_n_add(ws.tmp_u.as_mut_slice(), ws.quu.as_slice(), kff.as_slice(), nu, nu);
         let vx = &mut vx_now[k];
         vx.copy_from(&ws.qx);
-        vx.gemv_tr(1.0, kfb, &ws.tmp_u, 1.0);
-        vx.gemv_tr(1.0, &ws.qux, kff, 1.0);
+        dense::gemv_t(vx.as_mut_slice(), kfb.as_slice(), ws.tmp_u.as_slice(), nu, ndx, true);
+        dense::gemv_t(vx.as_mut_slice(), ws.qux.as_slice(), kff.as_slice(), nu, ndx, true);
         ws.tmp_ux.copy_from(&ws.qux);
-        mul_add(&mut ws.tmp_ux, &ws.quu, kfb);
+        dense::mul_nn(ws.tmp_ux.as_mut_slice(), ws.quu.as_slice(), kfb.as_slice(), nu, nu, ndx, true);
+        {
+            let (z1, z2) = (ws.z1.as_mut_slice(), ws.z2.as_mut_slice());
+            let (l, qux, h) = (kfb.as_slice(), ws.qux.as_slice(), ws.tmp_ux.as_slice());
+            for c in 0..ndx {
+                let (s, t) = (c * nu, c * 2 * nu);
+                z1[t..t + nu].copy_from_slice(&l[s..s + nu]);
+                z1[t + nu..t + 2 * nu].copy_from_slice(&qux[s..s + nu]);
+                z2[t..t + nu].copy_from_slice(&h[s..s + nu]);
+                z2[t + nu..t + 2 * nu].copy_from_slice(&l[s..s + nu]);
+            }
+        }
         let vxx = &mut vxx_now[k];
         vxx.copy_from(&ws.qxx);
-        kfb.tr_mul_to(&ws.tmp_ux, &mut ws.fxt_v);
-        *vxx += &ws.fxt_v;
-        ws.qux.tr_mul_to(kfb, &mut ws.fxt_v);
-        *vxx += &ws.fxt_v;
-        symmetrise(vxx);
+        // (symmetric in exact arithmetic: the upper triangle is kept and mirrored)
+        dense::mul_tn_sym(vxx.as_mut_slice(), ws.z1.as_slice(), ws.z2.as_slice(), 2 * nu, ndx, true);
         if !vx.iter().all(|v| v.is_finite()) || !vxx.iter().all(|v| v.is_finite()) {
             // Gains too aggressive for the local model (tiny λ on an ill-conditioned Q_uu): treat it like a
             // failed factorisation so that the caller raises λ instead of stopping.
@@ -162,44 +126,12 @@ pub fn backward_pass(
     Ok(Backward::Done)
 }
 
-/// `out += a b` for column-major matrices, column by column (axpy form, vectorises well). Written out
-/// because nalgebra's dynamic `gemm` allocates a packing buffer on every call.
-fn mul_add(out: &mut DMatrix<f64>, a: &DMatrix<f64>, b: &DMatrix<f64>) {
-    let (m, k) = (a.nrows(), a.ncols());
-    debug_assert_eq!((out.nrows(), out.ncols(), b.nrows()), (m, b.ncols(), k));
-    let asl = a.as_slice();
-    for j in 0..b.ncols() {
-        let oc = &mut out.as_mut_slice()[j * m..(j + 1) * m];
-        for p in 0..k {
-            let bpj = b[(p, j)];
-            if bpj == 0.0 {
-                continue;
-            }
-            let ac = &asl[p * m..(p + 1) * m];
-            for i in 0..m {
-                oc[i] += ac[i] * bpj;
-            }
-        }
-    }
-}
-
-fn symmetrise(a: &mut DMatrix<f64>) {
-    let n = a.nrows();
-    for i in 0..n {
-        for j in i + 1..n {
-            let m = 0.5 * (a[(i, j)] + a[(j, i)]);
-            a[(i, j)] = m;
-            a[(j, i)] = m;
-        }
-    }
-}
-
 /// Coefficients of the cost change the local LQ model predicts for step α: `ΔJ(α) = α d1 + ½ α² d2`.
 /// Exact for the LQ model with the computed gains (any λ, gaps included): the linearised deviations are
 /// `δx_k = α d_k` with `d₀ = f̄₀`, `d_{k+1} = Fx d_k + Fu (l_k + L_k d_k) + f̄_{k+1}` (Valverde 2018,
 /// eq. (8.45) linearised).
 pub fn expected_change(ws: &mut Workspace, gaps: bool) -> (f64, f64) {
-    let n = ws.n;
+    let (n, ndx, nu) = (ws.n, ws.ndx, ws.nu);
     let (mut d1, mut d2) = (0.0, 0.0);
     if gaps {
         ws.dx.copy_from(&ws.gaps[0]);
@@ -210,48 +142,37 @@ pub fn expected_change(ws: &mut Workspace, gaps: bool) -> (f64, f64) {
         let d = &ws.diffs[k];
         // du = l + L dx
         ws.tmp_u.copy_from(&ws.kff[k]);
-        ws.tmp_u.gemv(1.0, &ws.kfb[k], &ws.dx, 1.0);
-        d1 += d.lx.dot(&ws.dx) + d.lu.dot(&ws.tmp_u);
+        dense::gemv_n_add(ws.tmp_u.as_mut_slice(), ws.kfb[k].as_slice(), ws.dx.as_slice(), nu, ndx);
+        d1 += dense::dot(d.lx.as_slice(), ws.dx.as_slice()) + dense::dot(d.lu.as_slice(), ws.tmp_u.as_slice());
         d2 += quad(&d.lxx, &ws.dx) + quad(&d.luu, &ws.tmp_u) + 2.0 * bilinear(&d.lxu, &ws.dx, &ws.tmp_u);
         if gaps {
             ws.dx2.copy_from(&ws.gaps[k + 1]);
         } else {
             ws.dx2.fill(0.0);
         }
-        ws.dx2.gemv(1.0, &d.fx, &ws.dx, 1.0);
-        ws.dx2.gemv(1.0, &d.fu, &ws.tmp_u, 1.0);
+        dense::gemv_n_add(ws.dx2.as_mut_slice(), d.fx.as_slice(), ws.dx.as_slice(), ndx, ndx);
+        dense::gemv_n_add(ws.dx2.as_mut_slice(), d.fu.as_slice(), ws.tmp_u.as_slice(), ndx, nu);
         std::mem::swap(&mut ws.dx, &mut ws.dx2);
     }
     let d = &ws.diffs[n];
-    d1 += d.lx.dot(&ws.dx);
+    d1 += dense::dot(d.lx.as_slice(), ws.dx.as_slice());
     d2 += quad(&d.lxx, &ws.dx);
     (d1, d2)
 }
 
+/// `xᵀ a x` (a square, column-major).
 fn quad(a: &DMatrix<f64>, x: &DVector<f64>) -> f64 {
-    let mut s = 0.0;
-    for j in 0..a.ncols() {
-        let xj = x[j];
-        if xj == 0.0 {
-            continue;
-        }
-        let mut c = 0.0;
-        for i in 0..a.nrows() {
-            c += a[(i, j)] * x[i];
-        }
-        s += c * xj;
-    }
-    s
+    bilinear(a, x, x)
 }
 
+/// `xᵀ a y` (a: len(x) × len(y), column-major).
 fn bilinear(a: &DMatrix<f64>, x: &DVector<f64>, y: &DVector<f64>) -> f64 {
+    let (m, xs) = (a.nrows(), x.as_slice());
     let mut s = 0.0;
-    for j in 0..a.ncols() {
-        let mut c = 0.0;
-        for i in 0..a.nrows() {
-            c += a[(i, j)] * x[i];
+    for (j, &yj) in y.iter().enumerate() {
+        if yj != 0.0 {
+            s += yj * dense::dot(&a.as_slice()[j * m..(j + 1) * m], xs);
         }
-        s += c * y[j];
     }
     s
 }

@@ -3,6 +3,7 @@
 //! with, in the feasibility-driven variant, the gaps closed by the fraction α:
 //! `x̂_{k+1} = F(x̂_k, û_k) ⊕ (α − 1) f̄_{k+1}` (α = 1 gives a true rollout).
 
+use super::dense;
 use super::problem::ActionModel;
 use super::workspace::Workspace;
 use crate::error::{FfError, Result};
@@ -65,7 +66,8 @@ pub fn rollout_trial(model: &mut dyn ActionModel, ws: &mut Workspace, alpha: f64
         let u = &mut ws.us_try[k];
         u.copy_from(&ws.us[k]);
         u.axpy(alpha, &ws.kff[k], 1.0);
-        u.gemv(1.0, &ws.kfb[k], &ws.dx, 1.0);
+        let nu = u.len();
+        dense::gemv_n_add(u.as_mut_slice(), ws.kfb[k].as_slice(), ws.dx.as_slice(), nu, ws.ndx);
         let c = model.calc(k, ws.xs_try[k].as_slice(), ws.us_try[k].as_slice(), ws.xnext.as_mut_slice())?;
         check_step(k, c, ws.xnext.as_slice(), "the line-search rollout")?;
         ws.costs_try[k] = c;

@@ -11,6 +11,7 @@
 //! central-difference oracle for the tests).
 
 pub mod backward;
+mod dense;
 pub mod forward;
 pub mod problem;
 pub mod regularisation;

@@ -48,6 +48,10 @@ impl NodeDiff {
     pub fn clear(&mut self) {
         self.fx.fill(0.0);
         self.fu.fill(0.0);
+        self.clear_costs();
+    }
+    /// Set the cost derivatives to zero, leaving fx and fu (for a model that overwrites both).
+    pub fn clear_costs(&mut self) {
         self.lx.fill(0.0);
         self.lu.fill(0.0);
         self.lxx.fill(0.0);

@@ -14,7 +14,7 @@ use crate::data::Data;
 use crate::dynamics::aba;
 use crate::dynamics::derivatives::Derivatives;
 use crate::error::{FfError, Result};
-use crate::kinematics::{frame_jacobian, Reference};
+use crate::kinematics::{jacobian_from_data, Reference};
 use crate::model::{JointType, Model};
 use crate::spatial::V6;
 use nalgebra::{DMatrix, DVector};
@@ -286,7 +286,8 @@ impl FloatingRobot {
             let w = &t.weights.current;
             match &t.residual {
                 Residual::FramePlacement { body, placement, refs } => {
-                    frame_jacobian(&self.model, &mut self.data, q, *body, placement, Reference::Local, &mut self.jac)?;
+                    // the kinematics of q are in `data` (after `step_jacobians` or forward kinematics)
+                    jacobian_from_data(&self.model, &self.data, *body, placement, Reference::Local, &mut self.jac);
                     let o_mf = self.data.o_mi[*body].compose(placement);
                     let (r, jl) = placement_residual(&o_mf, &refs[(k + self.offset).min(refs.len() - 1)]);
                     // J = Jr⁻¹(r) J_local (6 × nv), then 2 Jᵀ W r and 2 Jᵀ W J.
@@ -302,7 +303,7 @@ impl FloatingRobot {
                     add_gauss_newton(&self.jres, 6, &self.res, w, d, nv);
                 }
                 Residual::FrameDualQuat { body, placement, refs } => {
-                    frame_jacobian(&self.model, &mut self.data, q, *body, placement, Reference::Local, &mut self.jac)?;
+                    jacobian_from_data(&self.model, &self.data, *body, placement, Reference::Local, &mut self.jac);
                     let o_mf = self.data.o_mi[*body].compose(placement);
                     let g = frame_dual_quat(&self.model, q, *body, placement, &o_mf)?;
                     dual_quat_jacobian(&g, &o_mf, &self.jac, &mut self.jres);
@@ -427,12 +428,14 @@ impl ActionModel for FloatingRobot {
         self.cost(self.n, x, None)
     }
     fn calc_diff(&mut self, k: usize, x: &[f64], u: &[f64], d: &mut NodeDiff) -> Result<()> {
-        d.clear();
+        // `step_jacobians` writes every entry of fx and fu; the cost terms add into the rest.
+        d.clear_costs();
         self.step_jacobians(x, u, &mut d.fx, &mut d.fu)?;
         self.cost_diff(k, x, Some(u), d)
     }
     fn calc_diff_terminal(&mut self, x: &[f64], d: &mut NodeDiff) -> Result<()> {
         d.clear();
+        crate::kinematics::forward_kinematics(&self.model, &mut self.data, &x[..self.model.nq])?;
         self.cost_diff(self.n, x, None, d)
     }
     fn schedule_end(&self) -> usize {

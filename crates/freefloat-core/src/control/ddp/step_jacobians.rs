@@ -16,7 +16,6 @@
 
 use super::lie::{exp6, se3_right_jacobian_inv};
 use super::robot::FloatingRobot;
-use crate::dynamics::aba;
 use crate::dynamics::derivatives::aba_derivatives;
 use crate::error::{FfError, Result};
 use crate::model::JointType;
@@ -24,7 +23,7 @@ use crate::spatial::{skew, M6, V6};
 use nalgebra::DMatrix;
 
 impl FloatingRobot {
-    /// `fx` (2nv × 2nv) and `fu` (2nv × nv) of the step at (x, u); leaves the kinematics of q in `data` (as
+    /// `fx` (2nv × 2nv) and `fu` (2nv × nv) of the step at (x, u), every entry written; leaves the kinematics of q in `data` (as
     /// `step` does), which the cost derivatives read.
     pub fn step_jacobians(&mut self, x: &[f64], u: &[f64], fx: &mut DMatrix<f64>, fu: &mut DMatrix<f64>) -> Result<()> {
         let (nq, nv) = (self.model.nq, self.model.nv);
@@ -100,8 +99,7 @@ impl FloatingRobot {
                 }
             }
         }
-        // the cost derivatives read the kinematics at q, as after `step`
-        aba(&self.model, &mut self.data, q, v, u, None)?;
+        // `aba_derivatives` ran forward kinematics at q: the cost derivatives read them from `data`.
         Ok(())
     }
 }

@@ -51,16 +51,24 @@ pub struct Workspace {
     pub quu: DMatrix<f64>,
     /// Q_ux (nu × ndx).
     pub qux: DMatrix<f64>,
+    /// Q_uu + λI.
+    pub quu_reg: DMatrix<f64>,
     /// Cholesky factor of Q_uu + λI.
     pub quu_chol: DMatrix<f64>,
+    /// (Q_uu + λI)⁻¹.
+    pub quu_inv: DMatrix<f64>,
     /// V_x' + V_xx' f̄' (the gap-corrected gradient of the next node).
     pub vx_plus: DVector<f64>,
-    /// Fxᵀ V_xx' (ndx × ndx).
-    pub fxt_v: DMatrix<f64>,
-    /// Fuᵀ V_xx' (nu × ndx).
-    pub fut_v: DMatrix<f64>,
-    /// nu × ndx scratch.
+    /// P_x = V_xx' Fx (ndx × ndx).
+    pub px: DMatrix<f64>,
+    /// P_u = V_xx' Fu (ndx × nu).
+    pub pu: DMatrix<f64>,
+    /// nu × ndx scratch (Q_ux + Q_uu L).
     pub tmp_ux: DMatrix<f64>,
+    /// [L; Q_ux] (2 nu × ndx) of the value update.
+    pub z1: DMatrix<f64>,
+    /// [Q_ux + Q_uu L; L] (2 nu × ndx).
+    pub z2: DMatrix<f64>,
     /// nu scratch.
     pub tmp_u: DVector<f64>,
     /// ndx scratch.
@@ -100,11 +108,15 @@ impl Workspace {
             qxx: DMatrix::zeros(ndx, ndx),
             quu: DMatrix::zeros(nu, nu),
             qux: DMatrix::zeros(nu, ndx),
+            quu_reg: DMatrix::zeros(nu, nu),
             quu_chol: DMatrix::zeros(nu, nu),
+            quu_inv: DMatrix::zeros(nu, nu),
             vx_plus: DVector::zeros(ndx),
-            fxt_v: DMatrix::zeros(ndx, ndx),
-            fut_v: DMatrix::zeros(nu, ndx),
+            px: DMatrix::zeros(ndx, ndx),
+            pu: DMatrix::zeros(ndx, nu),
             tmp_ux: DMatrix::zeros(nu, ndx),
+            z1: DMatrix::zeros(2 * nu, ndx),
+            z2: DMatrix::zeros(2 * nu, ndx),
             tmp_u: DVector::zeros(nu),
             dx: DVector::zeros(ndx),
             dx2: DVector::zeros(ndx),

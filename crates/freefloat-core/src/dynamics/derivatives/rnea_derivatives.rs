@@ -348,7 +348,8 @@ pub(crate) fn cholesky_inverse(a: &DMatrix<f64>, l: &mut DMatrix<f64>, inv: &mut
             *x *= inv_d;
         }
     }
-    // inv = L⁻ᵀ L⁻¹, column by column: L y = e_c (forward, by columns), then Lᵀ x = y (dot products).
+    // inv = L⁻ᵀ L⁻¹ = Yᵀ Y with Y = L⁻¹ (lower triangular). First Y into inv, column by column by forward
+    // substitution in axpy form (L y = e_c).
     let ls = l.as_slice();
     let is = inv.as_mut_slice();
     for c in 0..n {
@@ -358,16 +359,43 @@ pub(crate) fn cholesky_inverse(a: &DMatrix<f64>, l: &mut DMatrix<f64>, inv: &mut
         for k in c..n {
             let yk = x[k] / ls[k * n + k];
             x[k] = yk;
-            if yk != 0.0 {
-                for (xi, li) in x[k + 1..].iter_mut().zip(&ls[k * n + k + 1..(k + 1) * n]) {
-                    *xi -= yk * li;
-                }
+            for (xi, li) in x[k + 1..].iter_mut().zip(&ls[k * n + k + 1..(k + 1) * n]) {
+                *xi -= yk * li;
             }
         }
-        for i in (0..n).rev() {
-            let t: f64 = x[i + 1..].iter().zip(&ls[i * n + i + 1..(i + 1) * n]).map(|(a, b)| a * b).sum();
-            x[i] = (x[i] - t) / ls[i * n + i];
+    }
+    // Then (Yᵀ Y)ᵢⱼ = Σ_{k ≥ j} Y_ki Y_kj for i ≤ j, in place: column by column, the diagonal last. An entry
+    // written at (i < j) overwrites a zero of Y; the diagonal Y_jj is read only by entries (i, j') with
+    // i, j' ≤ j, all done by then; the strict lower triangle of Y stays until the mirror at the end.
+    for j in 0..n {
+        for i in 0..=j {
+            let (ci, cj) = (i * n, j * n);
+            let t = dot4(&is[ci + j..ci + n], &is[cj + j..cj + n]);
+            is[cj + i] = t;
+        }
+    }
+    for j in 0..n {
+        for i in j + 1..n {
+            is[j * n + i] = is[i * n + j];
         }
     }
     true
+}
+
+/// Dot product with 4 partial sums (vectorises; a plain sum is one long dependency chain).
+#[inline(always)]
+fn dot4(x: &[f64], y: &[f64]) -> f64 {
+    let mut s = [0.0_f64; 4];
+    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
+    let (xr, yr) = (xc.remainder(), yc.remainder());
+    for (a, b) in xc.zip(yc) {
+        for l in 0..4 {
+            s[l] += a[l] * b[l];
+        }
+    }
+    let mut t = (s[0] + s[1]) + (s[2] + s[3]);
+    for (a, b) in xr.iter().zip(yr) {
+        t += a * b;
+    }
+    t
 }
