@@ -119,7 +119,11 @@ def test_bad_blocks_name_file_line_and_key(tmp_path, block, key, words):
 @pytest.mark.parametrize(
     "block,typo,suggestion",
     [
-        ("actuators:\n  thrusters:\n    - {direction: [0, 0, 1], max_thrust: 1, isp: 70, ramp_onn: 0.1}\n", "ramp_onn", "ramp_on"),
+        (
+            "actuators:\n  thrusters:\n    - {direction: [0, 0, 1], max_thrust: 1, isp: 70, ramp_onn: 0.1}\n",
+            "ramp_onn",
+            "ramp_on",
+        ),
         ("actuators:\n  tankz: []\n", "tankz", "tanks"),
         ("environment:\n  orbit: {altitud: 5.0e5}\n", "altitud", "altitude"),
         ("environment:\n  gravity_gradiant: true\n", "gravity_gradiant", "gravity_gradient"),
@@ -129,7 +133,9 @@ def test_bad_blocks_name_file_line_and_key(tmp_path, block, key, words):
     ],
 )
 def test_unknown_keys_suggest_the_right_one(tmp_path, block, typo, suggestion):
-    with pytest.raises(InputError, match=rf"line \d+: unknown key '[\w.\[\]]*{typo}' \(did you mean '{suggestion}'\?\)"):
+    with pytest.raises(
+        InputError, match=rf"line \d+: unknown key '[\w.\[\]]*{typo}' \(did you mean '{suggestion}'\?\)"
+    ):
         load_with(tmp_path, block)
 
 
@@ -183,7 +189,9 @@ def test_propellant_used_is_the_closed_form_of_the_firings(short_run):
 def test_momentum_changes_by_the_thrust_plus_what_the_propellant_carried(short_run):
     sc, res = short_run
     mb = res.to_dict()["momentum_balance"]
-    dP, thrust, away = (np.asarray(mb[k]) for k in ("momentum_change", "integrated_thrust", "carried_away_by_propellant"))
+    dP, thrust, away = (
+        np.asarray(mb[k]) for k in ("momentum_change", "integrated_thrust", "carried_away_by_propellant")
+    )
     # the thrust is a real fraction of the change (the check is not vacuous) and so is the carried momentum
     assert np.linalg.norm(thrust[:3]) > 10.0 and np.linalg.norm(away[:3]) > 1.0
     # the balance closes to the integration error of a 4th-order scheme at 0.5 ms (Simpson against RK4)

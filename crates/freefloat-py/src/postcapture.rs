@@ -2,11 +2,11 @@
 //! estimators (ordinary RLS with forgetting; the paper's modified RLS, eqs. 34-38) as Python objects
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
+use crate::environment::PyEnvironment;
 use crate::errors::{guard, input_err, reraise_foreign, signal_hook};
 use crate::model::PyModel;
-use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
-use crate::environment::PyEnvironment;
 use freefloat_core::environment::Environment;
+use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
 use freefloat_core::postcapture::{simulate_postcapture_with, thruster_base_wrench, PostcaptureControl};
 use freefloat_core::spatial::V3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};

@@ -38,6 +38,7 @@ def _tank_ref(x):
         raise _Bad(f"expected a tank name or index, got {x!r}")
     return x
 
+
 Numbers = numbers()
 NumberOrNumbers = numbers(scalar_ok=True)
 

@@ -142,7 +142,6 @@ def _blocks(d: dict, source: str, m):
     from .. import sensors as sn
     from ..actuators import Actuators
     from ..environment import environment_from_dict
-
     from ..io import schema
 
     # the blocks as the schema read them: numbers written as YAML 1.1 text (1e5) are numbers, as everywhere
