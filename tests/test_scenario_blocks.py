@@ -257,5 +257,6 @@ def test_identification_error_grows_with_gyro_noise(tmp_path):
         res.truth_history = truth_history(m, sim, False, pc.estimators._target_index(m))
         e = res.rel_error("force", "standard_rls")
         errs.append(float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in cols]))))
+    print("gyro noise x1, x10, x50: RMS relative error", errs)
     assert errs[0] < errs[1] < errs[2], errs
     assert errs[2] > 5 * errs[0], errs

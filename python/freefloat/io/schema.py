@@ -370,9 +370,11 @@ def check(kind: str, d: dict, source: str, text: str | None = None) -> None:
         raise InputError(first + more) from None
 
 
-def validated(kind: str, d: dict):
-    """The schema's reading of a mapping that `check` accepted (numbers as numbers, nested blocks as models)."""
-    return _model(kind).model_validate(d)
+def validated_block(name: str, value):
+    """The schema's reading of a registered block that `check` accepted (numbers as numbers, mappings as models)."""
+    from pydantic import TypeAdapter
+
+    return TypeAdapter(_BLOCKS[name][0]).validate_python(value)
 
 
 def literal(*values):

@@ -145,13 +145,12 @@ def _blocks(d: dict, source: str, m):
     from ..io import schema
 
     # the blocks as the schema read them: numbers written as YAML 1.1 text (1e5) are numbers, as everywhere
-    checked = schema.validated("postcapture", d)
     d = dict(d)
     for key in ("actuators", "environment", "telemetry"):
-        if getattr(checked, key, None) is not None:
-            d[key] = getattr(checked, key).model_dump(exclude_unset=True)
-    if getattr(checked, "sensors", None) is not None:
-        d["sensors"] = [s.model_dump(exclude_unset=True) for s in checked.sensors]
+        if d.get(key) is not None:
+            d[key] = schema.validated_block(key, d[key]).model_dump(exclude_unset=True)
+    if d.get("sensors") is not None:
+        d["sensors"] = [s.model_dump(exclude_unset=True) for s in schema.validated_block("sensors", d["sensors"])]
     acts = env = sset = None
     if d.get("actuators"):
         try:

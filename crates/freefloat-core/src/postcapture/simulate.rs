@@ -98,7 +98,45 @@ pub fn thruster_base_wrench(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::actuators::{Tank, Thruster};
     use crate::spatial::V3;
+
+    /// The base wrench of one thruster is [F d; r × F d] while it fires (closed form, d normalised) and zero
+    /// outside its firing; its tank's flow is −F/(Isp g0); an empty tank gives neither.
+    #[test]
+    fn thruster_base_wrench_is_the_closed_form() {
+        let m = crate::model::builtin::load("zhang2020_3d").unwrap();
+        let (f, isp) = (40.0, 70.0);
+        let th = Thruster {
+            body: 0,
+            position: V3::new(0.1, -0.2, 0.3),
+            direction: V3::new(0.0, 0.0, 2.0),
+            max_thrust: f,
+            min_on_time: 0.0,
+            ramp_on: 0.0,
+            ramp_off: 0.0,
+            isp: Some(isp),
+            tank: Some(0),
+            firings: vec![(1.0, 1.0)],
+        };
+        let tank = Tank { body: 0, position: V3::zeros(), mass: 10.0, radius: 0.0 };
+        let acts = Actuators { wheels: vec![], thrusters: vec![th], tanks: vec![tank] };
+        let t = [0.5, 1.5, 2.5, 1.5];
+        let mp = [10.0, 9.0, 8.0, 0.0];
+        let (w, flow) = thruster_base_wrench(&m, &acts, &t, &mp).unwrap();
+        let expect_on = [0.0, 0.0, f, -0.2 * f, -0.1 * f, 0.0]; // r × (0, 0, F)
+        for (k, on) in [false, true, false, false].iter().enumerate() {
+            for j in 0..6 {
+                let e = if *on { expect_on[j] } else { 0.0 };
+                assert!((w[6 * k + j] - e).abs() < 1e-12, "sample {k} entry {j}: {} vs {e}", w[6 * k + j]);
+            }
+            let e = if *on { -f / (isp * crate::sim::actuators::G0) } else { 0.0 };
+            assert!((flow[k] - e).abs() < 1e-15, "sample {k}: flow {} vs {e}", flow[k]);
+        }
+        let mut off_base = acts.clone();
+        off_base.thrusters[0].body = 1;
+        assert!(thruster_base_wrench(&m, &off_base, &t, &mp).is_err());
+    }
 
     fn control(nj: usize, f_max: f64) -> PostcaptureControl {
         PostcaptureControl {
