@@ -666,9 +666,15 @@ t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict wi
 parameters about the reference points). Arrays have a leading sample axis.
     """
 
-def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1, max_memory: ArrayLike | None = None) -> Any:
+def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1, max_memory: ArrayLike | None = None, actuators: ArrayLike | None = None, environment: ArrayLike | None = None) -> Any:
     """Simulate the post-capture scenario. Returns a dict like `simulate` (t, q, v, ddq, tau, momentum,
 kinetic_energy, work) recorded every `record_every` RK4 steps.
+    """
+
+def postcapture_thruster_wrench(model: Model, actuators: ArrayLike, t: ArrayLike, propellant: ArrayLike) -> Any:
+    """The thrusters' wrench on the base (T × 6, body frame about the base origin, the base entries of the
+generalized force) and each tank's propellant flow (T × tanks, kg/s) at the samples `t` of a run with
+`propellant` (T × tanks) left: the engine's thruster model, as the stepper evaluates it.
     """
 
 def quat_to_matrix(quat: ArrayLike) -> Any:

@@ -2,11 +2,13 @@
 //! estimators (ordinary RLS with forgetting; the paper's modified RLS, eqs. 34-38) as Python objects
 //! with `update(...)` for one sample and `run(...)` for many (one call, the loop in Rust).
 
+use crate::environment::PyEnvironment;
 use crate::errors::{guard, guard_raw, input_err, interrupted_with, reraise_foreign, signal_hook, to_py};
 use crate::model::PyModel;
+use freefloat_core::environment::Environment;
 use freefloat_core::error::{FfError, Partial};
 use freefloat_core::estimation::{CoupledSample, Coupling, ModifiedRls, Rls};
-use freefloat_core::postcapture::{simulate_postcapture, PostcaptureControl};
+use freefloat_core::postcapture::{simulate_postcapture_with, thruster_base_wrench, PostcaptureControl};
 use freefloat_core::spatial::V3;
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::prelude::*;
@@ -28,7 +30,7 @@ fn shaped(name: &str, a: &PyReadonlyArrayDyn<f64>, shape: &[Option<usize>]) -> P
 #[pyfunction]
 #[pyo3(signature = (
     model, q0, v0, t_final, dt, f_max, k_f, m_max, k_m, k_d, k_p, jet, damping, amp, freq, phase, record_every = 1,
-    max_memory = None
+    max_memory = None, actuators = None, environment = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn postcapture_simulate<'py>(
@@ -51,7 +53,15 @@ pub fn postcapture_simulate<'py>(
     phase: Vec<f64>,
     record_every: usize,
     max_memory: Option<f64>,
+    actuators: Option<Bound<'py, PyAny>>,
+    environment: Option<PyRef<'py, PyEnvironment>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let env: Option<Environment> = environment.map(|e| e.inner);
+    let acts = match &actuators {
+        None => None,
+        Some(a) if a.is_none() => None,
+        Some(a) => Some(crate::simulate::parse_actuators(&model.inner, a)?),
+    };
     // the recording must fit in `max_memory` bytes, checked before any work (the run records every step)
     if let (Some(limit), true) = (max_memory, t_final.is_finite() && dt.is_finite() && dt > 0.0 && t_final > 0.0) {
         let samples = (t_final / dt).round() / record_every.max(1) as f64 + 2.0;
@@ -97,7 +107,20 @@ pub fn postcapture_simulate<'py>(
         let raised = &mut raised;
         py.detach(move || {
             let mut hook = signal_hook(raised);
-            guard_raw(|| simulate_postcapture(&m, &q0, &v0, ctl, t_final, dt, record_every, Some(&mut hook)))
+            guard_raw(|| {
+                simulate_postcapture_with(
+                    &m,
+                    &q0,
+                    &v0,
+                    ctl,
+                    t_final,
+                    dt,
+                    record_every,
+                    acts,
+                    env.as_ref(),
+                    Some(&mut hook),
+                )
+            })
         })
     };
     reraise_foreign(py, raised)?;
@@ -113,6 +136,28 @@ pub fn postcapture_simulate<'py>(
         }
         Err(e) => Err(to_py(e)),
     }
+}
+
+/// The thrusters' wrench on the base (T × 6, body frame about the base origin, the base entries of the
+/// generalized force) and each tank's propellant flow (T × tanks, kg/s) at the samples `t` of a run with
+/// `propellant` (T × tanks) left: the engine's thruster model, as the stepper evaluates it.
+#[pyfunction]
+pub fn postcapture_thruster_wrench<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    actuators: Bound<'py, PyAny>,
+    t: PyReadonlyArray1<'py, f64>,
+    propellant: PyReadonlyArrayDyn<'py, f64>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
+    let acts = crate::simulate::parse_actuators(&model.inner, &actuators)?;
+    let tv = t.as_array().to_vec();
+    let mp: Vec<f64> = propellant.as_array().iter().copied().collect();
+    let nt = acts.tanks.len();
+    let (w, f) = guard(|| thruster_base_wrench(&model.inner, &acts, &tv, &mp))?;
+    Ok((
+        PyArray1::from_vec(py, w).reshape([tv.len(), 6])?.into_any(),
+        PyArray1::from_vec(py, f).reshape([tv.len(), nt])?.into_any(),
+    ))
 }
 
 /// Ordinary recursive least squares with forgetting factor (Rust `estimation::Rls`).

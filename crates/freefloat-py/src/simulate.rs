@@ -386,7 +386,7 @@ enum TorqueSpec<'py> {
 /// Read the `actuators` argument: a dict `{"wheels": [...], "thrusters": [...], "tanks": [...]}` of
 /// dicts (what `freefloat.Actuators.to_dict()` writes); joints and bodies by name. Every key is
 /// checked; errors name the entry (`actuators.wheels[1].max_torque`).
-fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actuators> {
+pub(crate) fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actuators> {
     let d = a.downcast::<PyDict>().map_err(|_| {
         input_err("argument `actuators`: expected a freefloat.Actuators or a dict with wheels/thrusters/tanks lists")
     })?;

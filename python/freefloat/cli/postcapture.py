@@ -19,7 +19,13 @@ from .._core import Interrupted
     default=None,
     help="Force measurement noise on (the scenario's `noise`, or the default study levels) or off.",
 )
-@click.option("--seed", type=int, default=0, show_default=True, help="Seed of the measurement noise.")
+@click.option(
+    "--seed",
+    type=int,
+    default=0,
+    show_default=True,
+    help="Seed of the measurement noise (the `noise:` block, or the random streams of the `sensors:`).",
+)
 @click.option(
     "--sweep/--no-sweep",
     default=True,
@@ -93,9 +99,21 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
         f"(rhs up to {r['momentum']['paper_angular_scale']:.2e}), force form {r['force']['paper_angular']:.2e} "
         f"(rhs up to {r['force']['paper_angular_scale']:.2e})"
     )
+    ex = res.extra
+    if "propellant" in ex:  # a scenario with thrusters and tanks (actuators: block)
+        mb, pb = ex["mass_balance"], ex.get("momentum_balance", {})
+        click.echo(
+            f"propellant used {sum(ex['propellant']['used_kg']):.4g} kg; base mass change + propellant through the "
+            f"nozzles = {mb['residual_kg']:.1e} kg"
+            + (f"; momentum balance relative residual {pb['relative_residual']:.1e}" if pb else "")
+        )
     click.echo(
         f"simulation + measurements + 4 estimators: {wall:.2f} s (simulation {res.timings['simulation']:.2f} s)"
-        + (f"; noise {sc.noise}" if sc.noise else "; noise-free")
+        + (
+            f"; noise {sc.noise}"
+            if sc.noise
+            else (f"; measured by the sensors {sc.sensors.names()}" if sc.sensors is not None else "; noise-free")
+        )
         + (f"; measurement {sc.measurement}" if sc.measurement else "")
     )
     sw = None

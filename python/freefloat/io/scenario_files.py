@@ -73,6 +73,36 @@ def _parse_yaml(text: str, source: str, check: bool = True) -> dict:
     return d
 
 
+# the YAML text of each scenario read, by its source description: for the line of an error found later
+_TEXTS: dict[str, str] = {}
+
+
+def error_at(source: str, err: Exception) -> InputError:
+    r"""An InputError for a problem found after the schema check (by the engine, against the robot), with the
+    file's line of the key the problem names (`argument \`actuators.tanks[0].mass\`: ...` or
+    `actuators.tanks[0].mass: ...`)."""
+    import re
+
+    msg = str(err)
+    m = re.match(r"(?:argument `([\w.\[\]]+)`|([a-z_]+(?:\[\d+\])?(?:\.[\w]+(?:\[\d+\])?)*))\s*:\s*", msg)
+    if not m:
+        return InputError(f"{source}: {msg}")
+    key = m.group(1) or m.group(2)
+    rest = msg[m.end() :]
+    line = ""
+    text = _TEXTS.get(source)
+    if text is not None:
+        try:
+            root = yaml.compose(text, Loader=yaml.SafeLoader)
+            parent, node = schema._node_at(root, schema._parse_dotted(key))
+            node = node if node is not None else parent
+            if node is not None:
+                line = f" line {node.start_mark.line + 1}:"
+        except yaml.YAMLError:
+            pass
+    return InputError(f"{source}:{line} key '{key}': {rest}")
+
+
 def read(spec: str | Path, kind: str) -> tuple[dict, str]:
     """The parsed scenario `spec` (a built-in name or a file path) and a description of where it came from.
 
@@ -93,6 +123,7 @@ def read(spec: str | Path, kind: str) -> tuple[dict, str]:
         own = ", ".join(s.name for s in listing() if s.kind == kind) or "none"
         raise InputError(f"scenario '{spec}' not found (built-in {kind} scenarios: {own}; or give a .yaml file path)")
     d = _parse_yaml(text, source)
+    _TEXTS[source] = text
     found = d.get("kind", DEFAULT_KIND)
     if found != kind:
         raise InputError(f"{source} is a '{found}' scenario, not '{kind}': run it with `{KINDS[found]} {spec}`")

@@ -8,7 +8,10 @@ block shared by several kinds with `schema.register_block`."""
 
 from __future__ import annotations
 
-from pydantic import model_validator
+import math
+from typing import Annotated, Any
+
+from pydantic import Field, PlainValidator, model_validator
 
 from .schema import (
     _TYPES_ONLY,
@@ -24,8 +27,17 @@ from .schema import (
     literal,
     number,
     numbers,
+    register_block,
     register_kind,
 )
+
+
+def _tank_ref(x):
+    # a thruster's tank: its name or its index in the tanks list
+    if isinstance(x, bool) or not isinstance(x, (str, int)) or (isinstance(x, int) and x < 0):
+        raise _Bad(f"expected a tank name or index, got {x!r}")
+    return x
+
 
 Numbers = numbers()
 NumberOrNumbers = numbers(scalar_ok=True)
@@ -132,6 +144,9 @@ class Postcapture(_Scenario):
                 f"key 'sample_period': {self.sample_period:g} s leaves fewer than 3 samples in duration = "
                 f"{self.duration:g} s"
             )
+        sensors = getattr(self, "sensors", None)
+        check_sensor_names(sensors)
+        check_sensor_rates(sensors, self.dt)
         steps = self.duration / self.dt
         if steps > MAX_STEPS:
             raise _Bad(
@@ -293,3 +308,283 @@ register_kind("control_adaptive", ControlAdaptive)
 register_kind("identify_cl", IdentifyCl)
 register_kind("control_ddp", ControlDdp)
 register_kind("campaign", Campaign)
+
+
+# -- shared blocks: actuators, environment, sensors (issue 17) ---------------------------------------------
+# Each block maps 1:1 onto the Python API object that runs it (freefloat.Actuators, freefloat.Environment,
+# freefloat.sensors.SensorSet): the keys are those objects' fields, so a scenario block and a
+# `simulate --actuators/--environment` / `measure --sensors` file read the same. Checks that need the robot (a
+# tank heavier than its body, a joint name) are the engine's, run when the scenario is read (scenario readers).
+Vec3 = numbers(3)
+NonNegOrNonNegs = numbers(scalar_ok=True, lo=0.0)
+OptPositive = Positive | None
+
+
+def _norm(x) -> float:
+    return math.sqrt(sum(float(c) ** 2 for c in x))
+
+
+class ActWheel(Block):
+    joint: Text
+    max_torque: Positive | None = None
+    max_speed: Positive | None = None
+    max_power: Positive | None = None
+    coulomb: NonNegative = 0.0
+    static_friction: NonNegative = 0.0
+    stribeck_speed: Positive | None = None
+    viscous: NonNegative = 0.0
+    limit_cycle_speed: Positive = 1e-4
+    static_imbalance: NonNegative = 0.0
+    dynamic_imbalance: NonNegative = 0.0
+
+
+class ActThruster(Block):
+    name: Text | None = None
+    body: Text | None = None
+    position: Vec3 = None
+    direction: Vec3
+    max_thrust: Positive
+    min_on_time: NonNegative = 0.0
+    ramp_on: NonNegative = 0.0
+    ramp_off: NonNegative = 0.0
+    isp: Positive | None = None
+    tank: Annotated[Any, PlainValidator(_tank_ref)] = None
+    firings: list[numbers(2)] = []
+
+
+class ActTank(Block):
+    name: Text
+    body: Text | None = None
+    position: Vec3 = None
+    mass: Positive
+    radius: NonNegative = 0.0
+
+
+class ActuatorsBlock(Block):
+    wheels: list[ActWheel] = []
+    thrusters: list[ActThruster] = []
+    tanks: list[ActTank] = []
+
+    @model_validator(mode="after")
+    def _cross(self):
+        if _TYPES_ONLY.get():
+            return self
+        seen = set()
+        for j, w in enumerate(self.wheels):
+            at = f"actuators.wheels[{j}]"
+            if w.joint in seen:
+                raise _Bad(f"key '{at}.joint': joint '{w.joint}' has two wheel models")
+            seen.add(w.joint)
+            if w.static_friction and w.static_friction < w.coulomb:
+                raise _Bad(
+                    f"key '{at}.static_friction': {w.static_friction:g} N m is below the Coulomb friction "
+                    f"{w.coulomb:g} N m (inverted: static friction must be >= coulomb)"
+                )
+            if w.static_friction > w.coulomb and w.stribeck_speed is None:
+                raise _Bad(f"key '{at}.stribeck_speed': static friction above Coulomb needs a Stribeck speed")
+        names = [t.name for t in self.tanks]
+        for j, t in enumerate(self.tanks):
+            if names.index(t.name) != j:
+                raise _Bad(f"key 'actuators.tanks[{j}].name': tank name '{t.name}' is used twice")
+        for j, th in enumerate(self.thrusters):
+            at = f"actuators.thrusters[{j}]"
+            if not _norm(th.direction) > 1e-12:
+                raise _Bad(f"key '{at}.direction': has zero length (a thrust direction needs a non-zero vector)")
+            if th.tank is not None:
+                if isinstance(th.tank, int) and th.tank >= len(self.tanks):
+                    raise _Bad(f"key '{at}.tank': tank {th.tank} does not exist ({len(self.tanks)} tanks)")
+                if isinstance(th.tank, str) and th.tank not in names:
+                    raise _Bad(f"key '{at}.tank': no tank named '{th.tank}' (tanks: {', '.join(names) or 'none'})")
+                if th.isp is None:
+                    raise _Bad(f"key '{at}.isp': a thruster fed by a tank needs its Isp (s)")
+            last_end = -math.inf
+            for k, (start, dur) in enumerate(th.firings):
+                if dur < 0:
+                    raise _Bad(f"key '{at}.firings': firing {k} has a negative duration {dur:g} s")
+                if start < last_end:
+                    raise _Bad(
+                        f"key '{at}.firings': firing {k} starts at {start:g} s, before firing {k - 1} ends at "
+                        f"{last_end:g} s (firings must be in time order and not overlap)"
+                    )
+                last_end = start + max(dur, th.min_on_time)
+        return self
+
+
+class EnvCentralBody(Block):
+    mu: Positive = 3.986004418e14
+    radius: Positive = 6378137.0
+    j2: Number = 1.0826267e-3
+
+
+class EnvOrbit(Block):
+    altitude: Positive | None = None
+    semi_major_axis: Positive | None = None
+    eccentricity: number(lo=0.0, hi=1.0, hi_open=True) = None
+    inclination_deg: Number = None
+    raan_deg: Number = None
+    arg_periapsis_deg: Number = None
+    true_anomaly_deg: Number = None
+    inclination: Number = None
+    raan: Number = None
+    arg_periapsis: Number = None
+    true_anomaly: Number = None
+    position: Vec3 = None
+    velocity: Vec3 = None
+
+
+class EnvDisturbance(Block):
+    force: Vec3 = None
+    torque: Vec3 = None
+    axes: literal("inertial", "body") = "inertial"
+    body: integer(lo=0) = 0
+
+
+class EnvironmentBlock(Block):
+    central_body: EnvCentralBody | None = None
+    orbit: EnvOrbit | None = None
+    gravity_gradient: Bool = False
+    j2: Bool = False
+    disturbance: EnvDisturbance | None = None
+
+    @model_validator(mode="after")
+    def _cross(self):
+        if _TYPES_ONLY.get():
+            return self
+        cb = self.central_body or EnvCentralBody()
+        o = self.orbit
+        if o is not None:
+            given = [k for k in ("altitude", "semi_major_axis", "position") if getattr(o, k) is not None]
+            if len(given) != 1:
+                raise _Bad(
+                    "key 'environment.orbit': give exactly one of altitude, semi_major_axis or position (+ velocity), "
+                    f"got {', '.join(given) or 'none'}"
+                )
+            for k in ("inclination", "raan", "arg_periapsis", "true_anomaly"):
+                if getattr(o, k) is not None and getattr(o, f"{k}_deg") is not None:
+                    raise _Bad(f"key 'environment.orbit.{k}': give {k} or {k}_deg, not both")
+            if o.semi_major_axis is not None:
+                rp = o.semi_major_axis * (1.0 - (o.eccentricity or 0.0))
+                if not rp > cb.radius:
+                    raise _Bad(
+                        f"key 'environment.orbit.semi_major_axis': the periapsis radius {rp:.6g} m is not above the "
+                        f"central body's radius {cb.radius:.6g} m (the orbit would be below its surface)"
+                    )
+            if o.position is not None:
+                if o.velocity is None:
+                    raise _Bad("key 'environment.orbit.velocity': an orbit from a position needs its velocity")
+                if not _norm(o.position) > cb.radius:
+                    raise _Bad(
+                        f"key 'environment.orbit.position': {_norm(o.position):.6g} m from the centre is not above "
+                        f"the central body's radius {cb.radius:.6g} m"
+                    )
+        elif self.gravity_gradient or self.j2:
+            which = "gravity_gradient" if self.gravity_gradient else "j2"
+            raise _Bad(f"key 'environment.{which}': needs an orbit (add environment.orbit)")
+        d = self.disturbance
+        if d is not None and d.force is None and d.torque is None:
+            raise _Bad("key 'environment.disturbance': give a force, a torque or both")
+        return self
+
+
+class _SensorBase(Block):
+    name: Text | None = None
+    rate: Positive | None = None
+    latency: NonNegative = 0.0
+
+
+class SenGyro(_SensorBase):
+    type: literal("gyro")
+    noise_density: NonNegative | None = None
+    noise_per_sample: NonNegative | None = None
+    bias: numbers(3, scalar_ok=True) = None
+    bias_instability: NonNegative = 0.0
+    bias_correlation_time: Positive | None = None
+    rate_random_walk: NonNegative = 0.0
+
+    @model_validator(mode="after")
+    def _one_noise(self):
+        if not _TYPES_ONLY.get() and self.noise_density is not None and self.noise_per_sample is not None:
+            raise _Bad("key 'noise_per_sample': give noise_density or noise_per_sample, not both")
+        return self
+
+
+class SenStarTracker(_SensorBase):
+    type: literal("star_tracker")
+    sigma: numbers(3, scalar_ok=True, lo=0.0) = 0.0
+
+
+class SenEncoder(_SensorBase):
+    type: literal("encoder")
+    joints: list[Text] | None = None
+    counts_per_rev: Positive | None = None
+    resolution: Positive | None = None
+    noise: NonNegative = 0.0
+
+
+class SenTachometer(_SensorBase):
+    type: literal("tachometer")
+    joints: list[Text] | None = None
+    resolution: NonNegative = 0.0
+    noise: NonNegative = 0.0
+    bias: Number = 0.0
+
+
+class SenBaseVelocity(_SensorBase):
+    type: literal("base_velocity")
+    noise: NonNegOrNonNegs = 0.0
+    bias: numbers(3, scalar_ok=True) = None
+
+
+class SenBasePosition(_SensorBase):
+    type: literal("base_position")
+    noise: NonNegOrNonNegs = 0.0
+    bias: numbers(3, scalar_ok=True) = None
+
+
+class SenForceTorque(_SensorBase):
+    type: literal("force_torque")
+    joint: Text
+    force_noise: NonNegative = 0.0
+    torque_noise: NonNegative = 0.0
+    force_bias: numbers(3, scalar_ok=True) = None
+    torque_bias: numbers(3, scalar_ok=True) = None
+
+
+SENSOR_TYPES = {
+    c.model_fields["type"].annotation.__args__[0]: c
+    for c in (SenGyro, SenStarTracker, SenEncoder, SenTachometer, SenBaseVelocity, SenBasePosition, SenForceTorque)
+}
+Sensor = Annotated[
+    SenGyro | SenStarTracker | SenEncoder | SenTachometer | SenBaseVelocity | SenBasePosition | SenForceTorque,
+    Field(discriminator="type"),
+]
+
+
+class TelemetryBlock(Block):
+    poses: literal("integrate", "measured") = "integrate"
+    rate: Positive | None = None
+
+
+def check_sensor_names(sensors) -> None:
+    seen = {}
+    for j, s in enumerate(sensors or []):
+        n = s.name or s.type
+        if n in seen:
+            raise _Bad(f"key 'sensors[{j}].name': sensor name '{n}' is used twice (sensors[{seen[n]}] has it)")
+        seen[n] = j
+
+
+def check_sensor_rates(sensors, dt: float, run_key: str = "dt") -> None:
+    """A sensor cannot sample faster than the run records (every integration step of `dt` seconds)."""
+    for j, s in enumerate(sensors or []):
+        if s.rate is not None and s.rate * dt > 1.0 + 1e-9:
+            raise _Bad(
+                f"key 'sensors[{j}].rate': {s.rate:g} Hz is above the integration rate {1.0 / dt:g} Hz "
+                f"({run_key} = {dt:g} s); lower the rate or the step"
+            )
+
+
+register_block("actuators", ActuatorsBlock, kinds=("postcapture",))
+register_block("environment", EnvironmentBlock, kinds=("postcapture",))
+register_block("sensors", list[Sensor], kinds=("postcapture",))
+register_block("telemetry", TelemetryBlock, kinds=("postcapture",))

@@ -217,25 +217,40 @@ def _model(kind: str) -> type[BaseModel]:
     return _BUILT[kind]
 
 
-def _unwrap(tp):
-    """The BaseModel class inside an annotation (Optional[M], list[M], dict[str, M]), or None."""
+def _unwrap(tp, data=None):
+    """The BaseModel class inside an annotation (Optional[M], list[M], dict[str, M]), or None. Of a union of
+    models told apart by their `type` key, the one whose type is `data`'s."""
     if isinstance(tp, type) and issubclass(tp, BaseModel):
         return tp
+    found = []
     for a in typing.get_args(tp):
-        m = _unwrap(a)
+        m = _unwrap(a, data)
         if m is not None:
-            return m
-    return None
+            found.append(m)
+    if len(found) > 1 and isinstance(data, dict) and "type" in data:
+        for m in found:
+            f = m.model_fields.get("type")
+            if f is not None and data["type"] in typing.get_args(f.annotation):
+                return m
+    return found[0] if found else None
 
 
-def fields_of(kind: str, path: tuple = ()) -> list[str]:
-    """The keys the schema of `kind` accepts at the dotted location `path` (a tuple of keys)."""
+def fields_of(kind: str, path: tuple = (), data=None) -> list[str]:
+    """The keys the schema of `kind` accepts at the dotted location `path` (a tuple of keys); `data`: the
+    file's mapping, to tell the members of a union apart (a sensor list's entries by their `type`)."""
     m = _model(kind)
-    for p in path:
+    cur = data
+    for j, p in enumerate(path):
         if isinstance(p, int):
+            cur = cur[p] if isinstance(cur, list) and 0 <= p < len(cur) else None
             continue
         f = m.model_fields.get(p)
-        m = _unwrap(f.annotation) if f is not None else None
+        cur = cur.get(p) if isinstance(cur, dict) else None
+        sub = cur
+        if isinstance(sub, list):
+            nxt = path[j + 1] if j + 1 < len(path) else None
+            sub = sub[nxt] if isinstance(nxt, int) and 0 <= nxt < len(sub) else None
+        m = _unwrap(f.annotation, sub) if f is not None else None
         if m is None:
             return []
     return list(m.model_fields)
@@ -271,9 +286,22 @@ def _data_path(d, loc) -> tuple:
         elif isinstance(cur, list) and isinstance(p, int) and 0 <= p < len(cur):
             out.append(p)
             cur = cur[p]
+        elif isinstance(cur, dict) and isinstance(p, str) and p == cur.get("type"):
+            continue  # the tag of a union member told apart by `type` (a sensor's type): not a key of the file
         elif isinstance(cur, dict) and isinstance(p, str) and not any(c in p for c in "[]-"):
             out.append(p)  # a missing or unknown key: part of the path, though not in the data
             cur = None
+    return tuple(out)
+
+
+def _parse_dotted(s: str) -> tuple:
+    """'actuators.thrusters[0].direction' -> ('actuators', 'thrusters', 0, 'direction')."""
+    out = []
+    for part in s.split("."):
+        name, *idx = part.split("[")
+        if name:
+            out.append(name)
+        out += [int(i.rstrip("]")) for i in idx]
     return tuple(out)
 
 
@@ -294,7 +322,7 @@ def _message(kind: str, d: dict, err: dict, source: str, root) -> str:
     line = f" line {where_node.start_mark.line + 1}:" if where_node is not None else ""
     if typ == "extra_forbidden":
         key = path[-1]
-        valid = fields_of(kind, path[:-1])
+        valid = fields_of(kind, path[:-1], d)
         close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
         if close:
             return f"{source}:{line} unknown key '{_dotted(path)}' (did you mean '{close[0]}'?)"
@@ -304,9 +332,11 @@ def _message(kind: str, d: dict, err: dict, source: str, root) -> str:
     msg = err["msg"]
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, ") :]
-        m = re.match(r"key '([\w.]+)': ", msg)
-        if m and not path:  # a check across keys (after the keys themselves): it names the key to change
-            path = tuple(m.group(1).split("."))
+        m = re.match(r"key '([\w.\[\]]+)': ", msg)
+        if m:  # a check across keys (after the keys themselves): it names the key to change
+            named = _parse_dotted(m.group(1))
+            # a key from the top of the file, or one relative to the block that checked it
+            path = named if not path or named[0] == path[0] else tuple(path) + named
             msg = msg[m.end() :]
             if root is not None:
                 parent, key_node = _node_at(root, path)
@@ -338,6 +368,13 @@ def check(kind: str, d: dict, source: str, text: str | None = None) -> None:
         first = _message(kind, d, errs[0], source, root)
         more = f" (and {len(errs) - 1} more problem{'s' if len(errs) > 2 else ''})" if len(errs) > 1 else ""
         raise InputError(first + more) from None
+
+
+def validated_block(name: str, value):
+    """The schema's reading of a registered block that `check` accepted (numbers as numbers, mappings as models)."""
+    from pydantic import TypeAdapter
+
+    return TypeAdapter(_BLOCKS[name][0]).validate_python(value)
 
 
 def literal(*values):

@@ -3,6 +3,7 @@ with both forms and both solvers; the initial-velocity sweep (Figs. 6-9) and the
 
 from __future__ import annotations
 
+import dataclasses
 import time
 
 import numpy as np
@@ -107,6 +108,8 @@ def run(sc: Scenario | str, methods=METHODS, seed: int | None = 0, progress=None
     if progress:
         progress("simulated")
     rng = np.random.default_rng(seed) if sc.noise else None
+    if sc.sensors is not None:
+        sc = dataclasses.replace(sc, sensor_seed=0 if seed is None else int(seed))
     t0 = time.perf_counter()
     meas = measure(m, sim, sc, rng)
     t_meas = time.perf_counter() - t0
@@ -116,6 +119,7 @@ def run(sc: Scenario | str, methods=METHODS, seed: int | None = 0, progress=None
         e.partial.simulation = sim
         raise
     res.simulation = sim
+    _spacecraft_extras(m, sim, sc, res)
     if stopped is not None:
         res.interrupted, res.t_end = stopped, float(sim["t"][-1])
         raise _interrupted(res)
@@ -128,6 +132,37 @@ def _interrupted(res: PostcaptureResult) -> Interrupted:
     e = Interrupted(f"post-capture run {res.interrupted}; kept t = 0 .. {res.t_end:g} s")
     e.partial = res
     return e
+
+
+def _spacecraft_extras(m, sim: dict, sc: Scenario, res: PostcaptureResult) -> None:
+    """The base's truth over time, the propellant used, the balance checks and the tracking summary of a run
+    with actuators/sensors (results.json)."""
+    from . import spacecraft
+
+    planar = m.joint_types[0] == "planar"
+    res.truth_history = spacecraft.truth_history(m, sim, planar, _target_index(m))
+    if sc.actuators:
+        res.extra["actuators"] = sc.actuators
+        res.extra.update(spacecraft.balances(m, sim, sc))
+        mp = np.asarray(sim.get("propellant"), float)
+        if mp.size:
+            step = max(1, int(round(0.1 / sc.dt)))
+            res.extra["propellant_history"] = {
+                "tanks": [tk.get("name", f"tank{k}") for k, tk in enumerate(sc.actuators.get("tanks", []))],
+                "t": np.asarray(sim["t"])[::step].tolist(),
+                "kg": mp[::step].tolist(),
+            }
+    if sc.environment is not None:
+        res.extra["environment"] = repr(sc.environment)
+    if sc.sensors is not None:
+        res.extra["sensors"] = {"set": sc.sensors.to_dict(), "seed": sc.sensor_seed}
+    if res.truth_history is not None:
+        res.extra["base_truth_history"] = {
+            "names": [n for n in res.names if len(n) > 1 and n[1] == "1"],
+            "t": res.truth_history[0][:: max(1, int(round(1.0 / sc.dt)))].tolist(),
+            "values": res.truth_history[1][:: max(1, int(round(1.0 / sc.dt))), : len(res.names) // 2].tolist(),
+        }
+        res.extra["tracking"] = spacecraft.tracking(res, sc)
 
 
 # -- initial-velocity sweep (Figs. 6-9) ----------------------------------------------------------------

@@ -33,7 +33,7 @@ def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
                 ax.axhspan(1 - tol, 1 + tol, color="0.8", alpha=0.6, lw=0, label=f"±{tol * 100:g} % band")
             for solver, style in zip(SOLVERS, ("-", "--")):
                 t, h = res.histories[(method, solver)]
-                y = h[:, j] / tr if tr != 0 else h[:, j]
+                y = h[:, j] / res.truth_at(t)[:, j] if tr != 0 else h[:, j]
                 (line,) = ax.plot(t, y, style, label=SOLVER_TITLES[solver])
                 stays = transits[solver][j][1]
                 if stays is not None:
@@ -75,6 +75,49 @@ def plot_sweep(sw: dict, out: Path, params=("In", "I1", "mn", "bnx")) -> Path:
         ax.grid(alpha=0.3)
     axes[0].legend(fontsize=7)
     p = Path(out) / "velocity_sweep.png"
+    fig.savefig(p, dpi=110)
+    plt.close(fig)
+    return p
+
+
+def plot_base_tracking(res: PostcaptureResult, out: Path) -> Path:
+    """The base's true parameters over time (they drift as propellant leaves) against each estimator's
+    estimate, one panel per base parameter (mass, centre of mass, principal inertias), and the propellant left."""
+    plt = pyplot()
+    th_t, th = res.truth_history
+    show = [j for j, n in enumerate(res.names) if len(n) > 1 and n[1] == "1" and not _is_product(n)]
+    prop = res.extra.get("propellant_history")
+    npan = len(show) + (1 if prop else 0)
+    ncol = 4
+    nrow = int(np.ceil(npan / ncol))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(3.4 * ncol, 2.5 * nrow), constrained_layout=True, squeeze=False)
+    styles = {"momentum": ":", "force": "-"}
+    for ax, j in zip(axes.ravel(), show):
+        ax.plot(th_t, th[:, j], "k", lw=2.2, alpha=0.35, label="truth")
+        for (method, solver), (t, h) in res.histories.items():
+            ax.plot(t, h[:, j], styles.get(method, "-"), lw=1, label=f"{method}/{SOLVER_TITLES[solver]}")
+        lo, hi = th[:, j].min(), th[:, j].max()
+        pad = max(hi - lo, 1e-3 * max(abs(hi), abs(lo), 1e-6)) * 3
+        ax.set_ylim(lo - pad, hi + pad)
+        ax.set_title(res.names[j])
+        ax.grid(alpha=0.3)
+    k = len(show)
+    if prop:
+        ax = axes.ravel()[k]
+        for name, y in zip(prop["tanks"], np.asarray(prop["kg"]).T):
+            ax.plot(prop["t"], y, label=name)
+        ax.set_title("propellant left [kg]")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        k += 1
+    for ax in axes.ravel()[k:]:
+        ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("t [s]")
+    axes[0, 0].legend(fontsize=6)
+    lam = res.scenario.forgetting
+    fig.suptitle(f"{res.scenario.name}: the base's parameters as propellant leaves, truth and estimates (λ = {lam:g})")
+    p = Path(out) / "base_parameters_tracking.png"
     fig.savefig(p, dpi=110)
     plt.close(fig)
     return p

@@ -17,11 +17,15 @@ SOLVER_TITLES = {"modified_rls": "paper (modified RLS)", "standard_rls": "standa
 
 def transit_times(t, hist, truth, tol, zero_abs=1e-8):
     """Per parameter: (first time within tolerance, time after which it stays within). Relative
-    tolerance; for a zero true value the paper's absolute 1e-8 (Table 6 note)."""
+    tolerance; for a zero true value the paper's absolute 1e-8 (Table 6 note). `truth`: (P,) constant, or
+    (N, P) the truth at each time of `t` (a base whose propellant depletes)."""
     out = []
+    truth = np.asarray(truth, float)
+    tr_t = truth if truth.ndim == 2 else np.broadcast_to(truth, hist.shape)
     for j in range(hist.shape[1]):
-        err = np.abs(hist[:, j] - truth[j])
-        ok = err <= (tol * abs(truth[j]) if truth[j] != 0 else zero_abs)
+        tj = tr_t[:, j]
+        err = np.abs(hist[:, j] - tj)
+        ok = np.where(tj != 0, err <= tol * np.abs(tj), err <= zero_abs)
         first = float(t[np.argmax(ok)]) if ok.any() else None
         bad = np.nonzero(~ok)[0]
         stays = None if not ok[-1] else (float(t[0]) if len(bad) == 0 else float(t[bad[-1] + 1]))
@@ -42,18 +46,35 @@ class PostcaptureResult:
     t_end: float | None = None
     #: the simulated samples (the engine's dict: t, q, v, ddq, tau, ...), when the run made them
     simulation: dict | None = None
+    #: (t (T,), truth (T, P)) when the base's parameters change along the run (propellant depletion): errors
+    #: and transit times are then against the truth at each time; `truth` stays the initial (model file) value
+    truth_history: tuple | None = None
+    #: what a run with actuators and sensors adds to results.json (propellant, balances, tracking, sensors)
+    extra: dict = field(default_factory=dict)
 
     def final(self, method, solver):
         return self.histories[(method, solver)][1][-1]
 
+    def truth_at(self, t) -> np.ndarray:
+        """The true parameters at the times t (N, P)."""
+        t = np.asarray(t, float)
+        if self.truth_history is None:
+            return np.broadcast_to(self.truth, (len(t), len(self.truth)))
+        th_t, th = self.truth_history
+        return np.stack([np.interp(t, th_t, th[:, j]) for j in range(th.shape[1])], -1)
+
+    def final_truth(self, method, solver) -> np.ndarray:
+        t, _ = self.histories[(method, solver)]
+        return self.truth_at(t[-1:])[0]
+
     def rel_error(self, method, solver):
-        tr = self.truth
+        tr = self.final_truth(method, solver)
         est = self.final(method, solver)
         return np.where(tr != 0, np.abs(est - tr) / np.where(tr != 0, np.abs(tr), 1), np.abs(est - tr))
 
     def transits(self, method, solver):
         t, h = self.histories[(method, solver)]
-        return transit_times(t, h, self.truth, self.scenario.tolerance)
+        return transit_times(t, h, self.truth_at(t), self.scenario.tolerance)
 
     def warnings(self) -> list[str]:
         """Sentences for results that look like answers but are not: an estimate that never moved from its
@@ -64,6 +85,11 @@ class PostcaptureResult:
             out.append(
                 "the scenario's excitation amplitudes are all zero: the joints do not move relative to the base, so "
                 "the data carry little information about the payload"
+            )
+        if self.scenario.sensors is not None and self.scenario.measurement.get("accelerations", "exact") == "exact":
+            out.append(
+                "the force-based estimates use the simulation's exact accelerations, not the sensors' (set "
+                "measurement.accelerations: central_difference to difference the measured rates)"
             )
         for (method, solver), (_, h) in self.histories.items():
             h = np.asarray(h, float)
@@ -89,18 +115,21 @@ class PostcaptureResult:
             "noise": self.scenario.noise,
             "measurement": self.scenario.measurement,
             "methods": {},
+            **self.extra,
         }
         if self.interrupted is not None:
             out.update(interrupted=True, stopped=self.interrupted, t_end=self.t_end)
         for (method, solver), (_t, h) in self.histories.items():
             tt = self.transits(method, solver)
             err = self.rel_error(method, solver)
+            ftr = self.final_truth(method, solver)
             out["methods"].setdefault(method, {})[solver] = {
                 n: {
-                    "truth": float(self.truth[j]),
+                    "truth": float(ftr[j]),
+                    **({"truth_initial": float(self.truth[j])} if self.truth_history is not None else {}),
                     "estimate": float(h[-1, j]),
                     "error": float(err[j]),
-                    "error_kind": "relative" if self.truth[j] != 0 else "absolute",
+                    "error_kind": "relative" if ftr[j] != 0 else "absolute",
                     "transit_time": tt[j][1],
                     "first_within": tt[j][0],
                     "paper": self.scenario.paper.get(method, {}).get(n),
@@ -118,6 +147,11 @@ class PostcaptureResult:
             + f"{self.scenario.duration if self.t_end is None else self.t_end:g} s, "
             f"(transit time to {tol * 100:g} %, after which the estimate stays within)"
         ]
+        if self.truth_history is not None:
+            lines.append(
+                "(the base's propellant depletes: 'truth' is its value at the end of the run, errors and transit times "
+                "are against the truth at each time)"
+            )
         for method in METHODS:
             if (method, "modified_rls") not in self.histories:
                 continue
@@ -128,6 +162,7 @@ class PostcaptureResult:
             lines += ["", f"{method}-based", hdr, "-" * len(hdr)]
             tr = {s: self.transits(method, s) for s in SOLVERS}
             err = {s: self.rel_error(method, s) for s in SOLVERS}
+            ftr = self.final_truth(method, SOLVERS[0])
             for j, n in enumerate(self.names):
                 if n not in paper and paper and _is_product(n):
                     continue
@@ -142,7 +177,7 @@ class PostcaptureResult:
                     e = self.final(method, s)[j]
                     tt = tr[s][j][1]
                     cells.append(f"{e:>13.6g} ({'not converged' if tt is None else f'{tt:.1f} s'}, {err[s][j]:.1e})")
-                lines.append(f"{n:>6} {self.truth[j]:>12.6g} | {ptxt:>26} | " + " | ".join(f"{c:>40}" for c in cells))
+                lines.append(f"{n:>6} {ftr[j]:>12.6g} | {ptxt:>26} | " + " | ".join(f"{c:>40}" for c in cells))
         lines.append("")
         lines.append(
             "(PAPER: the paper's printed value and transit time; 'not in the paper': the paper prints no value, "
@@ -171,6 +206,10 @@ class PostcaptureResult:
         from .plots import plot_histories
 
         plot_histories(self, out)
+        if self.truth_history is not None:
+            from .plots import plot_base_tracking
+
+            plot_base_tracking(self, out)
         return out / "results.json"
 
 

@@ -43,6 +43,14 @@ class Scenario:
     sweep: dict | None = None
     paper_sweep: dict | None = None
     source: str = ""
+    #: the `actuators:` block as the engine reads it (freefloat.Actuators.to_dict()), or None
+    actuators: dict | None = None
+    #: the `environment:` block as a freefloat.Environment, or None
+    environment: object = None
+    #: the `sensors:` (+ `telemetry:`) blocks as a freefloat.sensors.SensorSet, or None (the plain samples)
+    sensors: object = None
+    #: seed of the sensors' random streams (`freefloat identify postcapture --seed`)
+    sensor_seed: int = 0
 
     def with_base_velocity(self, vel) -> Scenario:
         """Copy with the initial base (sensor) linear velocity replaced (inertial frame)."""
@@ -96,6 +104,7 @@ def _parse(d: dict, source: str) -> Scenario:
         "phase": [float(x) * deg for x in ex.get("phase_deg", [0] * nj)],
     }
     ident = d["identification"]
+    acts, env, sset = _blocks(d, source, m)
     return Scenario(
         name=d["name"],
         description=str(d.get("description", "")).strip(),
@@ -118,7 +127,62 @@ def _parse(d: dict, source: str) -> Scenario:
         sweep=d.get("sweep"),
         paper_sweep=d.get("paper_sweep"),
         source=source,
+        actuators=acts,
+        environment=env,
+        sensors=sset,
     )
+
+
+def _blocks(d: dict, source: str, m):
+    """The `actuators:`, `environment:` and `sensors:`/`telemetry:` blocks as the Python API objects that run
+    them (the same readers as `freefloat simulate --actuators/--environment` and `freefloat measure --sensors`),
+    checked against the robot by the engine now, so that a tank heavier than its body or an unknown joint is
+    refused before the run with the file, line and key."""
+    from .. import _core
+    from .. import sensors as sn
+    from ..actuators import Actuators
+    from ..environment import environment_from_dict
+    from ..io import schema
+
+    # the blocks as the schema read them: numbers written as YAML 1.1 text (1e5) are numbers, as everywhere
+    d = dict(d)
+    for key in ("actuators", "environment", "telemetry"):
+        if d.get(key) is not None:
+            d[key] = schema.validated_block(key, d[key]).model_dump(exclude_unset=True)
+    if d.get("sensors") is not None:
+        d["sensors"] = [s.model_dump(exclude_unset=True) for s in schema.validated_block("sensors", d["sensors"])]
+    acts = env = sset = None
+    if d.get("actuators"):
+        try:
+            acts = Actuators.from_dict(d["actuators"]).to_dict()
+            ntanks = len(acts.get("tanks", []))
+            # resolves names and runs every engine check (ActuatorRt::new) without simulating
+            _core.postcapture_thruster_wrench(m._core, acts, np.zeros(1), np.zeros((1, ntanks)))
+        except InputError as e:
+            raise scenario_files.error_at(source, e) from None
+    if d.get("environment"):
+        try:
+            env = environment_from_dict(d["environment"])
+        except InputError as e:
+            raise scenario_files.error_at(source, e) from None
+    if d.get("sensors"):
+        spec = {"sensors": d["sensors"]}
+        if d.get("telemetry"):
+            spec["telemetry"] = d["telemetry"]
+        try:
+            sset = sn.load(spec)
+            sset.names()  # the engine's check of the whole set
+            for j, s in enumerate(sset.to_dicts()):
+                named = s.get("joints") or ([s["joint"]] if s.get("joint") else [])
+                for k, jn in enumerate(named):
+                    if jn not in m.joint_names:
+                        key = f"sensors[{j}].joints[{k}]" if s.get("joints") else f"sensors[{j}].joint"
+                        raise InputError(
+                            f"{key}: the robot '{m.name}' has no joint '{jn}' (joints: {', '.join(m.joint_names)})"
+                        )
+        except InputError as e:
+            raise scenario_files.error_at(source, e) from None
+    return acts, env, sset
 
 
 def _base_attitude(m, q) -> np.ndarray:

@@ -37,7 +37,75 @@ def simulate(sc: Scenario, model=None) -> dict:
         e["phase"],
         1,
         max_memory=memory_limit(),  # refused before any work, not an abort or a swapping machine
+        actuators=sc.actuators,
+        environment=sc.environment,
     )
+
+
+def thruster_wrench(model, sim: dict, sc: Scenario) -> tuple[np.ndarray, np.ndarray]:
+    """The thrusters' base wrench (T, 6) [f; τ] (base frame, about the base origin) and each tank's propellant
+    flow (T, tanks) [kg/s] at every recorded step, from the engine's thruster model (zeros without thrusters)."""
+    t = sim["t"]
+    if not sc.actuators or not sc.actuators.get("thrusters"):
+        return np.zeros((len(t), 6)), np.zeros((len(t), 0))
+    return _core.postcapture_thruster_wrench(model._core, sc.actuators, t, np.asarray(sim["propellant"], float))
+
+
+def simpson_cumulative(f: np.ndarray, h: float, idx: np.ndarray) -> np.ndarray:
+    """∫₀^{t_idx} f dt by Simpson's rule on the step-rate samples f (T, ...) of spacing h, at the (even) sample
+    indices idx."""
+    pair = h / 3.0 * (f[:-2:2] + 4 * f[1:-1:2] + f[2::2])
+    cum = np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(pair, 0)])
+    return cum[idx // 2]
+
+
+def _telemetry_at_samples(model, sim: dict, sc: Scenario, idx: np.ndarray):
+    """(q, v) at the sample instants t[idx] from the telemetry of the scenario's sensors (`freefloat measure` on
+    the recorded run), and the sensors' summary. A sample instant the telemetry does not hold (its rate is not a
+    multiple of 1/sample_period, or a latency delays the first frame past it) is an error naming the key."""
+    from .. import sensors as sn
+
+    run = {"t": sim["t"], "q": sim["q"], "v": sim["v"], "ddq": sim["ddq"], "momentum": sim["momentum"]}
+    meas = sn.measure(model, run, sc.sensors, seed=sc.sensor_seed)
+    tel = meas.require_telemetry()
+    ts = sim["t"][idx]
+    k = np.searchsorted(tel.t, ts - 1e-9 * sc.dt)
+    ok = (k < len(tel.t)) & (np.abs(tel.t[np.minimum(k, len(tel.t) - 1)] - ts) <= 1e-6 * sc.dt)
+    first = int(np.argmax(ok)) if ok.any() else len(ts)
+    if not ok[first:].all() or first >= len(ts) - 2:
+        raise InputError(
+            f"{sc.source}: key 'sensors': the telemetry ({len(tel.t)} frames from t = {tel.t[0]:g} s) does not hold "
+            f"every sample instant (every sample_period = {sc.sample_period:g} s): give the sensors feeding the "
+            "velocities a rate that is a multiple of 1/sample_period (or set telemetry.rate to it)"
+        )
+    return first, k[first:], np.asarray(tel.t, float), np.asarray(tel.q, float), np.asarray(tel.v, float)
+
+
+def _central_difference(model, planar: bool, qs: np.ndarray, vs: np.ndarray, h: float) -> np.ndarray:
+    """v̇ at evenly spaced samples (spacing h) of the (measured) q and v by central differences.
+    The base's v holds body-frame components and ddq their time derivative, but differencing rotating-frame
+    components over a whole sample period (0.1 s of a tumbling base) drops the ω×v term the frame's rotation
+    adds. So the base velocities are differenced in the INERTIAL frame, where the derivative is the plain
+    acceleration, and brought back: with v_b = Aᵀ v_I,  d(v_b)/dt = Aᵀ a_I − ω_b × v_b  and
+    d(ω_b)/dt = Aᵀ d(ω_I)/dt. Joint rates are differenced as they are."""
+    as_ = np.gradient(vs, h, axis=0)
+    if not planar:
+        As = quat_to_matrix(np.asarray(alg.forward_kinematics(model, qs))[:, 0, 3:])  # measured attitude
+        lin_i, ang_i = eq.mv(As, vs[:, 0:3]), eq.mv(As, vs[:, 3:6])
+        a_lin = np.gradient(lin_i, h, axis=0)
+        a_ang = np.gradient(ang_i, h, axis=0)
+        At = np.swapaxes(As, -1, -2)
+        as_[:, 0:3] = eq.mv(At, a_lin) - np.cross(vs[:, 3:6], vs[:, 0:3])
+        as_[:, 3:6] = eq.mv(At, a_ang)
+    else:  # planar: (vx, vy) body-frame in the plane, yaw rate r: d(v_b)/dt = R(ψ)ᵀ a_I − r × v_b
+        psi = qs[:, 2]
+        c, s_ = np.cos(psi), np.sin(psi)
+        vi = np.stack([c * vs[:, 0] - s_ * vs[:, 1], s_ * vs[:, 0] + c * vs[:, 1]], -1)
+        ai = np.gradient(vi, h, axis=0)
+        r = vs[:, 2]
+        as_[:, 0] = c * ai[:, 0] + s_ * ai[:, 1] + r * vs[:, 1]
+        as_[:, 1] = -s_ * ai[:, 0] + c * ai[:, 1] - r * vs[:, 0]
+    return as_
 
 
 def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = None) -> eq.Measurements:
@@ -52,9 +120,13 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         raise InputError("sample_period / dt must be even (Simpson's rule between samples)")
     t, q, v, ddq = sim["t"], sim["q"], sim["v"].copy(), sim["ddq"].copy()
     wrench = sim["tau"][:, :nb].copy()
+    thrust, _flow = thruster_wrench(model, sim, sc)
+    wrench += thrust[:, [0, 1, 5]] if planar else thrust
     noise = sc.noise or {}
     if noise and rng is not None:
         wrench += rng.normal(0.0, float(noise.get("force", 0.0)), wrench.shape)
+    # the attitude at the step rate for the inertial thrust: the true one (a flight computer's attitude
+    # estimate between telemetry frames is not modelled)
     fk = np.asarray(alg.forward_kinematics(model, q))[:, 0]
     A, rb = quat_to_matrix(fk[:, 3:]), fk[:, :3]
     if planar:
@@ -68,9 +140,7 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
     h = sc.dt
 
     def simpson(f):
-        pair = h / 3.0 * (f[:-2:2] + 4 * f[1:-1:2] + f[2::2])
-        cum = np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(pair, 0)])
-        return cum[idx // 2]
+        return simpson_cumulative(f, h, idx)
 
     def trapezoid(f):
         # only the sampled thrust (the alternative when the 1 kHz thrust is not recorded):
@@ -78,6 +148,20 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         fs = f[idx]
         return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * (fs[1:] + fs[:-1]) * sc.sample_period, 0)])
 
+    qs, tel = q[idx], None
+    if sc.sensors is not None and noise:
+        raise InputError(
+            f"{sc.source}: key 'noise': the scenario has sensors, whose errors are the measurement noise; give "
+            "either sensors or noise (or run with --no-noise)"
+        )
+    if sc.sensors is not None:
+        # the measured telemetry replaces the true samples of q and v (from the first complete frame on)
+        first, rows, tel_t, tel_q, tel_v = _telemetry_at_samples(model, sim, sc, idx)
+        idx = idx[first:]
+        qs = tel_q[rows]
+        v = v.copy()
+        v[idx] = tel_v[rows]
+        tel = (rows, tel_q, tel_v, float(tel_t[1] - tel_t[0]))
     mode = sc.measurement
     vs, as_ = v[idx], ddq[idx]
     if noise and rng is not None:
@@ -85,30 +169,15 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         as_ = as_ + rng.normal(0.0, float(noise.get("acceleration", 0.0)), as_.shape)
     keep = slice(None)
     if mode.get("accelerations", "exact") == "central_difference":
-        # v̇ from the sampled (possibly noisy) velocities by central differences. The base's v holds body-frame
-        # components and ddq their time derivative, but differencing rotating-frame components over a whole
-        # sample period (0.1 s of a tumbling base) drops the ω×v term the frame's rotation adds. So the base
-        # velocities are differenced in the INERTIAL frame, where the derivative is the plain acceleration,
-        # and brought back: with v_b = Aᵀ v_I,  d(v_b)/dt = Aᵀ a_I − ω_b × v_b  and  d(ω_b)/dt = Aᵀ d(ω_I)/dt.
-        # Joint rates are differenced as they are. The first and last samples have no central difference and
-        # are dropped (an online estimator runs one sample behind).
-        as_ = np.gradient(vs, sc.sample_period, axis=0)
-        if not planar:
-            As = A[idx]
-            lin_i, ang_i = eq.mv(As, vs[:, 0:3]), eq.mv(As, vs[:, 3:6])
-            a_lin = np.gradient(lin_i, sc.sample_period, axis=0)
-            a_ang = np.gradient(ang_i, sc.sample_period, axis=0)
-            At = np.swapaxes(As, -1, -2)
-            as_[:, 0:3] = eq.mv(At, a_lin) - np.cross(vs[:, 3:6], vs[:, 0:3])
-            as_[:, 3:6] = eq.mv(At, a_ang)
-        else:  # planar: (vx, vy) body-frame in the plane, yaw rate r: d(v_b)/dt = R(ψ)ᵀ a_I − r × v_b
-            psi = q[idx][:, 2]
-            c, s_ = np.cos(psi), np.sin(psi)
-            vi = np.stack([c * vs[:, 0] - s_ * vs[:, 1], s_ * vs[:, 0] + c * vs[:, 1]], -1)
-            ai = np.gradient(vi, sc.sample_period, axis=0)
-            r = vs[:, 2]
-            as_[:, 0] = c * ai[:, 0] + s_ * ai[:, 1] + r * vs[:, 1]
-            as_[:, 1] = -s_ * ai[:, 0] + c * ai[:, 1] - r * vs[:, 0]
+        # v̇ from the sampled (possibly noisy) velocities by central differences (_central_difference). The
+        # first and last samples have no central difference and are dropped (an online estimator runs one
+        # sample behind).
+        if tel is None:
+            as_ = _central_difference(model, planar, qs, vs, sc.sample_period)
+        else:
+            # at the telemetry's own rate (the arm's joints move fast: differences over a whole sample period
+            # would not follow them), then read at the sample instants
+            as_ = _central_difference(model, planar, tel[1], tel[2], tel[3])[tel[0]]
         keep = slice(1, -1)
     elif mode.get("accelerations", "exact") != "exact":
         raise InputError(
@@ -118,5 +187,5 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
     if integ is None:
         raise InputError(f"measurement.impulses: expected 'simpson' or 'trapezoid', got {mode['impulses']!r}")
     return eq.Measurements(
-        t[idx][keep], q[idx][keep], vs[keep], as_[keep], wrench[idx][keep], integ(F)[keep], integ(M)[keep]
+        t[idx][keep], qs[keep], vs[keep], as_[keep], wrench[idx][keep], integ(F)[keep], integ(M)[keep]
     )

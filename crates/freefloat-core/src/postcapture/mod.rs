@@ -17,4 +17,4 @@ pub mod equations;
 mod simulate;
 
 pub use control::{saturate, PostcaptureControl};
-pub use simulate::simulate_postcapture;
+pub use simulate::{simulate_postcapture, simulate_postcapture_with, thruster_base_wrench};
