@@ -306,8 +306,10 @@ def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
     assert np.all(A @ x >= b - 1e-9)
     lo, hi = np.array(d.bounds()).T
     assert np.all((lo <= x) & (x <= hi))
-    again = d.evaluate(x, part.directions)  # one path on two threads: the same value up to rounding
-    assert again["objective"][0] == pytest.approx(part.best.objective, rel=1e-12)
+    # the same objective recomputed: equal up to rounding (the threads' summation order differs between the
+    # batched call and this one; measured 3.7e-12 relative on a loaded machine), far below any real change
+    again = d.evaluate(x, part.directions)
+    assert again["objective"][0] == pytest.approx(part.best.objective, rel=1e-9)
     start = d.evaluate(d.feasible_start(part.directions), part.directions)
     assert part.best.objective <= start["objective"][0] * (1 + 1e-12)  # (the start itself, up to rounding)
     assert part.to_dict()["interrupted"] is True

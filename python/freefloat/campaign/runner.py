@@ -16,6 +16,7 @@ import json
 import os
 import signal
 import socket
+import sys
 import threading
 import time
 import traceback
@@ -252,6 +253,14 @@ def _finish(spec, out, root, writer, state, all_runs, selected, todo, keys, t_st
     return res
 
 
+def _kill_local_workers(cluster) -> None:
+    """Kill the worker processes of a LocalCluster this process started (its nannies run here; each holds one
+    worker process). Used only when a campaign on a local cluster is stopped by Ctrl-C."""
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(Exception):  # a worker that already exited (or never started) has nothing to kill
+            os.kill(nanny.process.process.pid, signal.SIGKILL)
+
+
 def _execute_all(spec, todo, writer, state, workers, scheduler, progress, max_retries, on_row, done0, failed0):
     from dask.distributed import as_completed
     from tqdm import tqdm
@@ -317,8 +326,14 @@ def _execute_all(spec, todo, writer, state, workers, scheduler, progress, max_re
                 ac.add(submit(pending.pop()))
         bar.close()
     finally:
+        # On Ctrl-C the runs still in flight are abandoned (the finished ones are already in the writer), so the
+        # local workers are killed rather than asked to finish: a graceful LocalCluster shutdown waits for its
+        # worker processes and took about 5 s, against the one second a stop may take.
+        stopping = isinstance(sys.exc_info()[1], KeyboardInterrupt)
         try:
-            client.close(timeout=10)
+            if stopping and cluster is not None:
+                _kill_local_workers(cluster)
+            client.close(timeout=1 if stopping else 10)
         finally:
             if cluster is not None:
-                cluster.close(timeout=10)
+                cluster.close(timeout=1 if stopping else 10)

@@ -108,6 +108,7 @@ impl Environment {
             fext: vec![0.0; 6 * n],
             com: m.inertias.iter().map(|i| i.com()).collect(),
             i_com: m.inertias.iter().map(|i| i.i_com()).collect(),
+            mass: m.inertias.iter().map(|i| i.mass).collect(),
         })
     }
 }
@@ -124,6 +125,9 @@ pub struct EnvWorkspace {
     pub fext: Vec<f64>,
     com: Vec<V3>,
     i_com: Vec<M3>,
+    /// The mass each body's `com` / `i_com` were computed for: a body whose tank drains (variable-mass model
+    /// handed to `eval`) gets them recomputed, so its CoM and inertia follow the propellant.
+    mass: Vec<f64>,
 }
 
 impl EnvWorkspace {
@@ -146,6 +150,11 @@ impl EnvWorkspace {
         self.fext.fill(0.0);
         for i in 0..m.nbodies() {
             let mass = m.inertias[i].mass;
+            if mass != self.mass[i] {
+                self.com[i] = m.inertias[i].com();
+                self.i_com[i] = m.inertias[i].i_com();
+                self.mass[i] = mass;
+            }
             let x = &d.o_mi[i];
             let mut w = crate::dualquat::DualQuat::vector(&V3::zeros(), &V3::zeros());
             let mut any = false;
@@ -297,5 +306,42 @@ mod tests {
         assert!(bad.check().unwrap_err().to_string().contains("mu"));
         let esc = Orbit::new(c, V3::new(7e6, 0.0, 0.0), V3::new(0.0, 2e4, 0.0));
         assert!(esc.unwrap_err().to_string().contains("bound"));
+    }
+
+    #[test]
+    fn a_draining_body_gets_its_com_and_inertia_recomputed() {
+        // a tank draining off the base origin moves the base's CoM: the gravity gradient must follow it
+        // (the workspace was built from the full-tank model, the stepper hands it the drained one)
+        let full = crate::model::builtin::load("naveen_dual_arm").unwrap();
+        let mut drained = full.clone();
+        let b = &full.inertias[0];
+        let (m, c) = (b.mass * 0.9, b.com() + V3::new(0.05, -0.02, 0.03));
+        drained.inertias[0] = crate::spatial::Inertia::from_com(m, c, b.i_com() * 0.9);
+        let el = Elements { a: 7.0e6, e: 0.0, i: 0.3, raan: 0.0, argp: 0.0, nu: 0.0 };
+        let env = Environment {
+            orbit: Some(Orbit::from_elements(CentralBody::EARTH, &el).unwrap()),
+            gravity_gradient: true,
+            j2: true,
+            disturbance: None,
+        };
+        let mut d = Data::new(&full);
+        let mut q0 = vec![0.0; full.nq];
+        q0[3..7].copy_from_slice(&[0.1, -0.2, 0.3, 0.927_361_849_549_570_3]);
+        let v0 = vec![0.0; full.nv];
+        let mut ws = env.workspace(&full, &mut d, &q0, &v0).unwrap();
+        // the reference: the same workspace with body 0's CoM and inertia set to the drained values by hand
+        let mut reference = ws.clone();
+        reference.com[0] = drained.inertias[0].com();
+        reference.i_com[0] = drained.inertias[0].i_com();
+        reference.mass[0] = m;
+        let mut stale = ws.clone();
+        forward_kinematics_unchecked(&drained, &mut d, &q0);
+        ws.eval(&env, &drained, &d, 1.0);
+        reference.eval(&env, &drained, &d, 1.0);
+        stale.mass[0] = m; // pretend it was already refreshed: the old, full-tank CoM stays
+        stale.eval(&env, &drained, &d, 1.0);
+        assert_eq!(ws.fext, reference.fext);
+        let gap = (0..6).map(|k| (stale.fext[k] - reference.fext[k]).abs()).fold(0.0, f64::max);
+        assert!(gap > 1e-9 * reference.fext[..6].iter().map(|x| x.abs()).fold(0.0, f64::max), "{gap}");
     }
 }
