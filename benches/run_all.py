@@ -68,6 +68,7 @@ class Section:
     load_after: tuple = ()
     rows: list = field(default_factory=list)
     markdown: str = ""
+    quick: bool = False  # run in its quick mode inside a full run (--quick-for)
 
 
 def git_hash() -> str:
@@ -379,7 +380,7 @@ def run_script(name: str, fast: bool) -> Section:
     jf = out / (own_json[0] if own_json else f"{name}.json")
     jf.unlink(missing_ok=True)
     cmd = [sys.executable, str(HERE / script), *args, "--out", str(out)] + ([] if own_json else ["--json", str(jf)])
-    sec = Section(name, "python benches/" + " ".join([script, *args]))
+    sec = Section(name, "python benches/" + " ".join([script, *args]), quick=fast)
     missing = [m for m in needs if importlib.util.find_spec(m) is None]
     if missing:
         sec.status = f"skipped ({', '.join(missing)} not installed)"
@@ -498,8 +499,9 @@ def render(sections: list[Section], fast: bool, git: str, total: float) -> str:
             lines.append(f"| {s.name}: {s.status.splitlines()[0][:160]} | | | | | | | {load_str(s)} | `{git}` |")
         for r in s.rows:
             ratio = f"{r.ratio:.2f}" if isinstance(r.ratio, (int, float)) else (r.note or "-")
+            what = r.what + (" *(quick mode)*" if s.quick and not fast else "")
             lines.append(
-                f"| {r.what} | {r.peer} | {r.freefloat} | {r.peer_value} | {ratio} | {r.spread} | "
+                f"| {what} | {r.peer} | {r.freefloat} | {r.peer_value} | {ratio} | {r.spread} | "
                 f"{r.target} | {load_str(s)} | `{git}` |"
             )
     lines.append("")
@@ -581,12 +583,19 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--fast", action="store_true", help="quick modes and fewer repeats (aim: <= 15 min)")
     ap.add_argument("--only", nargs="+", default=None, help="run only these benchmarks")
+    ap.add_argument(
+        "--quick-for",
+        nargs="+",
+        default=[],
+        metavar="NAME",
+        help="in a full run, run these benchmarks in their quick mode (their rows say so)",
+    )
     ap.add_argument("--dry-run", action="store_true", help="do not touch BENCHMARKS.md / README.md")
     ap.add_argument("--benchmarks-md", type=Path, default=ROOT / "BENCHMARKS.md")
     ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
     a = ap.parse_args(argv)
     names = a.only or [*BENCHES, "rls"]
-    bad = [n for n in names if n not in BENCHES and n != "rls"]
+    bad = [n for n in [*names, *a.quick_for] if n not in BENCHES and n != "rls"]
     if bad:
         ap.error(f"unknown benchmark(s) {bad}; choose from {[*BENCHES, 'rls']}")
     git = git_hash()
@@ -595,7 +604,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         for i, n in enumerate(names, 1):
             print(f"[{i}/{len(names)}] {n} ... ", end="", flush=True)
-            sec = run_rls(a.fast) if n == "rls" else run_script(n, a.fast)
+            quick = a.fast or n in a.quick_for
+            sec = run_rls(quick) if n == "rls" else run_script(n, quick)
             sections.append(sec)
             elapsed = (time.perf_counter() - t0) / 60
             print(f"{sec.status.splitlines()[0][:200]} ({sec.seconds:.0f} s, total {elapsed:.1f} min)", flush=True)

@@ -52,7 +52,7 @@ def _run_interrupted(call, delay=1.0):
     return info.value, stopped - sent[0]
 
 
-def _check_partial(exc, robot, t_final):
+def _check_partial(exc, robot, t_final, drift_per_step=0.0):
     assert isinstance(exc, ff.Interrupted), type(exc)
     assert "t = " in str(exc), str(exc)
     tr = exc.partial
@@ -61,8 +61,10 @@ def _check_partial(exc, robot, t_final):
     assert tr.q.shape == (len(tr), robot.nq) and np.all(np.isfinite(tr.q))
     assert np.all(np.diff(tr.t) > 0)
     assert "interrupted" in tr.stats
-    # what was finished is a real motion: momentum conserved to round-off under internal torques
-    assert tr.momentum_drift()["angular_rel"] < 1e-8
+    # what was finished is a real motion: momentum conserved to round-off under internal torques (an adaptive
+    # run's local errors, of order rtol, add up along the run, and a faster machine gets further before the
+    # signal: 9184 s at rtol 1e-12, recorded every 1 s (9185 samples), drifted 1.15e-8 in CI)
+    assert tr.momentum_drift()["angular_rel"] < max(1e-8, drift_per_step * len(tr))
 
 
 def test_ctrl_c_stops_simulate_without_callbacks(robot):
@@ -106,7 +108,7 @@ def test_ctrl_c_with_a_progress_bar(robot):
         )
     )
     assert dt_stop < STOP_WITHIN
-    _check_partial(exc, m, 1e5)
+    _check_partial(exc, m, 1e5, drift_per_step=1e-11)  # per recorded second: 10 x rtol
 
 
 def test_ctrl_c_stops_rk45(robot):
