@@ -92,23 +92,8 @@ fn store(dst: &mut [f64], s: &[f64], acc: bool) {
     }
 }
 
-/// Dot product of two equally long slices with 4 partial sums.
-#[inline(always)]
-pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    let mut s = [0.0_f64; 4];
-    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
-    let (xr, yr) = (xc.remainder(), yc.remainder());
-    for (a, b) in xc.zip(yc) {
-        for l in 0..4 {
-            s[l] += a[l] * b[l];
-        }
-    }
-    let mut t = (s[0] + s[1]) + (s[2] + s[3]);
-    for (a, b) in xr.iter().zip(yr) {
-        t += a * b;
-    }
-    t
-}
+/// Dot product with 4 partial sums: the one in the dynamics derivatives (the Cholesky inverse uses it too).
+pub(crate) use crate::dynamics::derivatives::dot;
 
 /// `c (+)= aᵀ b` with `a` k × m, `b` k × n, `c` m × n, all column-major and contiguous.
 pub(crate) fn mul_tn(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, n: usize, acc: bool) {

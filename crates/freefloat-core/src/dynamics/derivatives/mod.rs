@@ -38,8 +38,8 @@ mod step;
 
 pub use frame::{frame_dq_pose_derivatives, frame_log_error_derivatives, se3_log, se3_log_jacobian};
 pub use lie::{difference, difference_jacobians, integrate, integrate_jacobians};
-pub(crate) use rnea_derivatives::cholesky_inverse;
 pub use rnea_derivatives::{aba_derivatives, rnea_derivatives};
+pub(crate) use rnea_derivatives::{cholesky_inverse, dot};
 pub use step::{step, step_derivatives, Scheme};
 
 use crate::error::{FfError, Result};

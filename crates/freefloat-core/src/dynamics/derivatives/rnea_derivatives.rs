@@ -370,7 +370,7 @@ pub(crate) fn cholesky_inverse(a: &DMatrix<f64>, l: &mut DMatrix<f64>, inv: &mut
     for j in 0..n {
         for i in 0..=j {
             let (ci, cj) = (i * n, j * n);
-            let t = dot4(&is[ci + j..ci + n], &is[cj + j..cj + n]);
+            let t = dot(&is[ci + j..ci + n], &is[cj + j..cj + n]);
             is[cj + i] = t;
         }
     }
@@ -382,9 +382,10 @@ pub(crate) fn cholesky_inverse(a: &DMatrix<f64>, l: &mut DMatrix<f64>, inv: &mut
     true
 }
 
-/// Dot product with 4 partial sums (vectorises; a plain sum is one long dependency chain).
+/// Dot product of two equally long slices with 4 partial sums (vectorises; a plain sum is one long dependency
+/// chain). Also the DDP backward pass's dot product (`control::ddp::dense`).
 #[inline(always)]
-fn dot4(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
     let mut s = [0.0_f64; 4];
     let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
     let (xr, yr) = (xc.remainder(), yc.remainder());
