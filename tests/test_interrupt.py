@@ -158,12 +158,6 @@ def _start_cli(args, cwd):
     )
 
 
-def _wait_running(p, seconds=120):
-    """Wait (generously: a loaded machine imports slowly) until the simulation is under way: its progress bar
-    appears on stderr."""
-    return _wait_for(p, "simulated", seconds)
-
-
 def _wait_for(p, marker, seconds=120):
     """Wait until `marker` appears on the command's stderr (its progress bar: the work is under way)."""
     buf = []
@@ -183,15 +177,13 @@ def _wait_for(p, marker, seconds=120):
     return buf, th
 
 
-def test_sigint_to_the_cli_stops_it_within_a_second_and_saves_the_partial_run(tmp_path):
-    out = tmp_path / "run"
-    # 1e6 s at dt = 1e-3 is 1e9 steps (hours); recording every 100 000th step keeps it within the memory check
-    p = _start_cli(
-        ["simulate", "naveen_dual_arm", "--t-final", "1e6", "--record-every", "100000", "--out", str(out)], tmp_path
-    )
+def _sigint_after(p, marker, delay):
+    """Wait (generously: a loaded machine imports slowly) until `marker` shows on the command's stderr (its work is
+    under way), wait `delay` seconds more, send SIGINT and time the exit. Returns (exit code, seconds from the
+    signal to the exit, everything the command wrote to stderr); the process is killed if it outlives this."""
     try:
-        buf, th = _wait_running(p)
-        time.sleep(1.0)  # well into the run
+        buf, th = _wait_for(p, marker)
+        time.sleep(delay)
         sent = time.monotonic()
         p.send_signal(signal.SIGINT)
         p.wait(timeout=60)
@@ -200,8 +192,18 @@ def test_sigint_to_the_cli_stops_it_within_a_second_and_saves_the_partial_run(tm
     finally:
         if p.poll() is None:
             p.kill()
-    err = "".join(buf)
-    assert p.returncode == 130, (p.returncode, err[-2000:])
+    return p.returncode, took, "".join(buf)
+
+
+def test_sigint_to_the_cli_stops_it_within_a_second_and_saves_the_partial_run(tmp_path):
+    out = tmp_path / "run"
+    # 1e6 s at dt = 1e-3 is 1e9 steps (hours); recording every 100 000th step keeps it within the memory check
+    p = _start_cli(
+        ["simulate", "naveen_dual_arm", "--t-final", "1e6", "--record-every", "100000", "--out", str(out)], tmp_path
+    )
+    # well into the run
+    code, took, err = _sigint_after(p, "simulated", 1.0)
+    assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     assert "interrupted" in err and "t = " in err, err[-2000:]
     tr = ff.Trajectory.from_parquet(out / "trajectory.parquet")
@@ -320,19 +322,9 @@ def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
 def test_sigint_to_freefloat_excite_keeps_the_best_trajectory(tmp_path):
     out = tmp_path / "ex"
     p = _start_cli(["excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--out", str(out)], tmp_path)
-    try:
-        buf, th = _wait_for(p, "C=")  # the first SQP iteration is done: there is a design to keep
-        time.sleep(0.5)
-        sent = time.monotonic()
-        p.send_signal(signal.SIGINT)
-        p.wait(timeout=60)
-        took = time.monotonic() - sent
-        th.join(5)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    err = "".join(buf)
-    assert p.returncode == 130, (p.returncode, err[-2000:])
+    # the first SQP iteration is done: there is a design to keep
+    code, took, err = _sigint_after(p, "C=", 0.5)
+    assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     res = json.loads((out / "results.json").read_text())
     assert res["interrupted"] is True and res["stopped_in"] == "step 1/3"
@@ -424,19 +416,8 @@ def test_sigint_to_freefloat_identify_postcapture_writes_the_partial_run(tmp_pat
     path.write_text(yaml.safe_dump(spec))
     out = tmp_path / "pc"
     p = _start_cli(["identify", "postcapture", str(path), "--out", str(out), "--no-sweep"], tmp_path)
-    try:
-        buf, th = _wait_for(p, "stage")
-        time.sleep(1.0)
-        sent = time.monotonic()
-        p.send_signal(signal.SIGINT)
-        p.wait(timeout=60)
-        took = time.monotonic() - sent
-        th.join(5)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    err = "".join(buf)
-    assert p.returncode == 130, (p.returncode, err[-2000:])
+    code, took, err = _sigint_after(p, "stage", 1.0)
+    assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     res = json.loads((out / "results.json").read_text())
     assert res["interrupted"] is True and 0 < res["t_end"] < 2000.0

@@ -71,3 +71,29 @@ def test_readme_dual_quaternion_snippet_runs_as_written():
     exec(compile(code, "README.md (dual quaternions)", "exec"), ns)
     m, q, v, tau = ns["m"], ns["q"], ns["v"], ns["tau"]
     np.testing.assert_allclose(ns["a"], ff.aba(m, q, v, tau), atol=1e-9)
+
+
+def test_writing_parquet_files_does_not_import_pandas(tmp_path):
+    """pyarrow's table constructors import pandas (half a second) to ask whether their input is a DataFrame; the
+    write that saves a run after Ctrl-C must not pay that. A fresh interpreter writes a trajectory and a telemetry
+    file without importing pandas; both read back unchanged (reading may import it)."""
+    import subprocess
+    import sys
+
+    code = f"""
+import sys, numpy as np, freefloat as ff
+from freefloat.io.telemetry import Telemetry
+m = ff.models.load("naveen_dual_arm")
+tr = ff.simulate(m, m.neutral(), np.full(m.nv, 0.01), 0.01, 1e-3)
+tr.to_parquet({str(tmp_path / "t.parquet")!r})
+tel = Telemetry.from_trajectory(tr)
+tel.to_parquet({str(tmp_path / "tel.parquet")!r})
+print("pandas" in sys.modules)
+back = ff.Trajectory.from_parquet({str(tmp_path / "t.parquet")!r})
+assert np.array_equal(back.q, tr.q) and np.array_equal(back.momentum, tr.momentum)
+again = Telemetry.from_file({str(tmp_path / "tel.parquet")!r}, m)
+assert np.array_equal(again.t, tel.t) and np.array_equal(again.v, tel.v)
+"""
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[0] == "False"

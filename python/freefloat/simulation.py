@@ -165,13 +165,12 @@ class Trajectory:
         """Write to a Parquet file: one row per sample, columns t, q.<joint>[.k], v.…, ddq.…, tau.…,
         momentum.<px…Lz>, kinetic_energy, work (and, when the run has them, propellant.<tank index>,
         base_parameters.<m…Izz>, orbit.<x…vz>); the model name and run statistics in the metadata."""
-        import pyarrow as pa
         import pyarrow.parquet as pq
 
-        cols = self._columns()
+        from .io import arrow
+
         meta = {"freefloat": json.dumps({"model": self.model_name, "stats": self.stats})}
-        table = pa.table(cols).replace_schema_metadata(meta)
-        pq.write_table(table, str(path))
+        pq.write_table(arrow.table(self._columns(), meta), str(path))
 
     @classmethod
     def from_parquet(cls, path) -> Trajectory:

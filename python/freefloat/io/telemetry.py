@@ -118,14 +118,15 @@ class Telemetry:
 
     def to_parquet(self, path) -> None:
         """Write one row per sample; the model name goes in the file metadata."""
-        import pyarrow as pa
         import pyarrow.parquet as pq
+
+        from . import arrow
 
         info = {"model": self.model_name, "kind": "telemetry"}
         if self.rate_noise is not None:
             info["rate_noise"] = [float(x) for x in self.rate_noise]
         meta = {"freefloat": json.dumps(info)}
-        pq.write_table(pa.table(self.columns()).replace_schema_metadata(meta), str(path))
+        pq.write_table(arrow.table(self.columns(), meta), str(path))
 
     def to_csv(self, path) -> None:
         """Write a comma-separated file: a `# model: <name>` comment line, a header of column names,
