@@ -146,13 +146,15 @@ def test_an_exception_in_a_callback_is_still_that_exception(robot):
         ff.simulate(m, m.neutral(), np.zeros(m.nv), 1.0, 1e-3, torques=torques)
 
 
-def _start_cli(args, cwd):
+def _start_cli(args, cwd, merged=False):
+    """The CLI as a child process; `merged` sends its stdout into the stderr pipe (for commands whose progress is
+    printed on stdout)."""
     env = dict(os.environ, PYTHONUNBUFFERED="1")
     return subprocess.Popen(
         [sys.executable, "-m", "freefloat.cli", *args],
         cwd=cwd,
         stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
+        stderr=subprocess.STDOUT if merged else subprocess.PIPE,
         text=True,
         env=env,
     )
@@ -164,7 +166,8 @@ def _wait_for(p, marker, seconds=120):
     done = threading.Event()
 
     def reader():
-        for line in iter(lambda: p.stderr.read(1), ""):
+        stream = p.stderr if p.stderr is not None else p.stdout
+        for line in iter(lambda: stream.read(1), ""):
             buf.append(line)
             if marker in "".join(buf[-400:]):
                 done.set()
@@ -332,6 +335,20 @@ def test_sigint_to_freefloat_excite_keeps_the_best_trajectory(tmp_path):
 
     traj = load_trajectory(out / "trajectory.json")
     assert traj is not None
+
+
+def test_sigint_to_freefloat_control_ddp_keeps_the_best_iterate_and_exits_130(tmp_path):
+    out = tmp_path / "ddp"
+    args = ["control", "ddp", "valverde_ch8_tracking", "--max-iter", "100000", "--out", str(out)]
+    p = _start_cli(args, tmp_path, merged=True)
+    code, took, err = _sigint_after(p, "\n    2 ", 0.3)  # iteration 2's progress line: there is an iterate to keep
+    assert code == 130, (code, err[-2000:])
+    assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
+    res = json.loads((out / "results.json").read_text())
+    assert res["interrupted"] is True and res["stop"] == "interrupted"
+    assert 2 <= res["iterations"] < 100000 and np.isfinite(res["final_cost"])
+    assert res["final_cost"] <= res["initial_cost"]
+    assert not list(out.glob("*.png")), "figures are skipped after Ctrl-C"
 
 
 # -- ch. 9 estimate_recorded ------------------------------------------------------------------------------------

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 from pathlib import Path
 
 import click
@@ -176,8 +177,13 @@ def ddp_cmd(
     res["timings"] = sol["timings"]
     if warm is not None:
         res["warm_start"] = warm
+    # Ctrl-C during the solve: the best iterate is kept and written, without the closed loop or figures (they
+    # take seconds), and the command exits with 130 as every interrupted freefloat command does
+    interrupted = sol["stop"] == "interrupted"
+    if interrupted:
+        res["interrupted"] = True
     runs = {}
-    if closed_loop:
+    if closed_loop and not interrupted:
         runs, res["closed_loop"] = _closed_loop(
             prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps
         )
@@ -199,7 +205,7 @@ def ddp_cmd(
         d = Path(out)
         d.mkdir(parents=True, exist_ok=True)
         (d / "results.json").write_text(json.dumps(res, indent=2))
-        if not no_plots:
+        if not no_plots and not interrupted:
             from ..control.ddp_plots import plot_all
 
             paths = plot_all(prob, sol, d)
@@ -209,7 +215,11 @@ def ddp_cmd(
                 paths += plot(runs, prob, d)
             click.echo(f"  wrote {d / 'results.json'} and {len(paths)} figures")
         else:
-            click.echo(f"  wrote {d / 'results.json'}")
+            click.echo(
+                f"  wrote {d / 'results.json'}" + (" (the best iterate before the interrupt; no figure)" * interrupted)
+            )
+    if interrupted:
+        sys.exit(130)
 
 
 def _closed_loop(prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps):
