@@ -177,11 +177,13 @@ def test_wheel_jitter_is_a_rotating_force_on_the_hub():
     2 U_s Ω, back to zero after whole turns; the work of the force is in the energy balance."""
     m = hub_wheel()
     v0 = np.zeros(m.nv)
-    om = 50.0
+    dt = 1e-4
+    t_final = 12566 * dt  # ten whole turns at about 50 rad/s, in whole steps
+    om = 10 * 2 * np.pi / t_final
     v0[6] = om
     us = 1e-4
     acts = ff.Actuators(wheels=[ff.Wheel("rw", static_imbalance=us)])
-    tr = ff.simulate(m, m.neutral(), v0, 2 * np.pi / om * 10, 1e-4, actuators=acts)
+    tr = ff.simulate(m, m.neutral(), v0, t_final, dt, actuators=acts)
     p = np.linalg.norm(tr.momentum[:, :2], axis=1)
     assert p.max() <= 2 * us * om * (1 + 1e-6)
     assert p.max() >= 1.9 * us * om
