@@ -105,6 +105,42 @@ def test_cli_help_and_bad_scenario():
     assert r.exit_code != 0 and "not found" in r.output
 
 
+def _reach_problem(n: int = 30) -> ddp.Problem:
+    """A short reach of a fixed end-effector pose with the chapter 8 arm (log-SE(3) cost, no wrist spin)."""
+    from freefloat.models import load
+
+    m = load("valverde_ch8_arm")
+    x0 = np.r_[m.neutral(), np.zeros(m.nv)]
+    x0[7:10] = [0.1, -0.2, 0.1]
+    ref = np.array([[6.0, 0.5, 4.5, 0.0, 0.0, math.sin(math.pi / 8), math.cos(math.pi / 8)]])
+    run = [ddp.frame_cost("pose", "ee", ref, [1.0] * 6, "log"), ddp.control_cost("u", m, [1e-2] * m.nv)]
+    term = [ddp.frame_cost("pose", "ee", ref, [100.0] * 6, "log"), ddp.state_cost("v", m, [0.0] * m.nv + [1.0] * m.nv)]
+    return ddp.Problem(
+        model=m,
+        x0=x0,
+        dt=0.05,
+        horizon=n,
+        running=run,
+        terminal=term,
+        us0=np.zeros((n, m.nv)),
+        options={"variant": "ddp", "alphas": [0.5**k for k in range(10)]},
+    )
+
+
+def test_full_ddp_on_the_robot_reaches_the_ilqg_optimum():
+    """Full DDP (second-order dynamics terms, engine `step_hessian`) and iLQG are two Newton-type methods on the same
+    problem: from the same start they must end at the same stationary point. The second-order terms change the
+    iterates (else the option did nothing), and every accepted step lowers the cost."""
+    prob = _reach_problem()
+    ilqg = ddp.solve(prob, max_iter=80)
+    full = ddp.solve(prob, max_iter=80, second_order=True)
+    assert ilqg["stop"] == "converged" and full["stop"] == "converged", (ilqg["stop_message"], full["stop_message"])
+    assert abs(full["cost"] - ilqg["cost"]) <= 1e-9 * ilqg["cost"], (full["cost"], ilqg["cost"])
+    assert abs(full["history"][0]["cost"] - ilqg["history"][0]["cost"]) > 1e-3 * ilqg["history"][0]["cost"]
+    assert all(h["reduction"] > 0 for h in full["history"] if h["accepted"])
+    np.testing.assert_allclose(np.asarray(full["us"]), np.asarray(ilqg["us"]), atol=1e-4)
+
+
 @pytest.mark.slow
 def test_cli_writes_results_and_figures(tmp_path):
     r = CliRunner().invoke(
@@ -114,6 +150,16 @@ def test_cli_writes_results_and_figures(tmp_path):
     res = json.loads((tmp_path / "results.json").read_text())
     assert res["iterations"] == 2 and res["final_cost"] < res["initial_cost"]
     assert len(list(tmp_path.glob("*.png"))) >= 6
+
+
+@pytest.mark.slow
+def test_cli_second_order_runs_full_ddp(tmp_path):
+    args = ["control", "ddp", "valverde_ch8_tracking", "--cost", "log", "--no-schedule", "--no-keep-out"]
+    r = CliRunner().invoke(main, [*args, "--second-order", "--max-iter", "1", "--no-plots", "--out", str(tmp_path)])
+    assert r.exit_code == 0, r.output
+    assert "full DDP" in r.output
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert res["second_order"] is True and res["iterations"] == 1 and res["final_cost"] < res["initial_cost"]
 
 
 @pytest.mark.slow
@@ -201,3 +247,55 @@ def test_thesis_settings_meet_d18_from_the_unwound_log_se3_warm_start():
     assert pos[hold].max() <= 0.05 and ang[hold].max() <= 5.0, (pos[hold].max(), ang[hold].max())
     assert np.sqrt(np.mean(pos[move] ** 2)) <= 0.05
     assert sol["cost"] < sol["history"][0]["cost"]
+
+
+@pytest.mark.slow
+def test_quiet_base_tracking_meets_d18_to_d21_with_the_thesis_solver_settings():
+    """valverde_ch8_tracking_quiet_base (the thesis' reference, schedule, keep-out, alpha = 0.1 and 150 iterations;
+    pose weights 6x and base-velocity weights 3000x/30000x Table 8.2), warm-started as `--warm-start` does: tracking
+    (D.18), base quiescence (D.19: base speed < 0.011 m/s, 10 % of the reference's 0.11 m/s, and rate < 0.05 rad/s
+    at every node), effort ordering (D.20) and keep-out dwell under 10 % of the steps (D.21)."""
+    prob = ddp.load_scenario("valverde_ch8_tracking_quiet_base")
+    assert prob.options["alphas"] == [0.1] and prob.options["max_iter"] == 150 and len(prob.keep_out) == 2
+    guide = ddp.load_scenario("valverde_ch8_tracking_quiet_base", cost="log", schedule=False, keep_out=False)
+    warm, _ = ddp.warm_started(prob, guide)
+    sol = ddp.solve(warm)
+    res = ddp.results(warm, sol)
+    xs = np.asarray(sol["xs"])
+    m = prob.model
+    # D.19 from the states directly (base twist = first six velocities, in base axes)
+    vb = xs[:, m.nq : m.nq + 6]
+    speed, rate = np.linalg.norm(vb[:, :3], axis=1).max(), np.linalg.norm(vb[:, 3:], axis=1).max()
+    assert speed < 0.011 and rate < 0.05, (speed, rate)
+    assert (res["base_speed_peak_m_s"], res["base_rate_peak_rad_s"]) == pytest.approx((speed, rate), rel=1e-12)
+    # D.18
+    assert res["ee_position_error_final_hold_max_m"] <= 0.05 and res["ee_angle_error_final_hold_max_deg"] <= 5.0
+    from freefloat import _core
+
+    g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(xs[:, : m.nq]), "ee")
+    pos = np.linalg.norm(ddp.pose_errors(g, prob.reference_dq)["position"], axis=1)
+    t = np.arange(len(xs)) * prob.dt
+    assert np.sqrt(np.mean(pos[(t >= 7) & (t <= 27)] ** 2)) <= 0.05
+    assert sol["cost"] < sol["history"][0]["cost"]
+    # D.20: sum |f|^2 <= sum |tau_base|^2 (the force weight is the larger one, Table 8.2)
+    us = np.asarray(sol["us"])
+    assert np.sum(us[:, :3] ** 2) <= np.sum(us[:, 3:6] ** 2)
+    # D.21: the keep-out joints spend less than 10 % of the steps within 1 deg of zero
+    for j in ("shoulder", "elbow"):
+        theta = xs[:-1, m.idx_q[m.joint_names.index(j)]]
+        frac = np.mean(np.abs(np.angle(np.exp(1j * theta))) < math.radians(1.0))
+        assert frac < 0.10 and res["keep_out_dwell_within_1deg"][j] == pytest.approx(frac), (j, frac)
+
+
+def test_unknown_weight_keys_are_refused(tmp_path):
+    text = (ddp_scenarios_dir() / "valverde_ch8_tracking.yaml").read_text()
+    bad = tmp_path / "typo.yaml"
+    bad.write_text(text.replace("  base_velocity_running:", "  base_velocity_runing:"))
+    with pytest.raises(InputError, match="base_velocity_runing"):
+        ddp.load_scenario(bad)
+
+
+def ddp_scenarios_dir():
+    from importlib.resources import files
+
+    return files("freefloat") / "data" / "scenarios"

@@ -92,7 +92,7 @@ fn ddp_iterations_allocate_nothing() {
         backward_pass(&mut rob, ws, 1e-6, false, false).unwrap();
     });
     let c = count(|| {
-        freefloat_core::control::ddp::backward::expected_change(ws, true);
+        freefloat_core::control::ddp::backward::expected_change(ws, true, false);
     });
     let e = count(|| {
         rollout_trial(&mut rob, ws, 0.5, false).unwrap();

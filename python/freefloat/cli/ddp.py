@@ -39,6 +39,13 @@ from .._core import InputError
     "thesis' single step 0.1.",
 )
 @click.option("--variant", type=click.Choice(["ddp", "fddp"]), default=None, help="DDP or feasibility-driven DDP.")
+@click.option(
+    "--second-order",
+    is_flag=True,
+    help="Full DDP: add the second-order dynamics terms (eqs. 8.39-8.44) to the backward pass instead of iLQG's "
+    "first-order model. Each iteration then costs about 2 (2 nv + nu) dynamics-derivative evaluations per node "
+    "(on the chapter 8 tracking problem about 35x an iLQG iteration); see docs/ddp.md for when it pays.",
+)
 @click.option("--no-plots", is_flag=True, help="Write results.json only.")
 @click.option(
     "--warm-start",
@@ -87,6 +94,7 @@ def ddp_cmd(
     initial_controls,
     line_search,
     variant,
+    second_order,
     no_plots,
     warm_start,
     closed_loop,
@@ -141,6 +149,8 @@ def ddp_cmd(
         opts["alphas"] = [0.1]
     if variant:
         opts["variant"] = variant
+    if second_order:
+        opts["second_order"] = True
     warm = None
     if warm_start:
         guide = ddp.load_scenario(scenario, cost="log", schedule=False, keep_out=False)
@@ -160,6 +170,7 @@ def ddp_cmd(
     click.echo(
         f"{prob.name}: {prob.model.name}, N = {prob.horizon}, dt = {prob.dt} s, pose cost '{prob.cost_kind}', "
         f"up to {({**prob.options, **opts}).get('max_iter', 100)} iterations"
+        + (", full DDP (second-order dynamics terms)" if second_order else "")
     )
     click.echo(f"{'iter':>5} {'cost':>16} {'step':>8} {'lambda':>9} {'expected':>11} {'gap':>9}")
 
@@ -175,6 +186,7 @@ def ddp_cmd(
     sol = ddp.solve(prob, progress=progress, **opts)
     res = ddp.results(prob, sol)
     res["timings"] = sol["timings"]
+    res["second_order"] = bool(second_order)
     if warm is not None:
         res["warm_start"] = warm
     # Ctrl-C during the solve: the best iterate is kept and written, without the closed loop or figures (they

@@ -222,6 +222,23 @@ def _concat(parts: list):
     return out
 
 
+#: the `weights` keys of a control_ddp scenario, each [Start, Medium, End] (Valverde 2018, Tables 8.1-8.2)
+_WEIGHT_KEYS = [
+    "pose_terminal_real",
+    "pose_terminal_dual",
+    "base_velocity_terminal",
+    "pose_running_real",
+    "pose_running_dual",
+    "base_velocity_running",
+    "control_force",
+    "control_torque",
+    "control_joints",
+    "control_wrist",
+]
+#: not in the thesis: a separate weight on the base's linear velocity (default: base_velocity_*)
+_OPTIONAL_WEIGHT_KEYS = ["base_linear_velocity_running", "base_linear_velocity_terminal"]
+
+
 def load_scenario(
     spec: str | Path,
     cost: str | None = None,
@@ -307,11 +324,23 @@ def load_scenario(
     pose_ref = ref_dq if cost == "dq" else dq_to_pose(ref_dq)
     nv = model.nv
     zeros = lambda k: [0.0] * k  # noqa: E731
-    vel_run, vel_fin = sched("base_velocity_running"), sched("base_velocity_terminal")
-    nb = 6
+    unknown = sorted(set(w) - set(_WEIGHT_KEYS) - set(_OPTIONAL_WEIGHT_KEYS))
+    if unknown:
+        raise InputError(
+            f"{wsrc}: unknown key(s) {', '.join(map(repr, unknown))}; the weights are "
+            + ", ".join(_WEIGHT_KEYS + _OPTIONAL_WEIGHT_KEYS)
+        )
+
+    def base_velocity(when):
+        # the base twist (linear, angular): one weight for all six, or the linear three apart when
+        # `base_linear_velocity_<when>` is given (a heavier hold on the base's drift than on its rotation)
+        both = sched(f"base_velocity_{when}")
+        lin = sched(f"base_linear_velocity_{when}") if f"base_linear_velocity_{when}" in w else both
+        return _concat([zeros(nv), _expand(lin, 3), _expand(both, 3), zeros(nv - 6)])
+
     running = [
         frame_cost("pose", frame, pose_ref, pose_weights(sched("pose_running_real"), sched("pose_running_dual")), cost),
-        state_cost("base_velocity", model, _concat([zeros(nv), _expand(vel_run, nb), zeros(nv - nb)])),
+        state_cost("base_velocity", model, base_velocity("running")),
         control_cost(
             "control",
             model,
@@ -329,7 +358,7 @@ def load_scenario(
         frame_cost(
             "pose", frame, pose_ref, pose_weights(sched("pose_terminal_real"), sched("pose_terminal_dual")), cost
         ),
-        state_cost("base_velocity", model, _concat([zeros(nv), _expand(vel_fin, nb), zeros(nv - nb)])),
+        state_cost("base_velocity", model, base_velocity("terminal")),
     ]
     # Keep-out.
     kos = []
@@ -406,7 +435,10 @@ def solve(problem: Problem, progress=None, **options) -> dict:
 
 def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> dict:
     """The numbers of results.json: iterations, final cost, timings, end-effector position and angle errors
-    (over the final hold and overall), peak base force and torque, peak joint torque."""
+    (over the final hold and overall), peak base force and torque, peak joint torque, and the quantities of the
+    end-to-end criteria: peak base speed and rate over the whole run (base quiescence), the summed squared base
+    force and torque (effort ordering), and for each keep-out joint the fraction of nodes within ±1° of the
+    keep-out centre (dwell)."""
     m = problem.model
     xs, us = np.asarray(sol["xs"]), np.asarray(sol["us"])
     nq = m.nq
@@ -421,6 +453,15 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
     sel = t >= t_end - hold - 1e-9
     f, tau = us[:, :3], us[:, 3:6]
     it = int(sol["iterations"])
+    # base twist in base axes (linear, angular) is the first block of the velocities
+    vb = xs[:, nq : nq + 6] if m.joint_types and m.joint_types[0] == "free" else np.zeros((len(xs), 6))
+    dwell = {}
+    for ko in problem.keep_out:
+        i = m.joint_names.index(ko["joint"])
+        theta = xs[:-1, m.idx_q[i]]
+        # distance to the centre modulo whole turns (the keep-out term itself is not periodic, the joint is)
+        off = np.angle(np.exp(1j * (theta - ko["center"])))
+        dwell[ko["joint"]] = float(np.mean(np.abs(off) < math.radians(1.0)))
     return {
         "scenario": problem.name,
         "pose_cost": problem.cost_kind,
@@ -440,6 +481,11 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
         "base_force_peak_N": float(np.linalg.norm(f, axis=1).max()),
         "base_torque_peak_Nm": float(np.linalg.norm(tau, axis=1).max()),
         "joint_torque_peak_Nm": float(np.abs(us[:, 6:]).max()) if us.shape[1] > 6 else 0.0,
+        "base_speed_peak_m_s": float(np.linalg.norm(vb[:, :3], axis=1).max()),
+        "base_rate_peak_rad_s": float(np.linalg.norm(vb[:, 3:], axis=1).max()),
+        "base_force_sum_sq": float(np.sum(f**2)),
+        "base_torque_sum_sq": float(np.sum(tau**2)),
+        "keep_out_dwell_within_1deg": dwell,
         "gap": float(sol["gap"]),
         "cost_history": [float(h["cost"]) for h in sol["history"]],
     }

@@ -4,7 +4,7 @@
 //! gradient to `V_x' + V_xx' f̄'`).
 
 use super::dense;
-use super::problem::ActionModel;
+use super::problem::{ActionModel, DynamicsHessian};
 use super::workspace::Workspace;
 use crate::dynamics::derivatives::cholesky_inverse;
 use crate::error::{FfError, Result};
@@ -62,17 +62,20 @@ pub fn backward_pass(
         dense::mul_tn(ws.qux.as_mut_slice(), fu, ws.px.as_slice(), ndx, nu, ndx, true);
         if full {
             // Full DDP (eqs. (8.39)–(8.41)): + Σ_j V_x'[j] ∂²F^j.
+            if ws.hess.len() != n {
+                ws.hess = vec![DynamicsHessian::zeros(ndx, nu); n];
+            }
             let (xk, uk) = (ws.xs[k].as_slice(), ws.us[k].as_slice());
-            if !model.dynamics_hessian(k, xk, uk, ws.vx_plus.as_slice(), &mut ws.hess)? {
+            if !model.dynamics_hessian(k, xk, uk, ws.vx_plus.as_slice(), &mut ws.hess[k])? {
                 return Err(FfError::arg(
                     "second_order",
                     "full DDP needs the second-order dynamics terms, which this action model does not provide; \
                      use iLQG (second_order = false)",
                 ));
             }
-            ws.qxx += &ws.hess.hxx;
-            ws.quu += &ws.hess.huu;
-            ws.qux += &ws.hess.hux;
+            ws.qxx += &ws.hess[k].hxx;
+            ws.quu += &ws.hess[k].huu;
+            ws.qux += &ws.hess[k].hux;
         }
         // Regularised factorisation, Q̃_uu = Q_uu + λI (eq. (8.27) asks for Q_uu > 0), and its inverse.
         ws.quu_reg.copy_from(&ws.quu);
@@ -129,8 +132,10 @@ pub fn backward_pass(
 /// Coefficients of the cost change the local LQ model predicts for step α: `ΔJ(α) = α d1 + ½ α² d2`.
 /// Exact for the LQ model with the computed gains (any λ, gaps included): the linearised deviations are
 /// `δx_k = α d_k` with `d₀ = f̄₀`, `d_{k+1} = Fx d_k + Fu (l_k + L_k d_k) + f̄_{k+1}` (Valverde 2018,
-/// eq. (8.45) linearised).
-pub fn expected_change(ws: &mut Workspace, gaps: bool) -> (f64, f64) {
+/// eq. (8.45) linearised). With `full`, the model also has the dynamics curvature of full DDP: each node adds
+/// `δzᵀ H_k δz` (the terms `ws.hess` the last backward pass added to Q), so that the expected-improvement test
+/// judges a full-DDP step against the model it was computed from.
+pub fn expected_change(ws: &mut Workspace, gaps: bool, full: bool) -> (f64, f64) {
     let (n, ndx, nu) = (ws.n, ws.ndx, ws.nu);
     let (mut d1, mut d2) = (0.0, 0.0);
     if gaps {
@@ -145,6 +150,10 @@ pub fn expected_change(ws: &mut Workspace, gaps: bool) -> (f64, f64) {
         dense::gemv_n_add(ws.tmp_u.as_mut_slice(), ws.kfb[k].as_slice(), ws.dx.as_slice(), nu, ndx);
         d1 += dense::dot(d.lx.as_slice(), ws.dx.as_slice()) + dense::dot(d.lu.as_slice(), ws.tmp_u.as_slice());
         d2 += quad(&d.lxx, &ws.dx) + quad(&d.luu, &ws.tmp_u) + 2.0 * bilinear(&d.lxu, &ws.dx, &ws.tmp_u);
+        if full {
+            let h = &ws.hess[k];
+            d2 += quad(&h.hxx, &ws.dx) + quad(&h.huu, &ws.tmp_u) + 2.0 * bilinear(&h.hux, &ws.tmp_u, &ws.dx);
+        }
         if gaps {
             ws.dx2.copy_from(&ws.gaps[k + 1]);
         } else {

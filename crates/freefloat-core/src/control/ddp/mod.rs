@@ -7,8 +7,8 @@
 //!
 //! Files by job: `problem` (the action-model trait), `workspace` (per-node buffers), `backward`,
 //! `forward` (rollouts), `regularisation`, `solver` (driver), `costs`, `lie` (SE(3) exp/log),
-//! `robot` (the floating-base robot action model), `step_jacobians` (analytic step Jacobians), `fd_step` (their
-//! central-difference oracle for the tests).
+//! `robot` (the floating-base robot action model), `step_jacobians` (analytic step Jacobians), `step_hessian` (the
+//! second-order terms of full DDP), `fd_step` (the central-difference oracle of the Jacobians for the tests).
 
 pub mod backward;
 mod dense;
@@ -28,6 +28,7 @@ pub mod lie;
 pub mod mpc;
 pub use mpc::{Mpc, MpcOptions, MpcStats, Policy};
 pub mod robot;
+pub mod step_hessian;
 pub mod step_jacobians;
 pub use robot::FloatingRobot;
 pub mod reference;

@@ -49,6 +49,8 @@ pub struct FloatingRobot {
     /// Node k of this horizon reads reference k + offset (receding-horizon windows over a longer task; 0
     /// for an ordinary problem). Past the end of a reference table the last entry holds.
     pub(crate) offset: usize,
+    /// Scratch of the full-DDP step Hessian (`step_hessian`), made on first use.
+    pub(crate) hess: Option<super::step_hessian::HessianWork>,
 }
 
 impl FloatingRobot {
@@ -114,6 +116,7 @@ impl FloatingRobot {
         let data = Data::new(&model);
         FloatingRobot {
             offset: 0,
+            hess: None,
             data,
             deriv: Derivatives::new(&model),
             dt,
@@ -437,6 +440,17 @@ impl ActionModel for FloatingRobot {
         d.clear();
         crate::kinematics::forward_kinematics(&self.model, &mut self.data, &x[..self.model.nq])?;
         self.cost_diff(self.n, x, None, d)
+    }
+    fn dynamics_hessian(
+        &mut self,
+        _k: usize,
+        x: &[f64],
+        u: &[f64],
+        lambda: &[f64],
+        out: &mut super::problem::DynamicsHessian,
+    ) -> Result<bool> {
+        self.step_hessian(x, u, lambda, out)?;
+        Ok(true)
     }
     fn schedule_end(&self) -> usize {
         self.running.iter().chain(self.terminal.iter()).map(|t| t.weights.schedule_end()).max().unwrap_or(0)

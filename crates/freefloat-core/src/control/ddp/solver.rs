@@ -342,7 +342,7 @@ impl Solver {
                 }
                 break;
             }
-            let (d1, d2) = expected_change(&mut self.ws, use_gaps && !feasible);
+            let (d1, d2) = expected_change(&mut self.ws, use_gaps && !feasible, opts.second_order);
             tm.backward_s += t0.elapsed().as_secs_f64();
             let expected_full = -(d1 + 0.5 * d2);
             if feasible && expected_full.abs() < opts.tol_expected {

@@ -77,8 +77,9 @@ pub struct Workspace {
     pub dx2: DVector<f64>,
     /// nx scratch (the next state of a rollout).
     pub xnext: DVector<f64>,
-    /// Full DDP second-order terms of one node.
-    pub hess: DynamicsHessian,
+    /// Full DDP second-order terms of every running node (empty until a full-DDP backward pass needs them;
+    /// the expected-change model of the line search reads them back).
+    pub hess: Vec<DynamicsHessian>,
 }
 
 impl Workspace {
@@ -121,7 +122,7 @@ impl Workspace {
             dx: DVector::zeros(ndx),
             dx2: DVector::zeros(ndx),
             xnext: DVector::zeros(nx),
-            hess: DynamicsHessian::zeros(ndx, nu),
+            hess: Vec::new(),
         }
     }
 
