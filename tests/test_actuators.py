@@ -86,6 +86,66 @@ def test_negative_or_inverted_limits_are_errors_naming_the_key(lim, key):
         ff.Model.from_yaml_string(text)
 
 
+# -- joint limits given by the simulation (actuators.limits), overriding the model's --------------------------------
+def test_limit_from_the_actuators_clips_the_command_and_the_acceleration_is_the_closed_form():
+    """A model without limits, `JointLimit(rw, effort=0.05)`, command 0.1 N m: the applied torque is 0.05 and the
+    wheel's relative acceleration is the closed form τ (1/Js + 1/I_hub,z) for a free hub (τ/Js alone for a fixed
+    hub, below), constant through the run."""
+    m = hub_wheel()
+    acts = ff.Actuators(limits=[ff.JointLimit("rw", effort=0.05)])
+    tr = ff.simulate(m, m.neutral(), np.zeros(m.nv), 1.0, 1e-3, actuators=acts, **const(m, 6, 0.1))
+    np.testing.assert_allclose(tr.tau[:, 6], 0.05, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(tr.ddq[:, 6], 0.05 * (1 / 0.1 + 1 / 2.0), rtol=1e-12)
+    # without the limit the same command gives twice the acceleration
+    tr0 = ff.simulate(m, m.neutral(), np.zeros(m.nv), 1.0, 1e-3, **const(m, 6, 0.1))
+    np.testing.assert_allclose(tr0.ddq[:, 6], 0.1 * (1 / 0.1 + 1 / 2.0), rtol=1e-12)
+    assert tr.momentum_drift()["angular_abs"] < 1e-13
+    # a fixed hub: the closed form τ/Js
+    fixed = ff.Model.from_yaml_string(hub_wheel_yaml().replace("base: free", "base: fixed"))
+    trf = ff.simulate(fixed, fixed.neutral(), np.zeros(1), 1.0, 1e-3, actuators=acts, **const(fixed, 0, 0.1))
+    np.testing.assert_allclose(trf.ddq[:, 0], 0.05 / 0.1, rtol=1e-12)
+    np.testing.assert_allclose(trf.v[-1, 0], 0.5, rtol=1e-12)
+
+
+def test_limit_from_the_actuators_overrides_the_model_value_per_quantity():
+    """The model says effort 0.05, velocity 1.0. An override of the effort alone (0.08, above the model's: an
+    override, not the smaller of the two) changes the torque and keeps the model's velocity limit; an override of
+    the velocity alone (0.5) keeps the model's effort."""
+    m = hub_wheel(effort=0.05, velocity=1.0)
+    a = 0.08 * (1 / 0.1 + 1 / 2.0)
+    dt = 1e-3
+    acts = {"limits": [{"joint": "rw", "effort": 0.08}]}
+    tr = ff.simulate(m, m.neutral(), np.zeros(m.nv), 3.0, dt, actuators=acts, **const(m, 6, 0.1))
+    assert tr.tau[0, 6] == 0.08
+    assert 1.0 <= tr.v[-1, 6] <= 1.0 + a * dt + 1e-12  # the model's velocity limit holds
+    acts = ff.Actuators(limits=[ff.JointLimit("rw", velocity=0.5)])
+    tr = ff.simulate(m, m.neutral(), np.zeros(m.nv), 3.0, dt, actuators=acts, **const(m, 6, 0.1))
+    assert tr.tau[0, 6] == 0.05  # the model's effort
+    a = 0.05 * (1 / 0.1 + 1 / 2.0)
+    w = tr.v[:, 6]
+    assert w.max() <= 0.5 + a * dt + 1e-12 and w[-1] >= 0.5 - 1e-12  # the new velocity limit holds
+    assert tr.tau[-1, 6] == 0.0
+
+
+@pytest.mark.parametrize(
+    "limits, key, words",
+    [
+        ([{"joint": "nope", "effort": 1.0}], r"actuators.limits\[0\].joint", "no joint 'nope'"),
+        ([{"joint": "rw", "effort": -0.05}], r"actuators.limits\[0\].effort", "positive"),
+        ([{"joint": "rw", "effort": 0.0}], r"actuators.limits\[0\].effort", "positive"),
+        ([{"joint": "rw", "velocity": float("nan")}], r"actuators.limits\[0\].velocity", "positive"),
+        ([{"joint": "rw", "effort": 1.0}, {"joint": "rw", "velocity": 1.0}], r"actuators.limits\[1\].joint", "twice"),
+        ([{"joint": "rw"}], r"actuators.limits\[0\]", "effort, a velocity limit or both"),
+        ([{"joint": "rw", "efort": 1.0}], r"actuators.limits\[0\]", "efort"),
+    ],
+)
+def test_bad_actuator_limits_name_the_entry(limits, key, words):
+    m = hub_wheel()
+    with pytest.raises(InputError, match=key) as e:
+        ff.simulate(m, m.neutral(), np.zeros(m.nv), 0.1, 1e-3, actuators={"limits": limits})
+    assert words in str(e.value)
+
+
 # -- input timing -------------------------------------------------------------------------------------------------
 def point_body():
     return ff.Model.from_yaml_string(
@@ -348,6 +408,34 @@ def test_cli_simulate_reads_an_actuators_file(tmp_path):
         timeout=300,
     )
     assert r.returncode != 0 and "frition" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_cli_simulate_applies_limits_from_an_actuators_file(tmp_path):
+    """The same limit through the command line: `--actuators` with `limits: [{joint, effort, velocity}]` and a
+    table of 0.1 N m: the recorded torque is the limit and the wheel stops accelerating at the velocity limit."""
+    import subprocess
+    import sys
+
+    model = tmp_path / "hub_wheel.yaml"
+    model.write_text(hub_wheel_yaml())
+    acts = tmp_path / "acts.yaml"
+    acts.write_text("actuators:\n  limits:\n    - {joint: rw, effort: 0.05, velocity: 1.0}\n")
+    tau = tmp_path / "tau.npy"
+    np.save(tau, np.array([[0, 0, 0, 0, 0, 0, 0.1]]))
+    out = tmp_path / "run"
+    cmd = [sys.executable, "-m", "freefloat.cli", "simulate", str(model), "--actuators", str(acts)]
+    cmd += ["--t-final", "3", "--dt", "0.001", "--record-every", "1", "--torques", str(tau), "--out", str(out)]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    assert r.returncode == 0, r.stderr
+    tr = ff.Trajectory.from_parquet(out / "trajectory.parquet")
+    a = 0.05 * (1 / 0.1 + 1 / 2.0)
+    assert np.abs(tr.tau[:, 6]).max() == 0.05
+    early = tr.t < 0.9 / a
+    np.testing.assert_allclose(tr.v[early, 6], a * tr.t[early], atol=1e-12)
+    assert tr.v[:, 6].max() <= 1.0 + a * 1e-3 + 1e-12 and tr.v[-1, 6] >= 1.0 - 1e-12
+    acts.write_text("actuators:\n  limits:\n    - {joint: rw, effort: -1}\n")
+    r = subprocess.run(cmd[:7] + ["--t-final", "0.1"], capture_output=True, text=True, timeout=300)
+    assert r.returncode != 0 and "limits[0].effort" in r.stderr and "Traceback" not in r.stderr
 
 
 def test_propellant_and_base_parameters_survive_the_trajectory_files(tmp_path):

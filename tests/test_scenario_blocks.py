@@ -51,6 +51,21 @@ BAD = [
         "actuators.wheels[0].max_torque",
         "must be > 0",
     ),
+    (  # a joint limit that is negative
+        "actuators:\n  limits:\n    - {joint: J1, effort: -1.0}\n",
+        "actuators.limits[0].effort",
+        "must be > 0",
+    ),
+    (  # a joint limited twice
+        "actuators:\n  limits:\n    - {joint: J1, effort: 1.0}\n    - {velocity: 1.0, joint: J1}\n",
+        "actuators.limits[1].joint",
+        "limited twice",
+    ),
+    (  # a joint the robot does not have (the engine's check, on the robot)
+        "actuators:\n  limits:\n    - {joint: J9, effort: 1.0}\n",
+        "actuators.limits[0].joint",
+        "no joint 'J9'",
+    ),
     (  # limits inverted: static friction below Coulomb friction
         "actuators:\n  wheels:\n    - {joint: J1, coulomb: 0.01, static_friction: 0.005, stribeck_speed: 0.1}\n",
         "actuators.wheels[0].static_friction",

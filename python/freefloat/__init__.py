@@ -18,7 +18,7 @@ _cpu.check()  # before anything loads the engine: a clear ImportError on too old
 
 from . import constants, control, derivatives, dq, identification, io, models, trajectories, viz
 from ._core import InputError, Interrupted, ModelError, NumericalError
-from .actuators import Actuators, Tank, Thruster, Wheel
+from .actuators import Actuators, JointLimit, Tank, Thruster, Wheel
 from .algorithms import (
     aba,
     base_twist_for_momentum,
@@ -66,6 +66,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Actuators",
+    "JointLimit",
     "Wheel",
     "Thruster",
     "Tank",

@@ -1,11 +1,13 @@
-"""Actuator models for `simulate`: reaction wheels, thrusters and propellant tanks.
+"""Actuator models for `simulate`: joint limits, reaction wheels, thrusters and propellant tanks.
 
 They are evaluated in the engine, inside the integrator (no Python runs during the simulation). The joint
 limits of the model (URDF ``<limit effort velocity>``, YAML ``limits: {effort, velocity}``) always apply, with or
-without these. See ``docs/actuators.md`` for every formula and choice.
+without these; a `JointLimit` replaces the model's value of each quantity it gives for its joint. See
+``docs/actuators.md`` for every formula and choice.
 
     import freefloat as ff
     acts = ff.Actuators(
+        limits=[ff.JointLimit("joint3", effort=5.0)],
         wheels=[ff.Wheel("rw1", max_torque=0.2, max_speed=600.0, coulomb=5e-4, viscous=1e-6)],
         thrusters=[ff.Thruster(position=(0, 0, -0.5), direction=(0, 0, 1), max_thrust=1.0, isp=220.0,
                                tank="main", firings=[(1.0, 0.5)])],
@@ -19,7 +21,27 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
 
-from ._core import InputError
+from ._core import InputError, actuator_fields
+
+# The keys the engine reads and its wheel defaults (`Wheel::new`): one copy, in the engine; the classes below and
+# the scenario schema (`io/scenario_schemas.py`) take theirs from here.
+FIELDS = actuator_fields()
+WHEEL_DEFAULTS = FIELDS["wheels"]["defaults"]
+
+
+@dataclass
+class JointLimit:
+    """Limits of the model's joint `joint` (by name) for one simulation, replacing the model's (URDF `<limit>`)
+    value of each quantity given; a quantity left out (None) keeps the model's. Symmetric magnitudes: the drive's
+    command is clipped to [-effort, effort] (N m or N) and gives no force that drives |rate| further past
+    `velocity` (rad/s or m/s)."""
+
+    joint: str
+    effort: float | None = None
+    velocity: float | None = None
+
+
+_W = WHEEL_DEFAULTS
 
 
 @dataclass
@@ -30,16 +52,16 @@ class Wheel:
     Limits are optional (None: none). Units: N m, rad/s, W, N m s/rad, kg m, kg m²."""
 
     joint: str
-    max_torque: float | None = None
-    max_speed: float | None = None
-    max_power: float | None = None
-    coulomb: float = 0.0
-    static_friction: float = 0.0
-    stribeck_speed: float | None = None
-    viscous: float = 0.0
-    limit_cycle_speed: float = 1e-4
-    static_imbalance: float = 0.0
-    dynamic_imbalance: float = 0.0
+    max_torque: float | None = _W["max_torque"]
+    max_speed: float | None = _W["max_speed"]
+    max_power: float | None = _W["max_power"]
+    coulomb: float = _W["coulomb"]
+    static_friction: float = _W["static_friction"]
+    stribeck_speed: float | None = _W["stribeck_speed"]
+    viscous: float = _W["viscous"]
+    limit_cycle_speed: float = _W["limit_cycle_speed"]
+    static_imbalance: float = _W["static_imbalance"]
+    dynamic_imbalance: float = _W["dynamic_imbalance"]
 
 
 @dataclass
@@ -77,16 +99,17 @@ class Tank:
 
 @dataclass
 class Actuators:
-    """Wheels, thrusters and tanks of one simulation (`simulate(..., actuators=...)`)."""
+    """Joint limits, wheels, thrusters and tanks of one simulation (`simulate(..., actuators=...)`)."""
 
     wheels: list = field(default_factory=list)
     thrusters: list = field(default_factory=list)
     tanks: list = field(default_factory=list)
+    limits: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
         """The plain mapping the engine reads (also the layout of a YAML `actuators:` block)."""
         out = {}
-        for key, kind in (("wheels", Wheel), ("thrusters", Thruster), ("tanks", Tank)):
+        for key, kind in _KINDS:
             items = []
             for j, a in enumerate(getattr(self, key)):
                 if isinstance(a, dict):
@@ -107,15 +130,16 @@ class Actuators:
 
     @classmethod
     def from_dict(cls, d, where: str = "actuators") -> Actuators:
-        """Read an `actuators:` mapping (from a scenario or YAML file): lists `wheels`, `thrusters`, `tanks` of
-        mappings with the fields of Wheel, Thruster, Tank. Unknown keys are errors naming them."""
+        """Read an `actuators:` mapping (from a scenario or YAML file): lists `limits`, `wheels`, `thrusters`,
+        `tanks` of mappings with the fields of JointLimit, Wheel, Thruster, Tank. Unknown keys are errors naming them."""
+        allowed = ", ".join(FIELDS["actuators"])
         if not isinstance(d, dict):
-            raise InputError(f"{where}: expected a mapping with wheels/thrusters/tanks, got {type(d).__name__}")
-        unknown = set(d) - {"wheels", "thrusters", "tanks"}
+            raise InputError(f"{where}: expected a mapping with {allowed}, got {type(d).__name__}")
+        unknown = set(d) - set(FIELDS["actuators"])
         if unknown:
-            raise InputError(f"{where}: unknown key(s) {sorted(unknown)} (allowed: wheels, thrusters, tanks)")
+            raise InputError(f"{where}: unknown key(s) {sorted(unknown)} (allowed: {allowed})")
         lists = {}
-        for key, kind in (("wheels", Wheel), ("thrusters", Thruster), ("tanks", Tank)):
+        for key, kind in _KINDS:
             items = d.get(key) or []
             if not isinstance(items, list):
                 raise InputError(f"{where}.{key}: expected a list")
@@ -133,6 +157,9 @@ class Actuators:
                     raise InputError(f"{where}.{key}[{j}]: {e}") from None
             lists[key] = out
         return cls(**lists)
+
+
+_KINDS = (("limits", JointLimit), ("wheels", Wheel), ("thrusters", Thruster), ("tanks", Tank))
 
 
 def add_wheels(model_yaml: dict, n: int = 3, *, axes=None, inertia=(0.1, 0.05), mass: float = 1.0, radius=0.2):

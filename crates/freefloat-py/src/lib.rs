@@ -60,6 +60,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(derivatives::frame_log_error_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(derivatives::frame_dq_pose_derivatives, m)?)?;
     m.add_function(wrap_pyfunction!(simulate::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate::actuator_fields, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::measure, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::check_sensors, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_many::simulate_many, m)?)?;

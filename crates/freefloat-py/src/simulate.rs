@@ -9,8 +9,8 @@ use crate::model::PyModel;
 use freefloat_core::environment::Environment;
 use freefloat_core::model::Model;
 use freefloat_core::sim::{
-    self, Actuators, Controller, Hold, InputTiming, Inputs, Method, Prescription, SimOptions, Tank, Thruster,
-    TorqueSource, Wheel,
+    self, Actuators, Controller, Hold, InputTiming, Inputs, JointLimit, Method, Prescription, SimOptions, Tank,
+    Thruster, TorqueSource, Wheel,
 };
 use freefloat_core::spatial::V3;
 use freefloat_core::FfError;
@@ -383,14 +383,82 @@ enum TorqueSpec<'py> {
     Callable(Bound<'py, PyAny>),
 }
 
-/// Read the `actuators` argument: a dict `{"wheels": [...], "thrusters": [...], "tanks": [...]}` of
+/// The keys `parse_actuators` reads: of the `actuators` mapping and of each entry of its lists. The
+/// Python classes (`freefloat.Actuators` and its entries) and the scenario schema read them, with the
+/// wheel defaults, from `actuator_fields`, and a test checks that they agree.
+const ACTUATOR_KEYS: &[&str] = &["limits", "wheels", "thrusters", "tanks"];
+const LIMIT_KEYS: &[&str] = &["joint", "effort", "velocity"];
+const WHEEL_KEYS: &[&str] = &[
+    "joint",
+    "max_torque",
+    "max_speed",
+    "max_power",
+    "coulomb",
+    "static_friction",
+    "stribeck_speed",
+    "viscous",
+    "limit_cycle_speed",
+    "static_imbalance",
+    "dynamic_imbalance",
+];
+const THRUSTER_KEYS: &[&str] = &[
+    "name",
+    "body",
+    "position",
+    "direction",
+    "max_thrust",
+    "min_on_time",
+    "ramp_on",
+    "ramp_off",
+    "isp",
+    "tank",
+    "firings",
+];
+const TANK_KEYS: &[&str] = &["name", "body", "position", "mass", "radius"];
+
+/// `actuator_fields()`: `{"actuators": [keys], "limits"/"wheels"/"thrusters"/"tanks": {"keys": [...],
+/// "defaults": {...}}}`: the keys `parse_actuators` accepts and, for wheels, the engine's defaults
+/// (`Wheel::new`; `None`: no limit). The one source the Python classes and the scenario schema read.
+#[pyfunction]
+pub fn actuator_fields(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("actuators", ACTUATOR_KEYS.to_vec())?;
+    let w = Wheel::new(0);
+    let wd = PyDict::new(py);
+    wd.set_item("max_torque", w.max_torque)?;
+    wd.set_item("max_speed", w.max_speed)?;
+    wd.set_item("max_power", w.max_power)?;
+    wd.set_item("coulomb", w.coulomb)?;
+    wd.set_item("static_friction", w.static_friction)?;
+    wd.set_item("stribeck_speed", w.stribeck_speed)?;
+    wd.set_item("viscous", w.viscous)?;
+    wd.set_item("limit_cycle_speed", w.limit_cycle_speed)?;
+    wd.set_item("static_imbalance", w.static_imbalance)?;
+    wd.set_item("dynamic_imbalance", w.dynamic_imbalance)?;
+    for (key, keys, defaults) in [
+        ("limits", LIMIT_KEYS, None),
+        ("wheels", WHEEL_KEYS, Some(wd)),
+        ("thrusters", THRUSTER_KEYS, None),
+        ("tanks", TANK_KEYS, None),
+    ] {
+        let e = PyDict::new(py);
+        e.set_item("keys", keys.to_vec())?;
+        e.set_item("defaults", defaults.unwrap_or_else(|| PyDict::new(py)))?;
+        d.set_item(key, e)?;
+    }
+    Ok(d)
+}
+
+/// Read the `actuators` argument: a dict `{"limits": [...], "wheels": [...], "thrusters": [...], "tanks": [...]}` of
 /// dicts (what `freefloat.Actuators.to_dict()` writes); joints and bodies by name. Every key is
 /// checked; errors name the entry (`actuators.wheels[1].max_torque`).
 pub(crate) fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actuators> {
     let d = a.downcast::<PyDict>().map_err(|_| {
-        input_err("argument `actuators`: expected a freefloat.Actuators or a dict with wheels/thrusters/tanks lists")
+        input_err(
+            "argument `actuators`: expected a freefloat.Actuators or a dict with limits/wheels/thrusters/tanks lists",
+        )
     })?;
-    check_keys(d, &["wheels", "thrusters", "tanks"], "actuators")?;
+    check_keys(d, ACTUATOR_KEYS, "actuators")?;
     let list = |key: &str| -> PyResult<Vec<Bound<'_, PyDict>>> {
         match d.get_item(key)? {
             None => Ok(vec![]),
@@ -410,42 +478,42 @@ pub(crate) fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actua
         }
     };
     let mut out = Actuators::default();
+    let joint = |name: &str, at: &str| -> PyResult<usize> {
+        m.joint_names.iter().position(|n| *n == name).ok_or_else(|| {
+            input_err(format!(
+                "{at}.joint: the model has no joint '{name}' (joints: {})",
+                m.joint_names[1..].join(", ")
+            ))
+        })
+    };
+    for (j, l) in list("limits")?.iter().enumerate() {
+        let at = format!("actuators.limits[{j}]");
+        check_keys(l, LIMIT_KEYS, &at)?;
+        let name = get_str(l, "joint", &at)?;
+        // NaN, zero, negative and duplicate joints: the engine's check names the entry
+        out.limits.push(JointLimit {
+            joint: joint(&name, &at)?,
+            effort: get_f_any(l, "effort", &at)?,
+            velocity: get_f_any(l, "velocity", &at)?,
+        });
+    }
     for (j, w) in list("wheels")?.iter().enumerate() {
         let at = format!("actuators.wheels[{j}]");
-        check_keys(
-            w,
-            &[
-                "joint",
-                "max_torque",
-                "max_speed",
-                "max_power",
-                "coulomb",
-                "static_friction",
-                "stribeck_speed",
-                "viscous",
-                "limit_cycle_speed",
-                "static_imbalance",
-                "dynamic_imbalance",
-            ],
-            &at,
-        )?;
+        check_keys(w, WHEEL_KEYS, &at)?;
         let name = get_str(w, "joint", &at)?;
-        let joint = m
-            .joint_names
-            .iter()
-            .position(|n| *n == name)
-            .ok_or_else(|| input_err(format!("{at}.joint: the model has no joint '{name}'")))?;
-        let mut wh = Wheel::new(joint);
-        wh.max_torque = get_f(w, "max_torque", &at)?;
-        wh.max_speed = get_f(w, "max_speed", &at)?;
-        wh.max_power = get_f(w, "max_power", &at)?;
-        wh.coulomb = get_f(w, "coulomb", &at)?.unwrap_or(0.0);
-        wh.static_friction = get_f(w, "static_friction", &at)?.unwrap_or(0.0);
-        wh.stribeck_speed = get_f(w, "stribeck_speed", &at)?;
-        wh.viscous = get_f(w, "viscous", &at)?.unwrap_or(0.0);
-        wh.limit_cycle_speed = get_f(w, "limit_cycle_speed", &at)?.unwrap_or(1e-4);
-        wh.static_imbalance = get_f(w, "static_imbalance", &at)?.unwrap_or(0.0);
-        wh.dynamic_imbalance = get_f(w, "dynamic_imbalance", &at)?.unwrap_or(0.0);
+        // the engine's `Wheel::new` holds every default (the Python classes and the schema read them from
+        // `actuator_fields`)
+        let mut wh = Wheel::new(joint(&name, &at)?);
+        wh.max_torque = get_f(w, "max_torque", &at)?.or(wh.max_torque);
+        wh.max_speed = get_f(w, "max_speed", &at)?.or(wh.max_speed);
+        wh.max_power = get_f(w, "max_power", &at)?.or(wh.max_power);
+        wh.coulomb = get_f(w, "coulomb", &at)?.unwrap_or(wh.coulomb);
+        wh.static_friction = get_f(w, "static_friction", &at)?.unwrap_or(wh.static_friction);
+        wh.stribeck_speed = get_f(w, "stribeck_speed", &at)?.or(wh.stribeck_speed);
+        wh.viscous = get_f(w, "viscous", &at)?.unwrap_or(wh.viscous);
+        wh.limit_cycle_speed = get_f(w, "limit_cycle_speed", &at)?.unwrap_or(wh.limit_cycle_speed);
+        wh.static_imbalance = get_f(w, "static_imbalance", &at)?.unwrap_or(wh.static_imbalance);
+        wh.dynamic_imbalance = get_f(w, "dynamic_imbalance", &at)?.unwrap_or(wh.dynamic_imbalance);
         out.wheels.push(wh);
     }
     let body = |d: &Bound<PyDict>, at: &str| -> PyResult<usize> {
@@ -465,7 +533,7 @@ pub(crate) fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actua
     let mut tank_names = Vec::new();
     for (j, t) in tanks.iter().enumerate() {
         let at = format!("actuators.tanks[{j}]");
-        check_keys(t, &["name", "body", "position", "mass", "radius"], &at)?;
+        check_keys(t, TANK_KEYS, &at)?;
         tank_names.push(match t.get_item("name")? {
             Some(x) if !x.is_none() => get_str(t, "name", &at)?,
             _ => format!("tank{j}"),
@@ -479,23 +547,7 @@ pub(crate) fn parse_actuators(m: &Model, a: &Bound<'_, PyAny>) -> PyResult<Actua
     }
     for (j, t) in list("thrusters")?.iter().enumerate() {
         let at = format!("actuators.thrusters[{j}]");
-        check_keys(
-            t,
-            &[
-                "name",
-                "body",
-                "position",
-                "direction",
-                "max_thrust",
-                "min_on_time",
-                "ramp_on",
-                "ramp_off",
-                "isp",
-                "tank",
-                "firings",
-            ],
-            &at,
-        )?;
+        check_keys(t, THRUSTER_KEYS, &at)?;
         let tank = match t.get_item("tank")? {
             None => None,
             Some(x) if x.is_none() => None,
@@ -558,6 +610,15 @@ fn get_f(d: &Bound<'_, PyDict>, key: &str, at: &str) -> PyResult<Option<f64>> {
             }
             Ok(Some(v))
         }
+    }
+}
+
+/// A number that may be anything (NaN, negative): the engine's check says what is wrong with it.
+fn get_f_any(d: &Bound<'_, PyDict>, key: &str, at: &str) -> PyResult<Option<f64>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(x) if x.is_none() => Ok(None),
+        Some(x) => Ok(Some(x.extract().map_err(|_| input_err(format!("{at}.{key}: expected a number")))?)),
     }
 }
 

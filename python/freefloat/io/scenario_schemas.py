@@ -13,6 +13,7 @@ from typing import Annotated, Any
 
 from pydantic import Field, PlainValidator, model_validator
 
+from ..actuators import WHEEL_DEFAULTS
 from .schema import (
     _TYPES_ONLY,
     Anything,
@@ -324,18 +325,28 @@ def _norm(x) -> float:
     return math.sqrt(sum(float(c) ** 2 for c in x))
 
 
+# the wheel defaults are the engine's (`Wheel::new`, read through the binding): one copy
+_WD = WHEEL_DEFAULTS
+
+
+class ActLimit(Block):
+    joint: Text
+    effort: Positive | None = None
+    velocity: Positive | None = None
+
+
 class ActWheel(Block):
     joint: Text
-    max_torque: Positive | None = None
-    max_speed: Positive | None = None
-    max_power: Positive | None = None
-    coulomb: NonNegative = 0.0
-    static_friction: NonNegative = 0.0
-    stribeck_speed: Positive | None = None
-    viscous: NonNegative = 0.0
-    limit_cycle_speed: Positive = 1e-4
-    static_imbalance: NonNegative = 0.0
-    dynamic_imbalance: NonNegative = 0.0
+    max_torque: Positive | None = _WD["max_torque"]
+    max_speed: Positive | None = _WD["max_speed"]
+    max_power: Positive | None = _WD["max_power"]
+    coulomb: NonNegative = _WD["coulomb"]
+    static_friction: NonNegative = _WD["static_friction"]
+    stribeck_speed: Positive | None = _WD["stribeck_speed"]
+    viscous: NonNegative = _WD["viscous"]
+    limit_cycle_speed: Positive = _WD["limit_cycle_speed"]
+    static_imbalance: NonNegative = _WD["static_imbalance"]
+    dynamic_imbalance: NonNegative = _WD["dynamic_imbalance"]
 
 
 class ActThruster(Block):
@@ -361,6 +372,7 @@ class ActTank(Block):
 
 
 class ActuatorsBlock(Block):
+    limits: list[ActLimit] = []
     wheels: list[ActWheel] = []
     thrusters: list[ActThruster] = []
     tanks: list[ActTank] = []
@@ -369,6 +381,17 @@ class ActuatorsBlock(Block):
     def _cross(self):
         if _TYPES_ONLY.get():
             return self
+        limited = {}
+        for j, lim in enumerate(self.limits):
+            at = f"actuators.limits[{j}]"
+            if lim.joint in limited:
+                raise _Bad(
+                    f"key '{at}.joint': joint '{lim.joint}' is limited twice (actuators.limits[{limited[lim.joint]}] "
+                    "limits it too)"
+                )
+            limited[lim.joint] = j
+            if lim.effort is None and lim.velocity is None:
+                raise _Bad(f"key '{at}': give an effort, a velocity limit or both for joint '{lim.joint}'")
         seen = set()
         for j, w in enumerate(self.wheels):
             at = f"actuators.wheels[{j}]"

@@ -120,7 +120,7 @@ mod tests {
             firings: vec![(1.0, 1.0)],
         };
         let tank = Tank { body: 0, position: V3::zeros(), mass: 10.0, radius: 0.0 };
-        let acts = Actuators { wheels: vec![], thrusters: vec![th], tanks: vec![tank] };
+        let acts = Actuators { thrusters: vec![th], tanks: vec![tank], ..Default::default() };
         let t = [0.5, 1.5, 2.5, 1.5];
         let mp = [10.0, 9.0, 8.0, 0.0];
         let (w, flow) = thruster_base_wrench(&m, &acts, &t, &mp).unwrap();

@@ -9,7 +9,7 @@ mod inputs;
 pub(crate) mod tableau;
 mod trajectory;
 
-pub use actuators::{Actuators, Tank, Thruster, Wheel};
+pub use actuators::{Actuators, JointLimit, Tank, Thruster, Wheel};
 pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use batch::{batch_size, simulate_many, simulate_many_interruptible, BatchSpec, Stacked};
 pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};

@@ -8,6 +8,7 @@ pub(crate) mod limits;
 mod thruster;
 mod wheel;
 
+pub use limits::JointLimit;
 pub use thruster::{Tank, Thruster, G0};
 pub use wheel::Wheel;
 
@@ -16,9 +17,12 @@ use crate::model::Model;
 use crate::spatial::Inertia;
 use wheel::WheelRt;
 
-/// The actuators of a simulation (besides the joint limits, which every model carries).
+/// The actuators of a simulation (besides the joint limits, which every model carries, and which
+/// `limits` may override joint by joint).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Actuators {
+    /// Joint limits replacing the model's for some joints (each quantity given replaces the model's).
+    pub limits: Vec<JointLimit>,
     /// Reaction wheels (each one a revolute joint of the model).
     pub wheels: Vec<Wheel>,
     /// Thrusters.
@@ -30,7 +34,7 @@ pub struct Actuators {
 impl Actuators {
     /// Whether there is nothing to model.
     pub fn is_empty(&self) -> bool {
-        self.wheels.is_empty() && self.thrusters.is_empty() && self.tanks.is_empty()
+        self.limits.is_empty() && self.wheels.is_empty() && self.thrusters.is_empty() && self.tanks.is_empty()
     }
 }
 
@@ -52,6 +56,7 @@ impl ActuatorRt {
     /// prescribed motion (no limit or wheel model applies to those).
     pub fn new(m: &Model, a: Option<Actuators>, prescribed: &[bool]) -> Result<Self> {
         let a = a.unwrap_or_default();
+        limits::check(m, &a.limits, prescribed)?;
         let mut seen = vec![false; m.nbodies()];
         let mut wheels = Vec::with_capacity(a.wheels.len());
         for (j, w) in a.wheels.iter().enumerate() {
@@ -94,7 +99,14 @@ impl ActuatorRt {
         }
         let uses_fext = !thrusters.is_empty() || wheels.iter().any(|w| w.jitters());
         let wet = a.tanks.iter().map(|t| m.inertias[t.body]).collect();
-        Ok(ActuatorRt { limits: limits::collect(m, prescribed), wheels, thrusters, tanks: a.tanks, wet, uses_fext })
+        Ok(ActuatorRt {
+            limits: limits::collect(m, &a.limits, prescribed),
+            wheels,
+            thrusters,
+            tanks: a.tanks,
+            wet,
+            uses_fext,
+        })
     }
 
     /// Number of tanks (extra integrated states: the propellant left in each).
