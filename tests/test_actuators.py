@@ -456,3 +456,39 @@ def test_propellant_and_base_parameters_survive_the_trajectory_files(tmp_path):
     plain = ff.simulate(m, m.neutral(), np.zeros(6), 0.1, 0.01)
     plain.to_parquet(tmp_path / "plain.parquet")
     assert ff.Trajectory.from_parquet(tmp_path / "plain.parquet").propellant is None
+
+
+def test_actuator_keys_and_wheel_defaults_have_one_source():
+    """The engine (`Wheel::new`, the binding's key lists) is the one source: the Python classes and the scenario
+    schema take their wheel defaults and keys from it, and all three agree."""
+    from dataclasses import fields
+
+    from freefloat import _core
+    from freefloat.io import scenario_schemas as ss
+
+    f = _core.actuator_fields()
+    assert f["actuators"] == ["limits", "wheels", "thrusters", "tanks"]
+    assert set(f["actuators"]) == {x.name for x in fields(ff.Actuators)} == set(ss.ActuatorsBlock.model_fields)
+    for key, cls, block in [
+        ("limits", ff.JointLimit, ss.ActLimit),
+        ("wheels", ff.Wheel, ss.ActWheel),
+        ("thrusters", ff.Thruster, ss.ActThruster),
+        ("tanks", ff.Tank, ss.ActTank),
+    ]:
+        assert set(f[key]["keys"]) == {x.name for x in fields(cls)} == set(block.model_fields), key
+    wd = f["wheels"]["defaults"]
+    assert set(wd) == set(f["wheels"]["keys"]) - {"joint"}  # every setting has its engine default
+    for k, v in wd.items():
+        assert getattr(ff.Wheel("rw"), k) == v, k
+        assert ss.ActWheel.model_fields[k].default == v, k
+    # Basilisk's default limit-cycle speed (ReactionWheelStateEffector, 1e-4 rad/s), the documented value
+    assert wd["limit_cycle_speed"] == 1e-4
+    # a wheel given without a setting runs with the engine's default: the same run as with it written out
+    m = hub_wheel()
+    v0 = np.zeros(m.nv)
+    v0[6] = 5e-5  # inside the limit-cycle band, where the default matters
+    a = {"wheels": [{"joint": "rw", "coulomb": 1e-3}]}
+    b = {"wheels": [{"joint": "rw", "coulomb": 1e-3, "limit_cycle_speed": wd["limit_cycle_speed"]}]}
+    ta = ff.simulate(m, m.neutral(), v0, 0.01, 1e-3, actuators=a)
+    tb = ff.simulate(m, m.neutral(), v0, 0.01, 1e-3, actuators=b)
+    np.testing.assert_array_equal(ta.v, tb.v)

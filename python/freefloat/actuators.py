@@ -131,7 +131,8 @@ class Actuators:
     @classmethod
     def from_dict(cls, d, where: str = "actuators") -> Actuators:
         """Read an `actuators:` mapping (from a scenario or YAML file): lists `limits`, `wheels`, `thrusters`,
-        `tanks` of mappings with the fields of JointLimit, Wheel, Thruster, Tank. Unknown keys are errors naming them."""
+        `tanks` of mappings with the fields of JointLimit, Wheel, Thruster, Tank. Unknown keys are errors naming
+        them."""
         allowed = ", ".join(FIELDS["actuators"])
         if not isinstance(d, dict):
             raise InputError(f"{where}: expected a mapping with {allowed}, got {type(d).__name__}")
