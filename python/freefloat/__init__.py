@@ -61,6 +61,8 @@ from .identification import (
 from .io import Telemetry, telemetry
 from .model import Model
 from .simulation import Trajectory, simulate
+from .simulation_scenario import load as load_simulation_scenario
+from .simulation_scenario import run as run_simulation_scenario
 
 __version__ = "0.1.0"
 
@@ -84,6 +86,8 @@ __all__ = [
     "reactions",
     "simulate",
     "simulate_many",
+    "load_simulation_scenario",
+    "run_simulation_scenario",
     "torque_table",
     "Trajectories",
     "telemetry",

@@ -107,7 +107,9 @@ def simulate_cmd(
     out,
     max_memory,
 ):
-    """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation.
+    """Simulate MODEL (a built-in name or a .yaml/.urdf file) and report conservation. MODEL may also be a
+    scenario file of `kind: simulate` (robot, duration, dt, initial state, torques and the `actuators:`,
+    `environment:`, `sensors:` blocks; see docs/scenarios.md): its keys then replace the options.
 
     The robot floats freely; joints are driven by --torques. The summary gives the drift of total
     linear and angular momentum (conserved with internal torques only) and the difference between
@@ -115,6 +117,8 @@ def simulate_cmd(
 
     Ctrl-C stops the run within a fraction of a second; with --out the part simulated so far is written
     (and results.json says the run was interrupted)."""
+    if _is_simulate_scenario(model):
+        return _run_scenario(click.get_current_context(), model, out)
     m = load_model(model, base)
     _check_base(click.get_current_context(), model, base, m)
     q = parse_vector(q0, m.nq, "--q0", m.neutral())
@@ -164,6 +168,92 @@ def simulate_cmd(
         click.echo(f"warning: {warn}", err=True)
         s["integration_warning"] = warn
     write_outputs(traj, s, out, "trajectory", f"{m.name}: conservation")
+
+
+def _is_simulate_scenario(spec: str) -> bool:
+    """A YAML file whose top-level `kind` is `simulate`, or a built-in scenario of that kind."""
+    import yaml
+
+    from ..io import data
+
+    p = Path(spec)
+    if not p.suffix:
+        return not models_is_builtin(spec) and data.exists("scenarios", spec)
+    if p.suffix.lower() not in (".yaml", ".yml") or not p.is_file():
+        return False
+    try:
+        d = yaml.safe_load(p.read_text(encoding="utf-8"))
+    except (yaml.YAMLError, UnicodeDecodeError):
+        return False  # the model reader says what is wrong
+    return isinstance(d, dict) and d.get("kind") == "simulate"
+
+
+def models_is_builtin(name: str) -> bool:
+    from .. import models
+
+    return models.is_builtin(name)
+
+
+# the options a scenario file replaces: given with one, they are an error rather than silently overridden
+_SCENARIO_KEYS = {
+    "base": "model",
+    "t_final": "duration",
+    "dt": "dt",
+    "method": "method",
+    "rtol": "rtol",
+    "atol": "atol",
+    "torques": "torques",
+    "amplitude": "torques",
+    "q0": "initial.q",
+    "v0": "initial.v",
+    "record_every": "record_every",
+    "formulation": "formulation",
+    "actuators_file": "actuators",
+    "input_timing": "input_timing",
+    "environment_file": "environment",
+}
+
+
+def _run_scenario(ctx, spec: str, out) -> None:
+    from ..simulation_scenario import load, run
+
+    for opt, key in _SCENARIO_KEYS.items():
+        if ctx.get_parameter_source(opt) not in (None, click.core.ParameterSource.DEFAULT):
+            flag = "--" + opt.replace("_file", "").replace("_", "-")
+            raise click.BadParameter(
+                f"{spec} is a simulate scenario: set '{key}' in the file instead of {flag}", param_hint=flag
+            )
+    sc = load(spec)
+    if out:
+        pq, _, _ = out_paths(out, "trajectory")
+        if pq.suffix.lower() != ".csv":
+            import pyarrow.parquet  # noqa: F401
+    t0 = time.perf_counter()
+    try:
+        r = run(sc, progress=True, max_steps=2**62)
+    except Interrupted as e:
+        _save_partial(e, sc.model, out, time.perf_counter() - t0)
+        sys.exit(130)
+    traj = r.trajectory
+    s = summarize(traj, time.perf_counter() - t0)
+    s["model"] = sc.model.name
+    s["scenario"] = sc.name
+    print_summary(f"{sc.name} ({sc.model.name}): {sc.duration} s, {sc.method}, {sc.formulation}", s)
+    warn = traj.integration_warning()
+    if warn:
+        click.echo(f"warning: {warn}", err=True)
+        s["integration_warning"] = warn
+    if r.measurement is not None:
+        s["measurement"] = r.measurement.summary()
+        for name, st in r.measurement.streams.items():
+            click.echo(f"  sensor {name:16s} {1.0 / st.period:10.6g} Hz  {len(st.t):8d} samples")
+    write_outputs(traj, s, out, "trajectory", f"{sc.name}: conservation")
+    if r.measurement is not None and out:
+        # beside the trajectory, in a folder of its own (the measurement writes its own results.json)
+        pq, _, _ = out_paths(out, "trajectory")
+        tel_dir = pq.parent / "telemetry" if pq.parent == Path(out) else pq.parent / (pq.stem + "_telemetry")
+        written = r.measurement.write(tel_dir)
+        click.echo(f"  wrote {', '.join(map(str, written))}")
 
 
 def read_actuators(path):

@@ -27,6 +27,7 @@ KINDS = {
     "control_adaptive": "freefloat control adaptive",
     "identify_cl": "freefloat identify cl",
     "control_ddp": "freefloat control ddp",
+    "simulate": "freefloat simulate",
 }
 DEFAULT_KIND = "postcapture"
 

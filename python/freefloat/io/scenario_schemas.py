@@ -28,6 +28,7 @@ from .schema import (
     literal,
     number,
     numbers,
+    refuse_block,
     register_block,
     register_kind,
 )
@@ -286,6 +287,49 @@ class ControlDdp(_Scenario):
     mpc: dict | None = None
 
 
+# -- simulate (freefloat simulate SCENARIO.yaml): a model, its initial state, torques, and the blocks below ------
+class SimInitial(Block):
+    q: Numbers = None
+    v: Numbers = None
+
+
+class SimTorques(Block):
+    # joint name -> generalized force held through the run [N m or N]; the names are checked against the robot
+    constant: dict[str, Number] | None = None
+
+
+class Simulate(_Scenario):
+    kind: literal("simulate")
+    model: Text
+    duration: Positive
+    dt: Positive = 1e-3
+    method: literal("rk4", "rk45") = "rk4"
+    rtol: number(lo=0.0, hi=1.0, lo_open=True, hi_open=True) = 1e-9
+    atol: Positive = 1e-12
+    record_every: integer(lo=1) = 1
+    formulation: literal("aba", "dq") = "aba"
+    input_timing: literal("step", "stage") = "step"
+    initial: SimInitial | None = None
+    torques: SimTorques | None = None
+    seed: integer(lo=0) = 0
+
+    @model_validator(mode="after")
+    def _timing(self):
+        if _TYPES_ONLY.get():
+            return self
+        sensors = getattr(self, "sensors", None)
+        check_sensor_names(sensors)
+        # the sensors sample the recorded run: one sample every record_every steps of dt
+        check_sensor_rates(sensors, self.dt * self.record_every, "dt × record_every")
+        steps = self.duration / self.dt
+        if steps > MAX_STEPS:
+            raise _Bad(
+                f"key 'duration': {self.duration:g} s at dt = {self.dt:g} s is {steps:.3g} steps, above the limit "
+                f"of {MAX_STEPS:.0e} (shorten duration or lengthen dt)"
+            )
+        return self
+
+
 # -- campaign specs (freefloat campaign) --------------------------------------------------------------------
 class MonteCarlo(Block):
     runs: integer(lo=1)
@@ -308,6 +352,7 @@ register_kind("postcapture", Postcapture)
 register_kind("control_adaptive", ControlAdaptive)
 register_kind("identify_cl", IdentifyCl)
 register_kind("control_ddp", ControlDdp)
+register_kind("simulate", Simulate)
 register_kind("campaign", Campaign)
 
 
@@ -607,7 +652,27 @@ def check_sensor_rates(sensors, dt: float, run_key: str = "dt") -> None:
             )
 
 
-register_block("actuators", ActuatorsBlock, kinds=("postcapture",))
-register_block("environment", EnvironmentBlock, kinds=("postcapture",))
-register_block("sensors", list[Sensor], kinds=("postcapture",))
-register_block("telemetry", TelemetryBlock, kinds=("postcapture",))
+# The kinds whose runner simulates the robot with the engine's simulator, and so applies these blocks. The other
+# kinds refuse them with a message that says so (`schema.refuse_block`): control_adaptive integrates its own
+# rigid-body dual-quaternion model, identify_cl its own estimator loop, control_ddp optimises over its own
+# dynamics; none of them would pass a block to the simulator, and a block silently ignored is worse than none.
+BLOCK_KINDS = ("postcapture", "simulate")
+_NOT_APPLIED = {
+    "control_adaptive": "its runner integrates its own rigid-body model (Valverde 2018 ch. 4), not the simulator",
+    "identify_cl": "its runner drives the concurrent-learning estimator's own loop (Valverde 2018 ch. 9), not the "
+    "simulator",
+    "control_ddp": "its runner optimises over its own dynamics (Valverde 2018 ch. 8)",
+}
+for _name, _block in (
+    ("actuators", ActuatorsBlock),
+    ("environment", EnvironmentBlock),
+    ("sensors", list[Sensor]),
+    ("telemetry", TelemetryBlock),
+):
+    register_block(_name, _block, kinds=BLOCK_KINDS)
+    for _kind, _why in _NOT_APPLIED.items():
+        refuse_block(
+            _name,
+            _kind,
+            f"a {_kind} scenario cannot apply it: {_why}; the kinds that apply it: " + ", ".join(BLOCK_KINDS),
+        )

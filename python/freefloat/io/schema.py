@@ -205,6 +205,15 @@ def register_block(name: str, model: type[BaseModel], kinds: tuple[str, ...]) ->
     _BUILT.clear()
 
 
+_REFUSED: dict[tuple[str, str], str] = {}
+
+
+def refuse_block(name: str, kind: str, why: str) -> None:
+    """A block that files of `kind` may not have, with the reason told to the user (rather than the plain
+    "unknown key"): a block registered for other kinds whose runner this kind's command does not use."""
+    _REFUSED[(name, kind)] = why
+
+
 def kinds() -> list[str]:
     return list(_KINDS)
 
@@ -322,6 +331,8 @@ def _message(kind: str, d: dict, err: dict, source: str, root) -> str:
     line = f" line {where_node.start_mark.line + 1}:" if where_node is not None else ""
     if typ == "extra_forbidden":
         key = path[-1]
+        if len(path) == 1 and (key, kind) in _REFUSED:
+            return f"{source}:{line} key '{key}': {_REFUSED[(key, kind)]}"
         valid = fields_of(kind, path[:-1], d)
         close = difflib.get_close_matches(str(key), valid, n=1, cutoff=0.6)
         if close:

@@ -1,0 +1,195 @@
+"""Scenario files of kind `simulate`: a robot, its initial state and torques, and the spacecraft blocks
+(`actuators:`, `environment:`, `sensors:`/`telemetry:`), run by `freefloat simulate SCENARIO.yaml` or from Python:
+
+    import freefloat as ff
+    sc = ff.load_simulation_scenario("hub_wheels.yaml")
+    run = ff.run_simulation_scenario(sc)
+    run.trajectory, run.measurement   # the Trajectory; the sensors' Measurement (None without sensors)
+
+A file:
+
+    kind: simulate
+    model: hub_wheels.yaml            # a built-in robot, or a model file (relative to this file)
+    duration: 30.0
+    dt: 0.001
+    initial: {q: [...], v: [...]}     # nq and nv numbers (default: neutral, at rest)
+    torques: {constant: {rw1: 0.1}}   # joint name -> generalized force held through the run
+    actuators: {...}                  # the blocks of docs/actuators.md, docs/environment.md, docs/sensors.md
+    environment: {...}
+    sensors: [...]
+
+The blocks are the same mappings as `freefloat simulate MODEL --actuators/--environment FILE` and `freefloat
+measure --sensors FILE` read, handed to the same engine calls: nothing here computes physics.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ._core import InputError
+from .model import Model
+
+
+@dataclass
+class SimulationScenario:
+    """A `kind: simulate` scenario, read and checked against its robot."""
+
+    name: str
+    description: str
+    model: Model
+    duration: float
+    dt: float
+    method: str
+    rtol: float
+    atol: float
+    record_every: int
+    formulation: str
+    input_timing: str
+    q0: np.ndarray
+    v0: np.ndarray
+    #: (1, nv) generalized forces held from t = 0, or None
+    torques: np.ndarray | None
+    #: the `actuators:` block as the engine reads it (freefloat.Actuators.to_dict()), or None
+    actuators: dict | None
+    environment: object
+    sensors: object
+    seed: int
+    source: str
+
+
+@dataclass
+class SimulationRun:
+    scenario: SimulationScenario
+    trajectory: object
+    #: the sensors' Measurement (freefloat.sensors.measure), or None without a `sensors:` block
+    measurement: object = None
+
+
+def _model(spec: str, source: str, base_dir: Path | None) -> Model:
+    from . import models
+
+    p = Path(spec)
+    if not p.suffix and models.is_builtin(spec):
+        return models.load(spec)
+    if base_dir is not None and not p.is_absolute() and (base_dir / p).is_file():
+        p = base_dir / p
+    if not p.is_file():
+        raise InputError(
+            f"{source}: key 'model': '{spec}' is neither a built-in robot ({', '.join(models.names())}) nor a model "
+            "file (paths are relative to the scenario file)"
+        )
+    suffix = p.suffix.lower()
+    if suffix in (".yaml", ".yml"):
+        return Model.from_yaml(p)
+    if suffix == ".urdf":
+        return Model.from_urdf(p)
+    if suffix in (".xml", ".mjcf"):
+        return Model.from_mjcf(p)
+    raise InputError(f"{source}: key 'model': '{spec}' is not a .yaml, .urdf or .xml (MJCF) model file")
+
+
+def _vector(x, n: int, key: str, source: str, default: np.ndarray) -> np.ndarray:
+    if x is None:
+        return default
+    a = np.asarray(x, float)
+    if a.shape != (n,):
+        raise InputError(f"{source}: key '{key}': expected {n} numbers for this robot, got {a.size}")
+    return a
+
+
+def load(spec) -> SimulationScenario:
+    """Read a `kind: simulate` scenario (a file path or a built-in name), checked against its schema and then,
+    by the engine, against its robot (joint names, tank masses, sensor joints): every error names the file,
+    line and key."""
+    from .io import scenario_files
+    from .postcapture.scenario import _blocks
+
+    d, source = scenario_files.read(spec, kind="simulate")
+    p = Path(spec)
+    base_dir = p.parent if p.suffix and p.is_file() else None
+    m = _model(d["model"], source, base_dir)
+    init = d.get("initial") or {}
+    q0 = _vector(init.get("q"), m.nq, "initial.q", source, m.neutral())
+    v0 = _vector(init.get("v"), m.nv, "initial.v", source, np.zeros(m.nv))
+    tau = None
+    const = (d.get("torques") or {}).get("constant")
+    if const:
+        tau = np.zeros((1, m.nv))
+        for name, value in const.items():
+            if name not in m.joint_names[1:]:
+                raise scenario_files.error_at(
+                    source,
+                    InputError(
+                        f"torques.constant: the robot '{m.name}' has no joint '{name}' (joints: "
+                        f"{', '.join(m.joint_names[1:])})"
+                    ),
+                )
+            j = m.joint_names.index(name)
+            k, nv = m.idx_v[j], m.nvs[j]
+            if nv != 1:
+                raise scenario_files.error_at(
+                    source, InputError(f"torques.constant: joint '{name}' has {nv} coordinates, not one")
+                )
+            tau[0, k] = float(value)
+    acts, env, sset = _blocks(d, source, m)
+    return SimulationScenario(
+        name=str(d.get("name", p.stem if p.suffix else spec)),
+        description=str(d.get("description", "")).strip(),
+        model=m,
+        duration=float(d["duration"]),
+        dt=float(d.get("dt", 1e-3)),
+        method=d.get("method", "rk4"),
+        rtol=float(d.get("rtol", 1e-9)),
+        atol=float(d.get("atol", 1e-12)),
+        record_every=int(d.get("record_every", 1)),
+        formulation=d.get("formulation", "aba"),
+        input_timing=d.get("input_timing", "step"),
+        q0=q0,
+        v0=v0,
+        torques=tau,
+        actuators=acts,
+        environment=env,
+        sensors=sset,
+        seed=int(d.get("seed", 0)),
+        source=source,
+    )
+
+
+def run(sc: SimulationScenario | str | Path, progress=False, max_steps: int | None = None) -> SimulationRun:
+    """Simulate the scenario (freefloat.simulate with its actuators and environment) and, with sensors, measure
+    the run (freefloat.sensors.measure with the scenario's seed)."""
+    from . import sensors as sn
+    from .simulation import simulate
+
+    if not isinstance(sc, SimulationScenario):
+        sc = load(sc)
+    kw = {}
+    if sc.torques is not None:
+        kw.update(torques=sc.torques, torque_times=np.array([0.0]), hold="zoh")
+    if max_steps is not None:
+        kw["max_steps"] = max_steps
+    traj = simulate(
+        sc.model,
+        sc.q0,
+        sc.v0,
+        sc.duration,
+        sc.dt,
+        method=sc.method,
+        rtol=sc.rtol,
+        atol=sc.atol,
+        record_every=sc.record_every,
+        formulation=sc.formulation,
+        input_timing=sc.input_timing,
+        actuators=sc.actuators,
+        environment=sc.environment,
+        progress=progress,
+        **kw,
+    )
+    meas = sn.measure(sc.model, traj, sc.sensors, seed=sc.seed) if sc.sensors is not None else None
+    return SimulationRun(sc, traj, meas)
+
+
+__all__ = ["SimulationRun", "SimulationScenario", "load", "run"]
