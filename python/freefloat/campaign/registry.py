@@ -92,6 +92,8 @@ _PC_OPTIONAL = [
     "measurement",
     "measurement.accelerations",
     "measurement.impulses",
+    "measurement.savgol_window",
+    "measurement.savgol_polyorder",
     "identification.project",
     "identification.forgetting",
     "identification.P0",

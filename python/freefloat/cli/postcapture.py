@@ -44,9 +44,10 @@ from .._core import Interrupted
 )
 @click.option(
     "--accelerations",
-    type=click.Choice(["exact", "central_difference"]),
-    help="Accelerations for the force form: exact at the samples (default) "
-    "or central differences of the sampled velocities.",
+    type=click.Choice(["exact", "central_difference", "savgol"]),
+    help="Accelerations for the force form: exact at the samples (default), central differences of the sampled "
+    "velocities, or their Savitzky-Golay derivative (measurement.savgol_window, savgol_polyorder in the scenario; "
+    "default a cubic over 21 samples).",
 )
 @click.option(
     "--impulses",

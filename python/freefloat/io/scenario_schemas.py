@@ -97,8 +97,30 @@ class PcIdentification(Block):
 
 
 class PcMeasurement(Block):
-    accelerations: literal("exact", "central_difference") = "exact"
+    accelerations: literal("exact", "central_difference", "savgol") = "exact"
     impulses: literal("simpson", "trapezoid") = "simpson"
+    # Savitzky-Golay derivative (accelerations: savgol): window in samples of the differentiated rates (the
+    # telemetry's with sensors, else one every sample_period), odd; polynomial degree below it
+    savgol_window: integer(lo=3) = None
+    savgol_polyorder: integer(lo=1) = None
+
+    @model_validator(mode="after")
+    def _savgol(self):
+        if _TYPES_ONLY.get():
+            return self
+        given = [k for k in ("savgol_window", "savgol_polyorder") if getattr(self, k) is not None]
+        if given and self.accelerations != "savgol":
+            raise _Bad(
+                f"key 'measurement.{given[0]}': applies to accelerations: savgol only (accelerations is "
+                f"'{self.accelerations}')"
+            )
+        w = self.savgol_window
+        if w is not None and w % 2 == 0:
+            raise _Bad(f"key 'measurement.savgol_window': must be an odd number of samples, got {w}")
+        p = self.savgol_polyorder
+        if p is not None and w is not None and p >= w:
+            raise _Bad(f"key 'measurement.savgol_polyorder': {p} must be below savgol_window = {w}")
+        return self
 
 
 class PcNoise(Block):
