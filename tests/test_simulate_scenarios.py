@@ -202,3 +202,26 @@ def test_ddp_scenarios_refuse_the_blocks(tmp_path):
     p.write_text(data.read_text("scenarios", "valverde_ch8_stabilisation") + "actuators:\n  wheels: []\n")
     with pytest.raises(InputError, match="a control_ddp scenario cannot apply it"):
         scenario_files.read(p, kind="control_ddp")
+
+
+def test_the_built_in_simulate_scenario_runs_from_the_command_line(tmp_path):
+    """`freefloat simulate valverde_ch5_leo`: the shoulder's drive limits hold (0.2 N m asked, 0.05 given; no push
+    past 0.05 rad/s), the sensors' telemetry is written, and the orbit's torques are external (the angular
+    momentum changes) while the tidal force on the system is second order (the linear momentum barely moves)."""
+    out = tmp_path / "leo"
+    r = subprocess.run(
+        [sys.executable, "-m", "freefloat.cli", "simulate", "valverde_ch5_leo", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 0, r.stderr
+    tr = ff.Trajectory.from_parquet(out / "trajectory.parquet")
+    m = models.load("valverde_ch5_single_arm")
+    k = m.idx_v[m.joint_names.index("J0")]
+    assert np.abs(tr.tau[:, k]).max() == 0.05
+    assert tr.v[-1, k] == pytest.approx(0.05, abs=0.01)  # pushed up to the limit, then only passive motion
+    assert (out / "telemetry" / "sensor_gyro.csv").is_file() and (out / "telemetry" / "sensor_encoder.csv").is_file()
+    res = json.loads((out / "results.json").read_text())
+    assert res["scenario"] == "valverde_ch5_leo" and "measurement" in res
+    assert res["momentum_drift_angular_abs"] > 1e-6 and res["momentum_drift_linear_rel"] < 1e-6

@@ -367,6 +367,12 @@ a base-frame displacement and a base-frame rotation vector, the axes of the base
 (Pinocchio's convention, so they compare with pin.computeABADerivatives). da_dtau = M⁻¹.
     """
 
+def actuator_fields() -> Any:
+    """`actuator_fields()`: `{"actuators": [keys], "limits"/"wheels"/"thrusters"/"tanks": {"keys": [...],
+"defaults": {...}}}`: the keys `parse_actuators` accepts and, for wheels, the engine's defaults
+(`Wheel::new`; `None`: no limit). The one source the Python classes and the scenario schema read.
+    """
+
 def adaptive_simulate(truth: ArrayLike, q0: ArrayLike, w0: ArrayLike, estimate0: ArrayLike, k_r: ArrayLike, k_q: ArrayLike, k_v: ArrayLike, k_w: ArrayLike, k_i: ArrayLike, alpha: float, t_final: float, learning: ArrayLike = 'continuous', n_s: ArrayLike = 50, sigma_stop: ArrayLike = Ellipsis, selection: ArrayLike = 'elementwise', seed: ArrayLike = 0, law_form: ArrayLike = 'corrected', reference_angular: ArrayLike | None = None, reference_linear: ArrayLike | None = None, reference_times: ArrayLike | None = None, reference_twists: ArrayLike | None = None, method: str = 'dopri5', dt: float = 0.01, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = Ellipsis, output_dt: ArrayLike = 0.01, max_steps: int = 50000000, rank_tol: ArrayLike = 1e-08, progress: Callable[[float], Any] | None = None) -> Any:
     """Simulate the closed loop of Valverde 2018 ch. 4 (relative pose-error dynamics (2.58) of a spacecraft with
 mass properties `truth`, adaptive law (4.9) corrected, update law (4.13) or (4.29)) in the engine, and
