@@ -120,3 +120,53 @@ pub(crate) fn apply(limits: &[Limit], v: &[f64], cmd: &mut [f64]) {
         cmd[l.k] = if w.abs() >= l.velocity && u * w > 0.0 { 0.0 } else { u };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::yaml::from_yaml_str;
+
+    fn hub_wheel(limits: &str) -> Model {
+        let text = format!(
+            "name: hw\nbase: free\ngravity: [0, 0, 0]\nbodies:\n  - name: hub\n    inertial: {{mass: 10.0, com: [0, 0, \
+             0], inertia: [2.0, 2.0, 2.0]}}\n  - name: rotor\n    parent: hub\n    joint: {{name: rw, type: revolute, \
+             axis: [0, 0, 1]{limits}}}\n    origin: {{xyz: [0, 0, 0], rpy: [0, 0, 0]}}\n    inertial: {{mass: 1.0, com: \
+             [0, 0, 0], inertia: [0.06, 0.06, 0.1]}}\n"
+        );
+        from_yaml_str(&text, "test").unwrap()
+    }
+
+    #[test]
+    fn override_replaces_each_quantity_given_and_keeps_the_others() {
+        let m = hub_wheel(", limits: {effort: 0.05, velocity: 1.0}");
+        let free = vec![false; m.nbodies()];
+        let o = [JointLimit { joint: 1, effort: Some(0.08), velocity: None }];
+        check(&m, &o, &free).unwrap();
+        let l = collect(&m, &o, &free);
+        assert_eq!(l.len(), 1);
+        assert_eq!((l[0].k, l[0].effort, l[0].velocity), (6, 0.08, 1.0));
+        // a model without limits gets the override alone
+        let m = hub_wheel("");
+        assert!(collect(&m, &[], &free).is_empty());
+        let l = collect(&m, &[JointLimit { joint: 1, effort: None, velocity: Some(0.5) }], &free);
+        assert_eq!((l[0].effort, l[0].velocity), (f64::INFINITY, 0.5));
+    }
+
+    #[test]
+    fn bad_overrides_name_the_entry() {
+        let m = hub_wheel("");
+        let free = vec![false; m.nbodies()];
+        let msg = |o: &[JointLimit]| format!("{}", check(&m, o, &free).unwrap_err());
+        let l = |joint, effort, velocity| JointLimit { joint, effort, velocity };
+        assert!(msg(&[l(0, Some(1.0), None)]).contains("actuators.limits[0].joint"));
+        assert!(msg(&[l(7, Some(1.0), None)]).contains("actuators.limits[0].joint"));
+        assert!(msg(&[l(1, Some(-1.0), None)]).contains("actuators.limits[0].effort"));
+        assert!(msg(&[l(1, None, Some(f64::NAN))]).contains("actuators.limits[0].velocity"));
+        assert!(msg(&[l(1, Some(0.0), None)]).contains("positive"));
+        assert!(msg(&[l(1, None, None)]).contains("both"));
+        let two = msg(&[l(1, Some(1.0), None), l(1, None, Some(1.0))]);
+        assert!(two.contains("actuators.limits[1].joint") && two.contains("twice"), "{two}");
+        let presc = vec![false, true];
+        assert!(format!("{}", check(&m, &[l(1, Some(1.0), None)], &presc).unwrap_err()).contains("prescribed"));
+    }
+}
