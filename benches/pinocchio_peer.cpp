@@ -202,6 +202,8 @@ int main() {
           }
           o.write(reinterpret_cast<const char *>(r.data()), sizeof(double) * r.size());
         }
+        o.close();  // flushed before the answer, which the driver takes as "the file is complete"
+        if (!o) throw std::runtime_error("cannot write " + out);
         std::cout << "ok" << std::endl;
       } else {
         throw std::runtime_error("unknown command: " + line);
