@@ -3,7 +3,7 @@ use crate::data::Data;
 use crate::error::Result;
 use crate::kinematics::{joint_placement, world_subspace_column};
 use crate::model::{JointType, Model};
-use crate::spatial::{principal_axis, rotate_about_principal_axis, Motion, Se3, V3};
+use crate::spatial::{rotate_about_principal_axis, Motion, Se3, V3};
 
 /// Joint-space inertia matrix by the composite-rigid-body algorithm, into `d.mass_matrix` (full,
 /// symmetric). Works in inertial-frame coordinates: composite inertias of subtrees add without a
@@ -40,15 +40,15 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
         d.mass_matrix = nalgebra::DMatrix::zeros(nv, nv);
     }
     let free_root = n > 0 && m.joint_types[0] == JointType::Free;
+    let principal = m.principal_revolute();
     for i in 0..n {
-        let jt = m.joint_types[i];
         if i == 0 && free_root {
             d.o_mi[0] = Se3::identity();
             d.ic[0] = m.inertias[0];
             continue;
         }
         // revolute joints about a principal axis of their frame: the rotation and subspace products specialised
-        let k = if jt == JointType::Revolute { principal_axis(&m.axes[i]) } else { None };
+        let k = principal[i];
         let li = match k {
             Some(k) => {
                 let p = &m.placements[i];

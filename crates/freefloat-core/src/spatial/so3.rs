@@ -122,11 +122,20 @@ pub fn principal_axis(axis: &V3) -> Option<usize> {
 #[inline(always)]
 pub fn rotate_about_principal_axis(r: &M3, k: usize, angle: f64) -> M3 {
     let (s, c) = angle.sin_cos();
-    let (a, b) = ((k + 1) % 3, (k + 2) % 3);
-    let (ca, cb) = (r.column(a).into_owned(), r.column(b).into_owned());
+    // one monomorphised body per axis: the column indices are constants, not run-time arithmetic
+    match k {
+        0 => mix_columns::<1, 2>(r, s, c),
+        1 => mix_columns::<2, 0>(r, s, c),
+        _ => mix_columns::<0, 1>(r, s, c),
+    }
+}
+
+#[inline(always)]
+fn mix_columns<const A: usize, const B: usize>(r: &M3, s: f64, c: f64) -> M3 {
+    let (ca, cb) = (r.column(A).into_owned(), r.column(B).into_owned());
     let mut out = *r;
-    out.set_column(a, &(ca * c + cb * s));
-    out.set_column(b, &(cb * c - ca * s));
+    out.set_column(A, &(ca * c + cb * s));
+    out.set_column(B, &(cb * c - ca * s));
     out
 }
 
