@@ -6,9 +6,10 @@ use crate::model::{JointType, Model};
 use crate::spatial::{rotate_about_principal_axis, Motion, Se3, V3};
 
 /// Joint-space inertia matrix by the composite-rigid-body algorithm, into `d.mass_matrix` (full,
-/// symmetric). Works in inertial-frame coordinates: composite inertias of subtrees add without a
-/// change of frame, and entry (j, i) for an ancestor j of i is `oSⱼᵀ oIcᵢ oSᵢ` with no force
-/// transport along the path.
+/// symmetric). Works in one frame for every body (the inertial frame, or the base frame under a free root):
+/// composite inertias of subtrees add without a change of frame, and entry (j, i) for an ancestor j of i is
+/// `oSⱼᵀ oIcᵢ oSᵢ` with no force transport along the path. Under a free root, `d.o_mi` is left holding
+/// placements relative to the base (see `crba_unchecked`): call `forward_kinematics` for world placements.
 /// Checks `q` and that `d` belongs to `m`.
 pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
     let fix = check_args(m, Some(d), &Args::q(q))?;
