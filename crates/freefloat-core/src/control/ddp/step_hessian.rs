@@ -53,22 +53,14 @@ impl HessianWork {
 }
 
 impl FloatingRobot {
-    /// `g = [Fx Fu]ᵀ λ` at (x ⊕ δx, u + δu), the perturbation `w.dz` = [δx; δu].
-    fn perturbed_gradient(
-        &mut self,
-        w: &mut HessianWork,
-        x: &[f64],
-        u: &[f64],
-        lambda: &[f64],
-        plus: bool,
-    ) -> Result<()> {
+    /// `g = [Fx Fu]ᵀ λ` (λ in `w.lambda`) at (x ⊕ δx, u + δu), the perturbation `w.dz` = [δx; δu].
+    fn perturbed_gradient(&mut self, w: &mut HessianWork, x: &[f64], u: &[f64], plus: bool) -> Result<()> {
         let (nv, ndx) = (self.model.nv, 2 * self.model.nv);
         self.integrate(x, &w.dz[..ndx], &mut w.xp);
         for i in 0..nv {
             w.up[i] = u[i] + w.dz[ndx + i];
         }
         self.step_jacobians(&w.xp, &w.up, &mut w.fx, &mut w.fu)?;
-        w.lambda.as_mut_slice().copy_from_slice(lambda);
         let g = if plus { &mut w.g_plus } else { &mut w.g_minus };
         g.rows_mut(0, ndx).gemv_tr(1.0, &w.fx, &w.lambda, 0.0);
         g.rows_mut(ndx, nv).gemv_tr(1.0, &w.fu, &w.lambda, 0.0);
@@ -79,13 +71,14 @@ impl FloatingRobot {
     pub fn step_hessian(&mut self, x: &[f64], u: &[f64], lambda: &[f64], out: &mut DynamicsHessian) -> Result<()> {
         let (ndx, nu) = (self.ndx(), self.nu());
         let mut w = self.hess.take().unwrap_or_else(|| HessianWork::new(self.nx(), ndx, nu));
+        w.lambda.as_mut_slice().copy_from_slice(lambda);
         let r = (|| -> Result<()> {
             for j in 0..ndx + nu {
                 w.dz.fill(0.0);
                 w.dz[j] = H;
-                self.perturbed_gradient(&mut w, x, u, lambda, true)?;
+                self.perturbed_gradient(&mut w, x, u, true)?;
                 w.dz[j] = -H;
-                self.perturbed_gradient(&mut w, x, u, lambda, false)?;
+                self.perturbed_gradient(&mut w, x, u, false)?;
                 for i in 0..ndx + nu {
                     w.h[(i, j)] = (w.g_plus[i] - w.g_minus[i]) / (2.0 * H);
                 }
