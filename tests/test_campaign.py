@@ -6,11 +6,13 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import signal
 import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -397,11 +399,11 @@ def test_cli_bad_input_is_one_clear_line(tmp_path):
 
 @pytest.mark.slow
 def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_continues(tmp_path):
-    # runs long enough (about 1 s each) that the campaign is still running when its first rows reach the disk
-    # (the writer flushes every 5 s): with 3 s runs a quiet machine finishes all 16 before the first flush, and
-    # the Ctrl-C lands after the campaign instead of in it
+    # Ctrl-C as soon as the progress line reports a finished run, with runs long enough (about 0.5 s each on a fast
+    # machine, 16 in all) that the campaign is surely still running then. Waiting for rows on disk instead raced:
+    # the writer flushes every 5 s, a fast machine finished all 16 runs first, and the signal hit the exiting process
     spec = json.loads(json.dumps(MEDIUM_2X8))
-    spec["set"]["duration"] = 20.0
+    spec["set"]["duration"] = 40.0
     spec_file = tmp_path / "spec.yaml"
     spec_file.write_text(yaml.safe_dump(spec))
     cmd = [
@@ -415,16 +417,21 @@ def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_continues(tmp_path)
         "--workers",
         "1",
     ]
-    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    err_chunks: list[bytes] = []
+    reader = threading.Thread(target=lambda: err_chunks.extend(iter(lambda: os.read(p.stderr.fileno(), 4096), b"")))
+    reader.start()
     deadline = time.monotonic() + 120
-    while not dataset.files(tmp_path / "o" / "runs"):  # wait until some rows are on disk
-        assert time.monotonic() < deadline and p.poll() is None, "no rows written"
-        time.sleep(0.3)
+    while not re.search(rb"done [1-9]", b"".join(err_chunks)):  # the progress bar's postfix: "done 1, failed 0"
+        assert time.monotonic() < deadline and p.poll() is None, ("no run finished", b"".join(err_chunks)[-2000:])
+        time.sleep(0.05)
     assert p.poll() is None, "the campaign finished before it could be interrupted (make its runs longer)"
     p.send_signal(signal.SIGINT)
     t_sig = time.monotonic()
-    _, err = p.communicate(timeout=60)
+    p.wait(timeout=60)
     stopped_after = time.monotonic() - t_sig
+    reader.join(timeout=10)
+    err = b"".join(err_chunks).decode(errors="replace")
     assert p.returncode == 130 and "run the same command again to continue" in err, (p.returncode, err[-2000:])
     # within a second: the local worker is killed, not waited for (a graceful shutdown took about 5 s)
     assert stopped_after < 1.0, f"the campaign exited {stopped_after:.2f} s after Ctrl-C"
