@@ -134,6 +134,78 @@ def test_cli_runs_a_simulate_scenario_and_refuses_options_it_replaces(tmp_path):
     assert r.returncode != 0 and "set 'duration' in the file" in r.stderr and "Traceback" not in r.stderr
 
 
+def test_a_steps_schedule_switches_exactly_at_its_times(tmp_path):
+    """`torques.steps`: 0 before 0.25 s, then 0.1 N m, then −0.05 N m from 0.5 s. The wheel's rate is the closed
+    form τ (1/Js + 1/I_hub,z) integrated over the pieces, to round-off: every switch falls on a step boundary and
+    acts from exactly there (the table is held per step)."""
+    text = (
+        "kind: simulate\nmodel: robot.yaml\nduration: 1.0\ndt: 0.001\n"
+        "torques:\n  steps:\n    - {t: 0.25, rw: 0.1}\n    - {t: 0.5, rw: -0.05}\n"
+    )
+    tr = ff.run_simulation_scenario(write(tmp_path, text)).trajectory
+    k = 1 / 0.1 + 1 / 2.0
+    t = tr.t
+    expected = k * (0.1 * np.clip(t - 0.25, 0, 0.25) - 0.05 * np.clip(t - 0.5, 0, None))
+    np.testing.assert_allclose(tr.v[:, 6], expected, rtol=0, atol=1e-13)
+
+
+def test_a_torque_table_replays_a_recorded_run(tmp_path):
+    """A run's trajectory file is a torque table: `torques.table` pointing at it (CSV or Parquet; its q., v.,
+    momentum... columns are ignored) reproduces the run's motion to round-off."""
+    text = (
+        "kind: simulate\nmodel: robot.yaml\nduration: 0.5\ndt: 0.001\n"
+        "torques:\n  steps:\n    - {t: 0.0, rw: 0.2}\n    - {t: 0.1, rw: -0.1}\n    - {t: 0.3, rw: 0.05}\n"
+    )
+    ref = ff.run_simulation_scenario(write(tmp_path, text)).trajectory
+    ref.to_parquet(tmp_path / "rec.parquet")
+    ref.to_csv(tmp_path / "rec.csv")
+    for f in ("rec.parquet", "rec.csv"):
+        replay = f"kind: simulate\nmodel: robot.yaml\nduration: 0.5\ndt: 0.001\ntorques: {{table: {f}}}\n"
+        tr = ff.run_simulation_scenario(write(tmp_path, replay, name=f"replay_{f}.yaml")).trajectory
+        np.testing.assert_allclose(tr.v, ref.v, rtol=0, atol=1e-14)
+        np.testing.assert_allclose(tr.q, ref.q, rtol=0, atol=1e-14)
+
+
+@pytest.mark.parametrize(
+    "torques, words",
+    [
+        ("{constant: {rw: 0.1}, table: x.csv}", "give one of constant, steps or table"),
+        ("{steps: [{t: 0.5, rw: 0.1}, {t: 0.2, rw: 0.0}]}", "later than the previous entry"),
+        ("{steps: [{rw: 0.1}]}", "needs its time t"),
+        ("{steps: [{t: 0.0, rx: 0.1}]}", "no joint 'rx'"),
+        ("{constant: {rw: 0.1}, hold: linear}", "applies to torques.table only"),
+        ("{table: missing.csv}", "not found"),
+    ],
+)
+def test_bad_torques_blocks_are_named(tmp_path, torques, words):
+    text = f"kind: simulate\nmodel: robot.yaml\nduration: 1.0\ndt: 0.001\ntorques: {torques}\n"
+    p = write(tmp_path, text)
+    with pytest.raises(InputError) as e:
+        ff.load_simulation_scenario(p)
+    msg = str(e.value)
+    assert msg.startswith(str(p)) and "torques" in msg and words in msg, msg
+
+
+@pytest.mark.parametrize(
+    "csv, words",
+    [
+        ("t,tau.rw\n0,0.1\n0.5,abc\n", "column 'tau.rw' row 1 (line 3): 'abc' is not a number"),
+        ("t,rw\n0,0.1\n", "did you mean 'tau.rw'"),
+        ("t,tau.rw\n0.1,0.1\n0.5,0\n", "must start at t = 0"),
+        ("t,tau.rw\n0,0.1\n0,0\n", "not strictly increasing at row 1"),
+        ("t,q.x\n0,0.1\n", "no tau.<coordinate> column"),
+        ("time,tau.rw\n0,0.1\n", "no column 't'"),
+    ],
+)
+def test_bad_torque_tables_are_named(tmp_path, csv, words):
+    (tmp_path / "tau.csv").write_text(csv)
+    p = write(tmp_path, "kind: simulate\nmodel: robot.yaml\nduration: 1.0\ndt: 0.001\ntorques: {table: tau.csv}\n")
+    with pytest.raises(InputError) as e:
+        ff.load_simulation_scenario(p)
+    msg = str(e.value)
+    assert "tau.csv" in msg and words in msg, msg
+
+
 @pytest.mark.parametrize(
     "block, key, words",
     [

@@ -316,8 +316,37 @@ class SimInitial(Block):
 
 
 class SimTorques(Block):
-    # joint name -> generalized force held through the run [N m or N]; the names are checked against the robot
+    # one of three forms; joint names and table columns are checked against the robot when the file is read
+    # joint name -> generalized force held through the run [N m or N]
     constant: dict[str, Number] | None = None
+    # a piecewise-constant schedule: [{t: 0.0, J0: 0.1}, {t: 2.0, J0: 0.0}, ...], each entry changing the named
+    # joints from its time t on (the others keep their value; zero before a joint's first entry)
+    steps: list[dict[str, Number]] | None = None
+    # a CSV or Parquet file (relative to the scenario file) with a column t and tau.<coordinate> columns
+    table: Text | None = None
+    hold: literal("zoh", "linear") = None
+
+    @model_validator(mode="after")
+    def _one_form(self):
+        if _TYPES_ONLY.get():
+            return self
+        given = [k for k in ("constant", "steps", "table") if getattr(self, k) is not None]
+        if len(given) > 1:
+            raise _Bad(f"key 'torques': give one of constant, steps or table, not {' and '.join(given)}")
+        if self.hold is not None and self.table is None:
+            raise _Bad("key 'torques.hold': applies to torques.table only (steps and constant are held as given)")
+        t_prev = None
+        for k, entry in enumerate(self.steps or []):
+            t = entry.get("t")
+            if t is None:
+                raise _Bad(f"key 'torques.steps[{k}]': every entry needs its time t [s], e.g. {{t: 0.0, J1: 0.1}}")
+            if not math.isfinite(t) or t < 0 or (t_prev is not None and t <= t_prev):
+                need = "at least 0" if t_prev is None else f"later than the previous entry's {t_prev:g} s"
+                raise _Bad(f"key 'torques.steps[{k}].t': {t!r} s must be finite and {need}")
+            if len(entry) < 2:
+                raise _Bad(f"key 'torques.steps[{k}]': names no joint (give joint: value pairs beside t)")
+            t_prev = t
+        return self
 
 
 class Simulate(_Scenario):

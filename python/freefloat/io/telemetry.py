@@ -149,8 +149,7 @@ class Telemetry:
         p = Path(path)
         if not p.exists():
             raise FileNotFoundError(f"telemetry file not found: {p}")
-        cols = _read_parquet(p) if p.suffix.lower() in (".parquet", ".pq") else _read_csv(p)
-        telem = _from_columns(cols, model, str(p))
+        telem = _from_columns(read_columns(p), model, str(p))
         telem.rate_noise = _read_rate_noise(p)
         return telem
 
@@ -177,6 +176,12 @@ def _read_rate_noise(p: Path):
     return None if r is None else [float(x) for x in r]
 
 
+def read_columns(p: Path) -> dict:
+    """The named float columns of a Parquet (.parquet/.pq) or CSV (anything else) file; a malformed file or a
+    value that is not a number raises InputError naming the file, column and row."""
+    return _read_parquet(p) if p.suffix.lower() in (".parquet", ".pq") else _read_csv(p)
+
+
 def _read_parquet(p: Path) -> dict:
     import pyarrow as pa
     import pyarrow.parquet as pq
@@ -185,7 +190,13 @@ def _read_parquet(p: Path) -> dict:
         table = pq.read_table(str(p))
     except (OSError, pa.ArrowException) as e:
         raise InputError(f"{p}: cannot be read as Parquet ({e})") from None
-    return {c: np.asarray(table[c].to_numpy(zero_copy_only=False), dtype=float) for c in table.column_names}
+    cols = {}
+    for c in table.column_names:
+        try:
+            cols[c] = np.asarray(table[c].to_numpy(zero_copy_only=False), dtype=float)
+        except (TypeError, ValueError):
+            raise InputError(f"{p}: column '{c}' is of type {table[c].type}, not numbers") from None
+    return cols
 
 
 def _read_csv(p: Path) -> dict:
@@ -234,7 +245,7 @@ def _from_columns(cols: dict, model, where: str) -> Telemetry:
         + ([f"momentum.{n}" for n in MOMENTUM_NAMES] if has_h else [])
         + ([f"wrench.{n}" for n in WRENCH_NAMES] if has_w else [])
     )
-    _check_finite(cols, used, where)
+    check_finite(cols, used, where)
     t = cols["t"]
     _check_time(t, where)
     return Telemetry(
@@ -258,7 +269,7 @@ def _optional_block(cols: dict, prefix: str, names: list, where: str) -> bool:
     return bool(have)
 
 
-def _check_finite(cols: dict, names: list, where: str) -> None:
+def check_finite(cols: dict, names: list, where: str) -> None:
     for c in names:
         bad = ~np.isfinite(cols[c])
         if bad.any():
