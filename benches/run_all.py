@@ -225,17 +225,26 @@ def rows_dq(res: dict) -> list[Row]:
 
 def rows_kernels(res: dict) -> list[Row]:
     targets = {"aba": "freefloat <= 0.5x (ratio >= 2)", "rnea": "<= 0.7x (ratio >= 1.43)", "crba": "<= 0.7x"}
-    peers = {"aba": "Pinocchio abaInParallel", "rnea": "Pinocchio rneaInParallel", "crba": "Pinocchio crba (C++ est.)"}
+    # row key -> (peer, words after the kernel's name); older JSON has no "peer" and only aba/rnea/crba (estimate)
+    labels = {
+        "pin abaInParallel": ("Pinocchio abaInParallel", ""),
+        "pin rneaInParallel": ("Pinocchio rneaInParallel", ""),
+        "pin crba (C++ estimate)": ("Pinocchio crba (C++ est.)", " (estimated peer)"),
+    }
     out = []
     for robot, r in res["results"].items():
         for k, v in r["rows"].items():  # freefloat time / Pinocchio's: inverted so that > 1 means faster
+            kernel = k.split("_")[0]
+            default = {"aba": "pin abaInParallel", "rnea": "pin rneaInParallel"}.get(k, "pin crba (C++ estimate)")
+            peer = v.get("peer", default)
+            name, words = labels.get(peer, ("Pinocchio C++ loop (benches/pinocchio_peer.cpp)", " (vs C++ loop)"))
             out.append(
                 Row(
-                    f"{k.upper()} per call, core to core, {robot} (nv = {r['nv']})",
-                    peers.get(k, "Pinocchio"),
+                    f"{kernel.upper()} per call{words}, core to core, {robot} (nv = {r['nv']})",
+                    name,
                     1.0 / v["median"] if v.get("median") else None,
                     _range(1.0 / v["max"], 1.0 / v["min"]) if v.get("min", 0) > 0 and v.get("max", 0) > 0 else "",
-                    target=targets.get(k, ""),
+                    target=targets.get(kernel, ""),
                     note=f"CPU-time ratio {1.0 / v['cpu_median']:.2f}" if v.get("cpu_median") else "",
                 )
             )
@@ -553,7 +562,7 @@ def speed_paragraph(sections: list[Section], git: str, fast: bool) -> str:
         parts.append(text + (f" (target {r.target})" if r.target else ""))
 
     for r in rows.get("kernels", []):
-        if "naveen" in r.what or "seed001" in r.what:
+        if ("naveen" in r.what or "seed001" in r.what) and "estimated peer" not in r.what:
             add(r, r.what.split(",")[0].replace(" per call", "") + " on the Naveen robot")
     for r in rows.get("mujoco", [])[:1]:
         add(r, "10 s 1 kHz RK4 simulation")

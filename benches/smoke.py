@@ -134,6 +134,8 @@ def _check_kernels(out: Path) -> list[str]:
     bad = []
     for robot, r in res["results"].items():
         bad += [f"{robot}: agreement {k} = {v:.3g} > 1e-9" for k, v in r["agreement_max_rel"].items() if not v <= 1e-9]
+        peer = r.get("cpp_peer_agreement_max_rel") or {}  # None when the C++ peer could not be built
+        bad += [f"{robot}: C++ peer agreement {k} = {v:.3g} > 1e-9" for k, v in peer.items() if not v <= 1e-9]
     if len(res["results"]) != 3:
         bad.append(f"expected 3 robots, got {sorted(res['results'])}")
     return bad

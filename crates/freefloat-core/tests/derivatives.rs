@@ -14,7 +14,7 @@ use freefloat_core::dynamics::derivatives::{
     Scheme,
 };
 use freefloat_core::dynamics::{aba, rnea};
-use freefloat_core::kinematics::forward_velocities;
+use freefloat_core::kinematics::{forward_kinematics, forward_velocities};
 use freefloat_core::model::{JointType, Model};
 use freefloat_core::spatial::{rpy_to_rot, Se3, V3};
 use freefloat_core::Data;
@@ -106,6 +106,19 @@ fn rnea_and_aba_derivatives_match_finite_differences() {
             );
 
             aba_derivatives(&m, &mut d, &mut w, &q, &v, &tau, fe).unwrap();
+            // It leaves world-frame kinematics in `d`, which callers (the DDP cost Jacobians) read: the CRBA it
+            // calls works relative to the base under a free root, and once left `d.o_mi` there.
+            let mut fk = Data::new(&m);
+            forward_kinematics(&m, &mut fk, &q).unwrap();
+            for (i, (x, y)) in d.o_mi.iter().zip(&fk.o_mi).enumerate() {
+                let e = (x.rot - y.rot).amax().max((x.trans - y.trans).amax());
+                assert!(
+                    e < 1e-12,
+                    "{} base {:?}: body {i} placement after aba_derivatives off by {e:.1e}",
+                    m.name,
+                    m.joint_types[0]
+                );
+            }
             let mut acc = |q: &[f64], v: &[f64], t: &[f64]| {
                 aba(&m, &mut dd, q, v, t, fe).unwrap();
                 dd.ddq.clone()

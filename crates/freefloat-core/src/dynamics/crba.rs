@@ -1,14 +1,15 @@
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
-use crate::kinematics::{forward_kinematics_unchecked, world_subspace_column};
+use crate::kinematics::{joint_placement, world_subspace_column};
 use crate::model::{JointType, Model};
-use crate::spatial::{Motion, V3};
+use crate::spatial::{rotate_about_principal_axis, Motion, Se3, V3};
 
 /// Joint-space inertia matrix by the composite-rigid-body algorithm, into `d.mass_matrix` (full,
-/// symmetric). Works in inertial-frame coordinates: composite inertias of subtrees add without a
-/// change of frame, and entry (j, i) for an ancestor j of i is `oSⱼᵀ oIcᵢ oSᵢ` with no force
-/// transport along the path.
+/// symmetric). Works in one frame for every body (the inertial frame, or the base frame under a free root):
+/// composite inertias of subtrees add without a change of frame, and entry (j, i) for an ancestor j of i is
+/// `oSⱼᵀ oIcᵢ oSᵢ` with no force transport along the path. Under a free root, `d.o_mi` is left holding
+/// placements relative to the base (see `crba_unchecked`): call `forward_kinematics` for world placements.
 /// Checks `q` and that `d` belongs to `m`.
 pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
     let fix = check_args(m, Some(d), &Args::q(q))?;
@@ -19,14 +20,19 @@ pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
 
 /// `crba` without the argument check (allocates `d.mass_matrix` infallibly if `crba` has not).
 ///
-/// One pass root to leaves (placements, each body's inertia oIᵢ and joint subspace oSᵢ in inertial coordinates),
-/// one pass leaves to root: body i's composite inertia oIcᵢ is complete when its turn comes (children have larger
+/// One pass root to leaves (placements, each body's inertia oIᵢ and joint subspace oSᵢ in one common frame), one
+/// pass leaves to root: body i's composite inertia oIcᵢ is complete when its turn comes (children have larger
 /// indices and were added already), its columns Fᵢ = oIcᵢ oSᵢ are formed once, and entry (j, i) for i and each
-/// ancestor j is oSⱼᵀ Fᵢ (Featherstone, RBDA §6.2, Table 6.2, in inertial coordinates: no force transport along
-/// the path). Leaves `d.ic` holding the composite inertias, as `world_composite_inertias` does; `d.os` is written
-/// for every joint but a free root (whose oS is the base placement itself, used directly).
+/// ancestor j is oSⱼᵀ Fᵢ (Featherstone, RBDA §6.2, Table 6.2, in one frame for all bodies: no force transport along
+/// the path).
+///
+/// The common frame is the inertial one, except under a free root, where it is the base frame: with the base
+/// twist in base coordinates, M does not depend on the base placement (kinetic energy is unchanged by a rigid
+/// motion of the whole system), so the base is put at the origin. Its inertia then needs no change of frame, the
+/// base block is oIc₀ itself and the base rows of column i are Fᵢ as they are (RBDA §6.2's floating-base remark);
+/// the base's children are placed by their joint alone. Leaves `d.o_mi`, `d.ic` (composite inertias) and `d.os`
+/// (every joint but a free root) in that common frame; under a free root `d.li_mi[0]` is not written.
 pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
-    forward_kinematics_unchecked(m, d, q);
     let n = m.nbodies();
     let nv = m.nv;
     if d.mass_matrix.shape() != (nv, nv) {
@@ -35,23 +41,58 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
         d.mass_matrix = nalgebra::DMatrix::zeros(nv, nv);
     }
     let free_root = n > 0 && m.joint_types[0] == JointType::Free;
+    let principal = m.principal_revolute();
     for i in 0..n {
-        d.ic[i] = m.inertias[i].transformed(&d.o_mi[i]);
         if i == 0 && free_root {
+            d.o_mi[0] = Se3::identity();
+            d.ic[0] = m.inertias[0];
             continue;
         }
-        for c in 0..m.nvs[i] {
-            let s = world_subspace_column(m, d, i, c);
-            d.os[i].set_column(c, &s.to_v6());
+        // revolute joints about a principal axis of their frame: the rotation and subspace products specialised
+        let k = principal[i];
+        let li = match k {
+            Some(k) => {
+                let p = &m.placements[i];
+                Se3::new(rotate_about_principal_axis(&p.rot, k, q[m.idx_q[i]]), p.trans)
+            }
+            None => joint_placement(m, d, i, q),
+        };
+        d.li_mi[i] = li;
+        let o = match m.parents[i] {
+            Some(0) if free_root => li,
+            Some(p) => d.o_mi[p].compose(&li),
+            None => li,
+        };
+        d.o_mi[i] = o;
+        d.ic[i] = m.inertias[i].transformed(&o);
+        match k {
+            // [p × R eₖ; R eₖ]: the world subspace of `world_subspace_column` with R a = column k of R
+            Some(k) => {
+                let w = o.rot.column(k).into_owned();
+                d.os[i].set_column(0, &Motion::new(o.trans.cross(&w), w).to_v6());
+            }
+            None => {
+                for c in 0..m.nvs[i] {
+                    let s = world_subspace_column(m, d, i, c);
+                    d.os[i].set_column(c, &s.to_v6());
+                }
+            }
         }
     }
     // Entries of bodies that are not on one path from the root are zero; the sweep writes all the others. Filled
     // as a slice (a memset): nalgebra's matrix `fill` compiles to a strided loop of about 12 instructions per entry,
     // a fifth of this function's instructions on `naveen_dual_arm` (callgrind).
     d.mass_matrix.as_mut_slice().fill(0.0);
-    let (os, ic, o_mi) = (&d.os, &mut d.ic, &d.o_mi);
+    let (os, ic) = (&d.os, &mut d.ic);
     let mm = d.mass_matrix.as_mut_slice();
-    assert!(mm.len() == nv * nv && m.idx_v.len() >= n && m.nvs.len() >= n && m.parents.len() >= n && os.len() >= n);
+    assert!(
+        mm.len() == nv * nv
+            && m.idx_v.len() >= n
+            && m.nvs.len() >= n
+            && m.parents.len() >= n
+            && os.len() >= n
+            && ic.len() >= n
+    );
     // Entry (r, c) and (c, r) of the column-major nv × nv matrix. SAFETY: every index below is idx_v[j] + k with
     // k < nvs[j], and the model builder guarantees idx_v[j] + nvs[j] <= nv; the matrix is nv × nv (asserted).
     let mut put = |r: usize, c: usize, x: f64| unsafe {
@@ -59,11 +100,12 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
         *mm.get_unchecked_mut(r * nv + c) = x;
     };
     for i in (0..n).rev() {
-        let ici = ic[i];
+        // SAFETY (all `get_unchecked` below): i < n and every j visited is i or an ancestor of i, so j < n (the
+        // builder orders bodies with parents[j] < j), and the per-body vectors have n entries (asserted above).
+        let ici = unsafe { *ic.get_unchecked(i) };
         if i == 0 && free_root {
-            // Base block: X₀ᵀ oIc₀ X₀ is the whole system's inertia in base coordinates, one change of frame of
-            // the composite inertia instead of six columns of 6×6 work.
-            let ib = ici.transformed(&o_mi[0].inverse()).to_matrix();
+            // Base block: oIc₀ is the whole system's inertia, already in base coordinates.
+            let ib = ici.to_matrix();
             for c in 0..6 {
                 for r in 0..6 {
                     put(r, c, ib[(r, c)]);
@@ -71,44 +113,42 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
             }
             break;
         }
-        let ci = m.idx_v[i];
-        for c in 0..m.nvs[i] {
-            let s = &os[i];
-            let f = ici.mul_motion(&Motion::new(
-                V3::new(s[(0, c)], s[(1, c)], s[(2, c)]),
-                V3::new(s[(3, c)], s[(4, c)], s[(5, c)]),
-            ));
+        let (ci, nvi, si) = unsafe { (*m.idx_v.get_unchecked(i), *m.nvs.get_unchecked(i), os.get_unchecked(i)) };
+        for c in 0..nvi {
+            let sc = si.fixed_view::<6, 1>(0, c);
+            let f = ici.mul_motion(&Motion::new(V3::new(sc[0], sc[1], sc[2]), V3::new(sc[3], sc[4], sc[5])));
             let col = ci + c;
             let mut j = i;
             loop {
                 if j == 0 && free_root {
-                    // oS₀ = X₀: X₀ᵀ f is f expressed in base coordinates (a force transform, not 6 dot products)
-                    let fb = o_mi[0].inv_act_force(&f);
+                    // oS₀ is the identity in base coordinates: the base rows are F itself
                     for r in 0..3 {
-                        put(r, col, fb.lin[r]);
-                        put(3 + r, col, fb.ang[r]);
+                        put(r, col, f.lin[r]);
+                        put(3 + r, col, f.ang[r]);
                     }
                     break;
                 }
-                let sj = &os[j];
-                let cj = m.idx_v[j];
-                for r in 0..m.nvs[j] {
-                    let x = sj[(0, r)] * f.lin.x
-                        + sj[(1, r)] * f.lin.y
-                        + sj[(2, r)] * f.lin.z
-                        + sj[(3, r)] * f.ang.x
-                        + sj[(4, r)] * f.ang.y
-                        + sj[(5, r)] * f.ang.z;
+                let (sj, cj, nvj) =
+                    unsafe { (os.get_unchecked(j), *m.idx_v.get_unchecked(j), *m.nvs.get_unchecked(j)) };
+                for r in 0..nvj {
+                    let s = sj.fixed_view::<6, 1>(0, r);
+                    let x = s[0] * f.lin.x
+                        + s[1] * f.lin.y
+                        + s[2] * f.lin.z
+                        + s[3] * f.ang.x
+                        + s[4] * f.ang.y
+                        + s[5] * f.ang.z;
                     put(cj + r, col, x);
                 }
-                match m.parents[j] {
+                match unsafe { *m.parents.get_unchecked(j) } {
                     Some(p) => j = p,
                     None => break,
                 }
             }
         }
-        if let Some(p) = m.parents[i] {
-            ic[p] = ic[p].add(&ici);
+        if let Some(p) = unsafe { *m.parents.get_unchecked(i) } {
+            let icp = unsafe { ic.get_unchecked_mut(p) };
+            *icp = icp.add(&ici);
         }
     }
 }

@@ -16,24 +16,31 @@ pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
 /// `forward_kinematics` without the argument check (`q` checked and normalised by the caller).
 pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     for i in 0..m.nbodies() {
-        let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
-        let jt = m.joint_types[i];
-        d.li_mi[i] = match jt {
-            // a rotation about the joint origin leaves the placement's translation as it is: one 3×3 product
-            JointType::Revolute => {
-                let p = &m.placements[i];
-                Se3::new(p.rot * rotation_about_axis(&m.axes[i], qi[0]), p.trans)
-            }
-            _ => m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi)),
-        };
-        if jt == JointType::Universal {
-            let s1 = universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]);
-            d.s[i].fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
-        }
+        d.li_mi[i] = joint_placement(m, d, i, q);
         d.o_mi[i] = match m.parents[i] {
             Some(p) => d.o_mi[p].compose(&d.li_mi[i]),
             None => d.li_mi[i],
         };
+    }
+}
+
+/// Placement of body i in its parent at `q` (the whole configuration), also refreshing `d.s[i]` for a universal
+/// joint: one step of `forward_kinematics`.
+#[inline(always)]
+pub(crate) fn joint_placement(m: &Model, d: &mut Data, i: usize, q: &[f64]) -> Se3 {
+    let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
+    let jt = m.joint_types[i];
+    if jt == JointType::Universal {
+        let s1 = universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]);
+        d.s[i].fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
+    }
+    match jt {
+        // a rotation about the joint origin leaves the placement's translation as it is: one 3×3 product
+        JointType::Revolute => {
+            let p = &m.placements[i];
+            Se3::new(p.rot * rotation_about_axis(&m.axes[i], qi[0]), p.trans)
+        }
+        _ => m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi)),
     }
 }
 

@@ -16,7 +16,7 @@ pub use joint::{universal_bias, universal_first_axis, JointLimits, JointType};
 pub use physics::{check_finite_nonnegative_mass, check_physical};
 
 use crate::error::{FfError, Result};
-use crate::spatial::{Inertia, Se3, M6, V3};
+use crate::spatial::{principal_axis, Inertia, Se3, M6, V3};
 
 /// A named frame rigidly attached to a body (end effector, sensor point, thruster).
 #[derive(Clone, Debug, PartialEq)]
@@ -114,6 +114,9 @@ pub struct Model {
     /// (body, offset in q) of every quaternion in q, so that the argument check and the
     /// normalisation visit only those (filled by `finalize`).
     quaternions: Vec<(usize, usize)>,
+    /// For each joint, `Some(k)` if it is revolute about the principal axis eₖ of its frame (filled by `finalize`;
+    /// CRBA's specialised products key on it).
+    principal_revolute: Vec<Option<usize>>,
 }
 
 /// A fresh model identity (process-wide counter; 0 is never handed out).
@@ -163,6 +166,7 @@ impl ModelBuilder {
             children: vec![],
             id: 0,
             quaternions: vec![],
+            principal_revolute: vec![],
         };
         Ok(ModelBuilder { model })
     }
@@ -299,6 +303,11 @@ impl Model {
         self.id
     }
 
+    /// For each joint, `Some(k)` if it is revolute about exactly eₖ of its own frame (k = 0, 1, 2), else `None`.
+    pub fn principal_revolute(&self) -> &[Option<usize>] {
+        &self.principal_revolute
+    }
+
     /// (body, offset in q) of every unit quaternion in q (free base, spherical joints).
     pub fn quaternions(&self) -> &[(usize, usize)] {
         &self.quaternions
@@ -369,6 +378,9 @@ impl Model {
         self.nv = nv;
         self.quaternions =
             (0..n).filter_map(|i| self.joint_types[i].quaternion_offset().map(|k| (i, self.idx_q[i] + k))).collect();
+        self.principal_revolute = (0..n)
+            .map(|i| if self.joint_types[i] == JointType::Revolute { principal_axis(&self.axes[i]) } else { None })
+            .collect();
         self.children = vec![vec![]; n];
         for i in 1..n {
             self.children[self.parents[i].unwrap()].push(i);

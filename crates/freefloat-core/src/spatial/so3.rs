@@ -103,6 +103,42 @@ pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
     )
 }
 
+/// The k (0, 1, 2) with `axis` exactly eₖ, if there is one: revolute and prismatic joints about a principal axis
+/// (every joint of an URDF arm written the usual way) take the specialised products below.
+#[inline(always)]
+pub fn principal_axis(axis: &V3) -> Option<usize> {
+    match (axis.x, axis.y, axis.z) {
+        (x, y, z) if x == 1.0 && y == 0.0 && z == 0.0 => Some(0),
+        (x, y, z) if x == 0.0 && y == 1.0 && z == 0.0 => Some(1),
+        (x, y, z) if x == 0.0 && y == 0.0 && z == 1.0 => Some(2),
+        _ => None,
+    }
+}
+
+/// `r · R(eₖ, angle)`, `R` as `rotation_about_axis`: a placement's rotation times a rotation about its own k-th
+/// axis. Column k of `r` is unchanged and the other two mix by the angle's cosine and sine (R(eₖ) maps
+/// eₐ → c eₐ + s e_b and e_b → −s eₐ + c e_b, with (k, a, b) a cyclic order): 12 products instead of
+/// Rodrigues' formula and a dense 3×3 product.
+#[inline(always)]
+pub fn rotate_about_principal_axis(r: &M3, k: usize, angle: f64) -> M3 {
+    let (s, c) = angle.sin_cos();
+    // one monomorphised body per axis: the column indices are constants, not run-time arithmetic
+    match k {
+        0 => mix_columns::<1, 2>(r, s, c),
+        1 => mix_columns::<2, 0>(r, s, c),
+        _ => mix_columns::<0, 1>(r, s, c),
+    }
+}
+
+#[inline(always)]
+fn mix_columns<const A: usize, const B: usize>(r: &M3, s: f64, c: f64) -> M3 {
+    let (ca, cb) = (r.column(A).into_owned(), r.column(B).into_owned());
+    let mut out = *r;
+    out.set_column(A, &(ca * c + cb * s));
+    out.set_column(B, &(cb * c - ca * s));
+    out
+}
+
 /// Rotation vector of a rotation matrix (inverse of the exponential), angle in [0, pi].
 pub fn so3_log(r: &M3) -> V3 {
     let q = quat_from_rot(r);

@@ -43,7 +43,8 @@ pub fn rnea_derivatives(
 /// `w.ddq` (= `aba`'s result), `w.da_dq`, `w.da_dv`, `w.minv` (= ∂a/∂τ = M⁻¹) and, on the way,
 /// `w.dtau_dq`, `w.dtau_dv` at a = FD. From differentiating `M(q) a + h(q, v) = τ` along the
 /// solution: `∂a/∂q = −M⁻¹ ∂τ/∂q`, `∂a/∂v = −M⁻¹ ∂τ/∂v` (Carpentier and Mansard 2018, eq. (9)).
-/// Checks every argument like `aba`.
+/// Leaves `d` holding forward kinematics at q in the inertial frame (as `aba` does). Checks every argument like
+/// `aba`.
 #[allow(clippy::too_many_arguments)]
 pub fn aba_derivatives(
     m: &Model,
@@ -69,13 +70,17 @@ pub(crate) fn aba_derivatives_unchecked(
     tau: &[f64],
     fext: Option<&[f64]>,
 ) -> Result<()> {
+    // CRBA first: under a free root it leaves `d.o_mi`, `d.ic` and `d.os` relative to the base (see
+    // `crba_unchecked`), and callers (the DDP cost Jacobians among them) read world-frame kinematics from `d`
+    // after this call. ABA and the derivative passes below overwrite them in the inertial frame; neither touches
+    // `d.mass_matrix`.
+    crba_unchecked(m, d, q);
     hybrid_aba_unchecked(m, d, q, v, tau, fext, None)?;
     w.ddq.copy_from_slice(&d.ddq);
     let a = std::mem::take(&mut w.ddq);
     // ABA ran forward kinematics at q already.
     rnea_derivatives_core(m, d, w, v, &a, fext);
     w.ddq = a;
-    crba_unchecked(m, d, q);
     if !cholesky_inverse(&d.mass_matrix, &mut w.chol, &mut w.minv) {
         return Err(FfError::Numerical("the mass matrix is not positive definite".into()));
     }
