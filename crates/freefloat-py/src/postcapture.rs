@@ -125,11 +125,11 @@ pub fn postcapture_simulate<'py>(
     };
     reraise_foreign(py, raised)?;
     match r? {
-        Ok(tr) => crate::simulate::traj_dict(py, &tr),
+        Ok(tr) => crate::simulate::traj_dict(py, tr),
         // the samples recorded up to the stop become `Interrupted.partial` (a dict like the full result's)
         Err(FfError::Interrupted { msg, partial }) => {
             let partial = match partial {
-                Some(Partial::Trajectory(tr)) => Some(crate::simulate::traj_dict(py, &tr)?.into_any().unbind()),
+                Some(Partial::Trajectory(tr)) => Some(crate::simulate::traj_dict(py, *tr)?.into_any().unbind()),
                 _ => None,
             };
             Err(interrupted_with(py, &msg, partial))

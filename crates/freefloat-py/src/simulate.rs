@@ -322,7 +322,7 @@ pub fn simulate<'py>(
         (s, Err(FfError::Interrupted { msg, partial })) if s.as_ref().is_none_or(|e| is_ctrl_c(py, e)) => {
             let msg = if returned_false { format!("{msg} (the progress callback returned False)") } else { msg };
             let partial = match partial {
-                Some(freefloat_core::error::Partial::Trajectory(tr)) => Some(traj_dict(py, &tr)?.into_any().unbind()),
+                Some(freefloat_core::error::Partial::Trajectory(tr)) => Some(traj_dict(py, *tr)?.into_any().unbind()),
                 _ => None,
             };
             Err(interrupted_with(py, &msg, partial))
@@ -330,11 +330,15 @@ pub fn simulate<'py>(
         (Some(e), _) => Err(e),
         (None, Err(e)) => Err(crate::errors::to_py(e)),
         (None, Ok(tr)) => {
-            let d = traj_dict(py, &tr)?;
-            if let Some(e) = env.as_ref().filter(|e| e.orbit.is_some()) {
-                // the frame origin's inertial orbit at the recorded times (the propagation the run used)
-                let orbit = guard(|| freefloat_core::environment::reference_orbit(e, &m_after, &q0, &v0, &tr.t))?;
-                d.set_item("orbit", PyArray1::from_vec(py, orbit).reshape([tr.len(), 6])?)?;
+            // the frame origin's inertial orbit at the recorded times (the propagation the run used)
+            let orbit = match env.as_ref().filter(|e| e.orbit.is_some()) {
+                Some(e) => Some(guard(|| freefloat_core::environment::reference_orbit(e, &m_after, &q0, &v0, &tr.t))?),
+                None => None,
+            };
+            let n = tr.len();
+            let d = traj_dict(py, tr)?;
+            if let Some(orbit) = orbit {
+                d.set_item("orbit", PyArray1::from_vec(py, orbit).reshape([n, 6])?)?;
             }
             Ok(d)
         }
@@ -342,21 +346,25 @@ pub fn simulate<'py>(
 }
 
 /// The trajectory as the dict of arrays the Python layer turns into a `Trajectory` (also `simulate_many`'s).
-pub(crate) fn traj_dict<'py>(py: Python<'py>, tr: &sim::Trajectory) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn traj_dict<'py>(py: Python<'py>, tr: sim::Trajectory) -> PyResult<Bound<'py, PyDict>> {
+    // The recorded vectors move into numpy (no copy): a long run's record is not held twice at the end.
     let d = PyDict::new(py);
     let n = tr.len();
-    d.set_item("t", PyArray1::from_slice(py, &tr.t))?;
-    d.set_item("q", PyArray1::from_slice(py, &tr.q).reshape([n, tr.nq])?)?;
-    d.set_item("v", PyArray1::from_slice(py, &tr.v).reshape([n, tr.nv])?)?;
-    d.set_item("ddq", PyArray1::from_slice(py, &tr.ddq).reshape([n, tr.nv])?)?;
-    d.set_item("tau", PyArray1::from_slice(py, &tr.tau).reshape([n, tr.nv])?)?;
-    d.set_item("momentum", PyArray1::from_slice(py, &tr.momentum).reshape([n, 6])?)?;
-    d.set_item("kinetic_energy", PyArray1::from_slice(py, &tr.kinetic_energy))?;
-    d.set_item("work", PyArray1::from_slice(py, &tr.work))?;
     let nt = tr.propellant.len().checked_div(n).unwrap_or(0);
-    d.set_item("propellant", PyArray1::from_slice(py, &tr.propellant).reshape([n, nt])?)?;
     let nb = if tr.base_parameters.is_empty() { 0 } else { 10 };
-    d.set_item("base_parameters", PyArray1::from_slice(py, &tr.base_parameters).reshape([n, nb])?)?;
+    let sim::Trajectory {
+        nq, nv, t, q, v, ddq, tau, momentum, kinetic_energy, work, propellant, base_parameters, ..
+    } = tr;
+    d.set_item("t", PyArray1::from_vec(py, t))?;
+    d.set_item("q", PyArray1::from_vec(py, q).reshape([n, nq])?)?;
+    d.set_item("v", PyArray1::from_vec(py, v).reshape([n, nv])?)?;
+    d.set_item("ddq", PyArray1::from_vec(py, ddq).reshape([n, nv])?)?;
+    d.set_item("tau", PyArray1::from_vec(py, tau).reshape([n, nv])?)?;
+    d.set_item("momentum", PyArray1::from_vec(py, momentum).reshape([n, 6])?)?;
+    d.set_item("kinetic_energy", PyArray1::from_vec(py, kinetic_energy))?;
+    d.set_item("work", PyArray1::from_vec(py, work))?;
+    d.set_item("propellant", PyArray1::from_vec(py, propellant).reshape([n, nt])?)?;
+    d.set_item("base_parameters", PyArray1::from_vec(py, base_parameters).reshape([n, nb])?)?;
     d.set_item("steps", tr.steps)?;
     d.set_item("rejected", tr.rejected)?;
     d.set_item("evaluations", tr.evaluations)?;

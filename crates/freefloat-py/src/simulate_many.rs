@@ -125,11 +125,11 @@ pub fn simulate_many<'py>(
         match r {
             Ok(tr) => {
                 finished += 1;
-                out.append(crate::simulate::traj_dict(py, &tr)?)?;
+                out.append(crate::simulate::traj_dict(py, tr)?)?;
             }
             // stopped by Ctrl-C: the member's samples so far, marked as such
             Err(FfError::Interrupted { msg, partial: Some(Partial::Trajectory(tr)) }) if stopped => {
-                let d = crate::simulate::traj_dict(py, &tr)?;
+                let d = crate::simulate::traj_dict(py, *tr)?;
                 d.set_item("interrupted", msg)?;
                 out.append(d)?;
             }
