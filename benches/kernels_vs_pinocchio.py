@@ -18,6 +18,9 @@ both alike; median, min and max over the repeats):
   a child process and timed inside it (wall and its own CPU time), interleaved with freefloat's repeats. Its
   outputs are checked against freefloat's first (abort above 1e-9, relative). This is the CRBA row; without g++
   or the headers (or with --no-cpp) the script says why and falls back to the estimate below.
+* freefloat's own loop (the `*_loop` rows): the same kernel called in a loop inside the engine over the same states
+  (`_core._time_kernel`, through the checked public function), timed there; against the C++ peer's loop this is
+  core to core with no binding, argument conversion or output allocation on either side.
 * CRBA, the old estimate (kept as the `crba_estimate` row): a Python loop of `pin.crba` minus the same loop on a
   one-body free-flyer model (the binding and loop cost, measured in the same run); freefloat's is a stacked batch
   of N = 1000.
@@ -41,6 +44,7 @@ import re
 import statistics
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -200,6 +204,16 @@ def one_body_freeflyer():
     return pm
 
 
+def ff_loop(m, kernel, Q, V, T, calls):
+    """freefloat's loop of `calls` kernel calls over the rows of Q, V, T, timed inside the engine: (wall, cpu) s."""
+    import freefloat as ff
+
+    # this thread's CPU time: the loop runs on it (the process's would also count idle-spinning BLAS threads)
+    c0 = time.thread_time()
+    wall, _ = ff._core._time_kernel(m, kernel, Q, V, T, calls)
+    return wall, time.thread_time() - c0
+
+
 class SelfTimed:
     """A case timed by someone else (the C++ peer): `fn()` returns (wall, cpu) seconds."""
 
@@ -288,6 +302,11 @@ def bench_core(m, ps, args, rng, peer=None, tmp=None):
     }
     per = {k: N for k in cases}
     per.update({"ff crba": n_crba, "pin crba loop": n_crba, "pin crba loop, 1-body model": n_crba})
+    # freefloat's own loop over the same states, timed inside the engine like the C++ peer times its loop (warm, no
+    # Python, no output allocation): the core-to-core figure for the C++ rows
+    for kernel, calls in (("aba", N), ("rnea", N), ("crba", n_crba)):
+        cases[f"ff loop {kernel}"] = SelfTimed(lambda kernel=kernel, calls=calls: ff_loop(m, kernel, Q, V, T, calls))
+        per[f"ff loop {kernel}"] = calls
     peer_err = None
     if peer is not None:
         kp = peer.load(ps.model, Qp.T, Vp.T, Tp.T, tmp)
@@ -313,6 +332,11 @@ def bench_core(m, ps, args, rng, peer=None, tmp=None):
         for kernel in ("aba", "rnea", "crba"):
             key = kernel if kernel == "crba" else f"{kernel}_cpp"
             rows[key] = ratio_stats(res["ff " + kernel], res[f"pin C++ {kernel}"]) | {"peer": f"pin C++ {kernel}"}
+            # both loops timed inside their own programs (freefloat: `_core._time_kernel`), no binding on either side
+            rows[f"{kernel}_loop"] = ratio_stats(res[f"ff loop {kernel}"], res[f"pin C++ {kernel}"]) | {
+                "peer": f"pin C++ {kernel}",
+                "freefloat": "ff loop",
+            }
     return {k: stats(s) for k, s in res.items()}, rows, peer_err
 
 
@@ -377,8 +401,10 @@ def report(env, args, results, single, single_rows, peer_note=""):
             judged = row["cpu_median"] if row["cpu_median"] is not None else row["median"]
             ok = 0 < judged <= TARGETS[kernel]
             verdict = "yes" if ok else ("**no**" if judged > 0 else "no estimate")
+            mine = f"{row.get('freefloat', 'ff')} {kernel}"  # "ff" = the batched call, "ff loop" = the engine's loop
+            label = f"{kernel} ({mine.removesuffix(' ' + kernel)}) vs {row['peer']}"
             lines.append(
-                f"| {name} | {r['nv']} | {kernel} vs {row['peer']} | {us(r['times']['ff ' + kernel]['median'])} | "
+                f"| {name} | {r['nv']} | {label} | {us(r['times'][mine]['median'])} | "
                 f"{us(r['times'][row['peer']]['median'])} | {row['median']:.2f} [{row['min']:.2f}-{row['max']:.2f}] | "
                 f"{row['cpu_median']:.2f} | <= {TARGETS[kernel]} | {verdict} |"
             )
@@ -386,7 +412,10 @@ def report(env, args, results, single, single_rows, peer_note=""):
         "",
         "Peers: `pin abaInParallel` / `pin rneaInParallel` are Pinocchio's batched C++ calls (one thread) from Python; "
         "`pin C++ ...` is Pinocchio's C++ called in a loop by a C++ program (benches/pinocchio_peer.cpp, built with "
-        "g++ -O3 -march=native against the pip wheel's headers), timed inside that program; `pin crba (C++ "
+        "g++ -O3 -march=native against the pip wheel's headers), timed inside that program. freefloat: `ff` is the "
+        "batched call from Python (`ff.aba(m, Q, V, T)`, outputs allocated and filled), `ff loop` the same kernel "
+        "called in a loop inside the engine over the same states (`_core._time_kernel`), timed there: the like of the "
+        "C++ peer's loop, core to core. `pin crba (C++ "
         "estimate)` is a Python loop of `pin.crba` minus the same loop on a one-body model. " + (peer_note or ""),
         "",
         f"## Single calls from Python ({SEED_ROBOT})",

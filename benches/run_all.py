@@ -238,6 +238,8 @@ def rows_kernels(res: dict) -> list[Row]:
             default = {"aba": "pin abaInParallel", "rnea": "pin rneaInParallel"}.get(k, "pin crba (C++ estimate)")
             peer = v.get("peer", default)
             name, words = labels.get(peer, ("Pinocchio C++ loop (benches/pinocchio_peer.cpp)", " (vs C++ loop)"))
+            if v.get("freefloat") == "ff loop":  # freefloat's own loop inside the engine: both sides loops, no binding
+                words = " (engine loop vs C++ loop)"
             out.append(
                 Row(
                     f"{kernel.upper()} per call{words}, core to core, {robot} (nv = {r['nv']})",

@@ -357,6 +357,13 @@ class RecursiveLS:
     def update(self, t: ArrayLike, phi: ArrayLike, y: ArrayLike) -> Any:
         """One sample: phi (r, n), y (r,)."""
 
+def _time_kernel(model: Model, kernel: ArrayLike, q: ArrayLike, v: ArrayLike, tau: ArrayLike, calls: ArrayLike) -> Any:
+    """`calls` calls of `kernel` ("aba", "rnea" or "crba") cycling through the rows of q, v, tau (tau is the
+acceleration for rnea; v and tau are ignored by crba), each through the checked public function as a user calls
+it. Returns (wall seconds of the loop, a checksum of the outputs that keeps the loop from being optimised away).
+The GIL is released: the caller can read the process CPU time around the call.
+    """
+
 def aba(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
     """Forward dynamics (articulated-body algorithm): accelerations for generalized forces `tau`."""
 

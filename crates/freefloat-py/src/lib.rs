@@ -14,6 +14,7 @@ mod environment;
 mod errors;
 mod estimation;
 mod excitation;
+mod kernel_timing;
 mod model;
 mod postcapture;
 mod sensors;
@@ -34,6 +35,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("NumericalError", py.get_type::<errors::NumericalError>())?;
     m.add("Interrupted", py.get_type::<errors::Interrupted>())?;
     m.add_function(wrap_pyfunction!(algorithms::forward_kinematics, m)?)?;
+    m.add_function(wrap_pyfunction!(kernel_timing::_time_kernel, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::frame_placement, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::center_of_mass, m)?)?;
     m.add_function(wrap_pyfunction!(algorithms::body_velocities, m)?)?;
