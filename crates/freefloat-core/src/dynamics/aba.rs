@@ -142,26 +142,36 @@ pub(crate) fn hybrid_aba_placed_unchecked(
             let pa6 = d.of[i].to_v6();
             if k == 1 {
                 // Single-DoF joint: rank-one update, fused into the parent's accumulation
-                // (I^a = I^A − u uᵀ/d and I^a c = I^A c − u (u·c)/d, with no 6×6 temporaries).
+                // (I^a = I^A − u uᵀ/d and I^a c = I^A c − u (u·c)/d, with no 6×6 temporaries), RBDA Table 7.1.
+                // On nalgebra's column-major arrays with fixed bounds: the loops vectorise (nalgebra's `ger`
+                // and `+=` on a 6×6 do not fully).
                 let s0 = s.column(0).into_owned();
+                let s0a: [f64; 6] = s0.into();
+                let oc: [f64; 6] = d.oc[i].to_v6().into();
                 let (lo, hi) = d.ia.split_at_mut(i);
-                let ia = &hi[0];
-                let u = ia * s0;
-                let dd = s0.dot(&u);
+                let ia = &hi[0].data.0;
+                // U = Iᴬ S and Iᴬ c in one sweep over the columns of Iᴬ
+                let (u, iac) = mat6_mul2(ia, &s0a, &oc);
+                let dd = dot6(&s0a, &u);
                 if !(dd > 0.0) || !dd.is_finite() {
                     return Err(singular(m, d, i, v));
                 }
                 let uu = tau[iv] - s0.dot(&pa6);
-                d.u[i].set_column(0, &u);
+                d.u[i].set_column(0, &V6::from(u));
                 d.dinv[i][(0, 0)] = 1.0 / dd;
                 d.uu[i][0] = uu;
                 if let Some(p) = parent {
-                    let oc = d.oc[i].to_v6();
-                    let pa = pa6 + ia * oc + u * ((uu - u.dot(&oc)) / dd);
-                    let iap = &mut lo[p];
-                    *iap += ia;
-                    iap.ger(-1.0 / dd, &u, &u, 1.0);
-                    d.of[p] += Force::from_v6(&pa);
+                    let coef = (uu - dot6(&u, &oc)) / dd;
+                    let pa: [f64; 6] = std::array::from_fn(|r| pa6[r] + iac[r] + u[r] * coef);
+                    let iap = &mut lo[p].data.0;
+                    let alpha = -1.0 / dd;
+                    for c in 0..6 {
+                        let uc = u[c] * alpha;
+                        for r in 0..6 {
+                            iap[c][r] += ia[c][r] + u[r] * uc;
+                        }
+                    }
+                    d.of[p] += Force::from_slice(&pa);
                 }
                 continue;
             }
@@ -296,6 +306,24 @@ fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f6
     d.ia[p] += ia_a;
     d.of[p] += Force::from_v6(&pa);
     Ok(())
+}
+
+/// `(A x, A y)` for a column-major 6×6 `A`, one pass over its columns.
+#[inline(always)]
+fn mat6_mul2(a: &[[f64; 6]; 6], x: &[f64; 6], y: &[f64; 6]) -> ([f64; 6], [f64; 6]) {
+    let (mut ax, mut ay) = ([0.0; 6], [0.0; 6]);
+    for c in 0..6 {
+        for r in 0..6 {
+            ax[r] += a[c][r] * x[c];
+            ay[r] += a[c][r] * y[c];
+        }
+    }
+    (ax, ay)
+}
+
+#[inline(always)]
+fn dot6(a: &[f64; 6], b: &[f64; 6]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
 }
 
 /// The error for a joint whose articulated inertia cannot be inverted. An overflow or a NaN upstream makes it look
