@@ -168,7 +168,7 @@ pub(crate) fn hybrid_aba_placed_unchecked(
                     for c in 0..6 {
                         let uc = u[c] * alpha;
                         for r in 0..6 {
-                            iap[c][r] += ia[c][r] + u[r] * uc;
+                            iap[c][r] += u[r].mul_add(uc, ia[c][r]);
                         }
                     }
                     d.of[p] += Force::from_slice(&pa);
@@ -311,11 +311,13 @@ fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f6
 /// `(A x, A y)` for a column-major 6×6 `A`, one pass over its columns.
 #[inline(always)]
 fn mat6_mul2(a: &[[f64; 6]; 6], x: &[f64; 6], y: &[f64; 6]) -> ([f64; 6], [f64; 6]) {
-    let (mut ax, mut ay) = ([0.0; 6], [0.0; 6]);
-    for c in 0..6 {
+    // the first column starts the sums (no additions to zero); fused multiply-adds for the rest
+    let mut ax: [f64; 6] = std::array::from_fn(|r| a[0][r] * x[0]);
+    let mut ay: [f64; 6] = std::array::from_fn(|r| a[0][r] * y[0]);
+    for c in 1..6 {
         for r in 0..6 {
-            ax[r] += a[c][r] * x[c];
-            ay[r] += a[c][r] * y[c];
+            ax[r] = a[c][r].mul_add(x[c], ax[r]);
+            ay[r] = a[c][r].mul_add(y[c], ay[r]);
         }
     }
     (ax, ay)
@@ -388,46 +390,82 @@ fn solve_spd(dm: &M6, k: usize, b: &[f64; 6]) -> Option<[f64; 6]> {
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
-/// Solve `A x = b` for a symmetric positive-definite 6×6 `A` (lower triangle read) by an unrolled Cholesky
-/// factorisation `A = L Lᵀ`; `None` if `A` is not numerically positive definite or the result is not finite.
-/// Fixed loop bounds let the compiler unroll it completely (nalgebra's general Cholesky keeps its loops).
+/// Solve `A x = b` for a symmetric positive-definite 6×6 `A` (lower triangle read) by a Cholesky factorisation
+/// `A = L Lᵀ`; `None` if `A` is not numerically positive definite or the result is not finite.
+/// One const-generic step per column: every loop has a compile-time trip count and every index is a constant, so
+/// the whole solve is straight-line code without bounds checks (with run-time triangular bounds the compiler kept
+/// the loops and their checks: about a tenth of ABA on `naveen_dual_arm`). Same operations in the same order as
+/// the textbook loops, so the same result to the bit.
 #[inline]
 fn solve_spd6(a: &M6, b: &V6) -> Option<V6> {
-    let mut l = [[0.0f64; 6]; 6];
-    for j in 0..6 {
-        let mut djj = a[(j, j)];
-        for k in 0..j {
-            djj -= l[j][k] * l[j][k];
-        }
-        if !(djj > 0.0) {
-            return None;
-        }
-        let ljj = djj.sqrt();
-        l[j][j] = ljj;
-        let inv = 1.0 / ljj;
-        for i in j + 1..6 {
-            let mut x = a[(i, j)];
-            for k in 0..j {
-                x -= l[i][k] * l[j][k];
-            }
-            l[i][j] = x * inv;
-        }
+    let a = &a.data.0; // column-major: a[c][r] = A(r, c)
+    let mut l = [[0.0f64; 6]; 6]; // l[i][j] = L(i, j), j <= i
+    let ok = chol_col::<0>(a, &mut l)
+        && chol_col::<1>(a, &mut l)
+        && chol_col::<2>(a, &mut l)
+        && chol_col::<3>(a, &mut l)
+        && chol_col::<4>(a, &mut l)
+        && chol_col::<5>(a, &mut l);
+    if !ok {
+        return None;
     }
     let mut y = [0.0f64; 6];
-    for i in 0..6 {
-        let mut x = b[i];
-        for k in 0..i {
-            x -= l[i][k] * y[k];
-        }
-        y[i] = x / l[i][i];
+    fwd_row::<0>(&l, b, &mut y);
+    fwd_row::<1>(&l, b, &mut y);
+    fwd_row::<2>(&l, b, &mut y);
+    fwd_row::<3>(&l, b, &mut y);
+    fwd_row::<4>(&l, b, &mut y);
+    fwd_row::<5>(&l, b, &mut y);
+    let mut x = [0.0f64; 6];
+    back_row::<5>(&l, &y, &mut x);
+    back_row::<4>(&l, &y, &mut x);
+    back_row::<3>(&l, &y, &mut x);
+    back_row::<2>(&l, &y, &mut x);
+    back_row::<1>(&l, &y, &mut x);
+    back_row::<0>(&l, &y, &mut x);
+    x.iter().all(|v| v.is_finite()).then(|| V6::from(x))
+}
+
+/// Column J of the Cholesky factor: `L(J,J) = √(A(J,J) − Σₖ L(J,k)²)`, `L(i,J) = (A(i,J) − Σₖ L(i,k) L(J,k)) / L(J,J)`
+/// for i > J (k < J); false if the pivot is not positive.
+#[inline(always)]
+fn chol_col<const J: usize>(a: &[[f64; 6]; 6], l: &mut [[f64; 6]; 6]) -> bool {
+    let mut djj = a[J][J];
+    for k in 0..J {
+        djj -= l[J][k] * l[J][k];
     }
-    let mut x = V6::zeros();
-    for i in (0..6).rev() {
-        let mut s = y[i];
-        for k in i + 1..6 {
-            s -= l[k][i] * x[k];
-        }
-        x[i] = s / l[i][i];
+    if !(djj > 0.0) {
+        return false;
     }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    let ljj = djj.sqrt();
+    l[J][J] = ljj;
+    let inv = 1.0 / ljj;
+    for i in J + 1..6 {
+        let mut x = a[J][i];
+        for k in 0..J {
+            x -= l[i][k] * l[J][k];
+        }
+        l[i][J] = x * inv;
+    }
+    true
+}
+
+/// Row I of `L y = b`.
+#[inline(always)]
+fn fwd_row<const I: usize>(l: &[[f64; 6]; 6], b: &V6, y: &mut [f64; 6]) {
+    let mut x = b[I];
+    for k in 0..I {
+        x -= l[I][k] * y[k];
+    }
+    y[I] = x / l[I][I];
+}
+
+/// Row I of `Lᵀ x = y` (rows above I already solved).
+#[inline(always)]
+fn back_row<const I: usize>(l: &[[f64; 6]; 6], y: &[f64; 6], x: &mut [f64; 6]) {
+    let mut s = y[I];
+    for k in I + 1..6 {
+        s -= l[k][I] * x[k];
+    }
+    x[I] = s / l[I][I];
 }
