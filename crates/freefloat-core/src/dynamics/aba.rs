@@ -118,9 +118,9 @@ pub(crate) fn hybrid_aba_placed_unchecked(
             let bias = omi.act_motion(&joint_bias(m, d, i, v));
             d.oc[i] += bias;
         }
-        let oi = m.inertias[i].transformed(&omi);
-        d.ia[i] = oi.to_matrix();
-        let hi = oi.mul_motion(&vi);
+        d.ia[i] = m.inertias[i].transformed(&omi).to_matrix();
+        // momentum oIᵢ vᵢ from the 6×6 just written: one vectorised product (the Inertia form is scalar code)
+        let hi = Force::from_slice(&mat6_mul(&d.ia[i].data.0, &vi.to_v6().into()));
         h_total += hi;
         ke += 0.5 * vi.dot(&hi);
         let mut f = vi.cross_force(&hi);
@@ -306,6 +306,18 @@ fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f6
     d.ia[p] += ia_a;
     d.of[p] += Force::from_v6(&pa);
     Ok(())
+}
+
+/// `A x` for a column-major 6×6 `A` (fused multiply-adds over its columns).
+#[inline(always)]
+fn mat6_mul(a: &[[f64; 6]; 6], x: &[f64; 6]) -> [f64; 6] {
+    let mut ax: [f64; 6] = std::array::from_fn(|r| a[0][r] * x[0]);
+    for c in 1..6 {
+        for r in 0..6 {
+            ax[r] = a[c][r].mul_add(x[c], ax[r]);
+        }
+    }
+    ax
 }
 
 /// `(A x, A y)` for a column-major 6×6 `A`, one pass over its columns.
