@@ -110,51 +110,32 @@ impl Inertia {
     /// The same inertia seen from the parent frame of `x` (x places this body's frame in the parent).
     ///
     /// Parallel-axis shift by `p` in the form `I' = R I Rᵀ − [p][h_r] − [h_r + m p][p]`, expanded with
-    /// `[a][b] = b aᵀ − (a·b) 1` into `R I Rᵀ − (h_r pᵀ + p h_rᵀ) + (2 p·h_r + m |p|²) 1 − m p pᵀ`, which avoids the
-    /// skew-matrix products (54 multiplications by zero). Featherstone, RBDA (2008), eq. 2.63.
-    /// Computed column by column on 3-vectors padded to four lanes (`A = R I`, then `A Rᵀ` as combinations of the
-    /// columns of A), with fused multiply-adds: every step is one vector operation (about half the instructions
-    /// of the entry-by-entry form on an AVX2 machine; ABA and CRBA call it once per body).
+    /// `[a][b] = b aᵀ − (a·b) 1` into `R I Rᵀ − h_r pᵀ − p h'ᵀ + (p·(h_r + h')) 1` with `h' = h_r + m p` (the
+    /// transformed first moment): only the six independent entries of the symmetric result are computed, each as one
+    /// chain of fused multiply-adds (the skew-matrix products would cost 54 multiplications by zero, which the
+    /// compiler may not drop for floats). Featherstone, RBDA (2008), eq. 2.63.
     #[inline]
     pub fn transformed(&self, x: &Se3) -> Inertia {
-        type L4 = [f64; 4];
-        #[inline(always)]
-        fn col(m: &M3, c: usize) -> L4 {
-            [m[(0, c)], m[(1, c)], m[(2, c)], 0.0]
-        }
-        // a x + b, lane by lane
-        #[inline(always)]
-        fn fma(a: &L4, x: f64, b: &L4) -> L4 {
-            std::array::from_fn(|k| a[k].mul_add(x, b[k]))
-        }
-        #[inline(always)]
-        fn scale(a: &L4, x: f64) -> L4 {
-            std::array::from_fn(|k| a[k] * x)
-        }
         let (r, io, m) = (&x.rot, &self.i_o, self.mass);
-        let (r0, r1, r2) = (col(r, 0), col(r, 1), col(r, 2));
-        let h = &self.h;
-        let h_r = fma(&r2, h.z, &fma(&r1, h.y, &scale(&r0, h.x)));
-        // A = R I, column c = Σₗ R[:, l] I(l, c)
-        let a: [L4; 3] = std::array::from_fn(|c| fma(&r2, io[(2, c)], &fma(&r1, io[(1, c)], &scale(&r0, io[(0, c)]))));
-        let p: L4 = [x.trans.x, x.trans.y, x.trans.z, 0.0];
-        let diag =
-            2.0 * (p[0] * h_r[0] + p[1] * h_r[1] + p[2] * h_r[2]) + m * (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]);
-        // column k of I' = Σₗ A[:, l] R(k, l) − h_r p_k − p (h_r,k + m p_k) + diag eₖ
-        let out: [L4; 3] = std::array::from_fn(|k| {
-            let b = fma(&a[2], r[(k, 2)], &fma(&a[1], r[(k, 1)], &scale(&a[0], r[(k, 0)])));
-            let mut c = fma(&p, -(h_r[k] + m * p[k]), &fma(&h_r, -p[k], &b));
-            c[k] += diag;
-            c
-        });
-        Inertia {
-            mass: m,
-            h: V3::new(p[0].mul_add(m, h_r[0]), p[1].mul_add(m, h_r[1]), p[2].mul_add(m, h_r[2])),
-            // upper triangle mirrored: exactly symmetric, as the callers (CRBA's mass matrix) expect
-            i_o: M3::new(
-                out[0][0], out[1][0], out[2][0], out[1][0], out[1][1], out[2][1], out[2][0], out[2][1], out[2][2],
-            ),
-        }
+        let (p, h) = (&x.trans, &self.h);
+        // h_r = R h
+        let hr = |j: usize| r[(j, 2)].mul_add(h.z, r[(j, 1)].mul_add(h.y, r[(j, 0)] * h.x));
+        let h_r = [hr(0), hr(1), hr(2)];
+        let pa = [p.x, p.y, p.z];
+        let hp: [f64; 3] = std::array::from_fn(|j| pa[j].mul_add(m, h_r[j]));
+        // A = R I (row j of R times column c of I)
+        let a =
+            |j: usize, c: usize| r[(j, 2)].mul_add(io[(2, c)], r[(j, 1)].mul_add(io[(1, c)], r[(j, 0)] * io[(0, c)]));
+        let ar: [[f64; 3]; 3] = std::array::from_fn(|j| [a(j, 0), a(j, 1), a(j, 2)]);
+        let diag = pa[0].mul_add(h_r[0] + hp[0], pa[1].mul_add(h_r[1] + hp[1], pa[2] * (h_r[2] + hp[2])));
+        // (A Rᵀ)(j, k) − h_r,j p_k − p_j h'_k, j ≤ k
+        let e = |j: usize, k: usize| {
+            let rak = ar[j][2].mul_add(r[(k, 2)], ar[j][1].mul_add(r[(k, 1)], ar[j][0] * r[(k, 0)]));
+            (-pa[j]).mul_add(hp[k], (-h_r[j]).mul_add(pa[k], rak))
+        };
+        let (xx, yy, zz) = (e(0, 0) + diag, e(1, 1) + diag, e(2, 2) + diag);
+        let (xy, xz, yz) = (e(0, 1), e(0, 2), e(1, 2));
+        Inertia { mass: m, h: V3::new(hp[0], hp[1], hp[2]), i_o: M3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) }
     }
 
     /// Sum of two inertias expressed in the same frame (a composite body).
