@@ -2,7 +2,7 @@ use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::{universal_bias, universal_first_axis, JointType, Model};
-use crate::spatial::{rotate_about_principal_axis, rotation_about_axis, Motion, Se3, V3};
+use crate::spatial::{rotate_about_principal_axis, rotation_about_axis, Motion, Se3, M6, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
 /// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
@@ -75,8 +75,13 @@ pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motio
 /// prismatic one's [a; 0] gives `[R a; 0]`: one 3×3 product instead of the general motion transform.
 #[inline(always)]
 pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> Motion {
-    let o = &d.o_mi[i];
-    let s = &d.s[i];
+    subspace_column_at(m, &d.o_mi[i], &d.s[i], i, c)
+}
+
+/// `world_subspace_column` from body i's placement `o` and child-frame subspace `s` (for callers that hold
+/// other fields of `Data` borrowed).
+#[inline(always)]
+pub(crate) fn subspace_column_at(m: &Model, o: &Se3, s: &M6, i: usize, c: usize) -> Motion {
     match m.joint_types[i] {
         JointType::Revolute => {
             // about a principal axis eₖ, R a is column k of R (no product)
@@ -95,11 +100,17 @@ pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> 
 /// eq. 3.41 `c_J`), after `forward_kinematics`.
 #[inline]
 pub(crate) fn joint_bias(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
+    joint_bias_at(m, &d.s[i], i, qd)
+}
+
+/// `joint_bias` from body i's current child-frame subspace `s` (`d.s[i]`).
+#[inline]
+pub(crate) fn joint_bias_at(m: &Model, s: &M6, i: usize, qd: &[f64]) -> Motion {
     if m.joint_types[i] != JointType::Universal {
         return Motion::ZERO;
     }
     let k = m.idx_v[i];
-    let s1 = V3::new(d.s[i][(3, 0)], d.s[i][(4, 0)], d.s[i][(5, 0)]);
+    let s1 = V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]);
     Motion::new(V3::zeros(), universal_bias(&s1, &m.axes2[i], qd[k], qd[k + 1]))
 }
 

@@ -1,4 +1,4 @@
-use super::{skew, Force, Motion, Se3, M3, M6, V3};
+use super::{cross_fma, skew, Force, Motion, Se3, M3, M6, V3};
 
 /// Rigid-body inertia in the parameters the whole project uses (ARCHITECTURE.md): mass, first
 /// moment `h = m c` and the rotational inertia `i_o` about the body-frame origin, all in body axes.
@@ -65,7 +65,14 @@ impl Inertia {
     /// Spatial momentum (about the body origin, body axes) of a body moving with twist `v`.
     #[inline]
     pub fn mul_motion(&self, v: &Motion) -> Force {
-        Force { lin: v.lin * self.mass - self.h.cross(&v.ang), ang: self.i_o * v.ang + self.h.cross(&v.lin) }
+        // fused multiply-adds throughout (ABA forms one momentum per body)
+        let (m, i, w) = (self.mass, &self.i_o, &v.ang);
+        let (hw, hv) = (cross_fma(&self.h, w), cross_fma(&self.h, &v.lin));
+        let iw = |r: usize| i[(r, 2)].mul_add(w.z, i[(r, 1)].mul_add(w.y, i[(r, 0)].mul_add(w.x, hv[r])));
+        Force {
+            lin: V3::new(v.lin.x.mul_add(m, -hw.x), v.lin.y.mul_add(m, -hw.y), v.lin.z.mul_add(m, -hw.z)),
+            ang: V3::new(iw(0), iw(1), iw(2)),
+        }
     }
 
     /// `mul_motion` as a linear map of the parameters: column k is the momentum contributed by

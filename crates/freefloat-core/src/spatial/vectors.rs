@@ -106,7 +106,7 @@ vec6_ops!(Force);
 
 /// `a × b` with one fused multiply-add per entry (`a_j b_k − a_k b_j` as `fma(a_j, b_k, −a_k b_j)`).
 #[inline(always)]
-fn cross(a: &V3, b: &V3) -> V3 {
+pub(crate) fn cross(a: &V3, b: &V3) -> V3 {
     V3::new(a.y.mul_add(b.z, -(a.z * b.y)), a.z.mul_add(b.x, -(a.x * b.z)), a.x.mul_add(b.y, -(a.y * b.x)))
 }
 
