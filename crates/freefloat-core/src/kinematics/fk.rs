@@ -15,11 +15,27 @@ pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
 
 /// `forward_kinematics` without the argument check (`q` checked and normalised by the caller).
 pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
-    for i in 0..m.nbodies() {
-        d.li_mi[i] = joint_placement(m, d, i, q);
-        d.o_mi[i] = match m.parents[i] {
-            Some(p) => d.o_mi[p].compose(&d.li_mi[i]),
-            None => d.li_mi[i],
+    let n = m.nbodies();
+    // The model's per-body vectors have n entries (the builder makes them so); said once, it lets the compiler
+    // drop the bounds checks of the loop below. The Data buffers as n-entry slices: their lengths stay in
+    // registers instead of being re-read after every store.
+    assert!(
+        m.parents.len() == n
+            && m.idx_q.len() == n
+            && m.nqs.len() == n
+            && m.joint_types.len() == n
+            && m.placements.len() == n
+            && m.axes.len() == n
+            && m.axes2.len() == n
+            && m.principal_revolute().len() == n
+    );
+    let (li_mi, o_mi, s) = (&mut d.li_mi[..n], &mut d.o_mi[..n], &mut d.s[..n]);
+    for i in 0..n {
+        let li = joint_placement_at(m, &mut s[i], i, q);
+        li_mi[i] = li;
+        o_mi[i] = match m.parents[i] {
+            Some(p) => o_mi[p].compose(&li),
+            None => li,
         };
     }
 }
@@ -28,11 +44,17 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
 /// joint: one step of `forward_kinematics`.
 #[inline(always)]
 pub(crate) fn joint_placement(m: &Model, d: &mut Data, i: usize, q: &[f64]) -> Se3 {
+    joint_placement_at(m, &mut d.s[i], i, q)
+}
+
+/// `joint_placement` with body i's subspace buffer `s` (`d.s[i]`) given.
+#[inline(always)]
+pub(crate) fn joint_placement_at(m: &Model, s: &mut M6, i: usize, q: &[f64]) -> Se3 {
     let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
     let jt = m.joint_types[i];
     if jt == JointType::Universal {
         let s1 = universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]);
-        d.s[i].fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
+        s.fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
     }
     match jt {
         // a rotation about the joint origin leaves the placement's translation as it is: one 3×3 product
