@@ -239,11 +239,11 @@ pub(crate) fn hybrid_aba_placed_unchecked(
             }
         } else if k == 1 {
             // Single DoF: q̈ = (u − Uᵀ a) / D, then a += oS q̈ (RBDA eq. 7.45, scalar D⁻¹).
-            let u = &b.u[i];
-            let x = b.dinv[i][(0, 0)] * (b.uu[i][0] - u.column(0).dot(&a));
+            let (u, s0) = (&b.u[i].data.0[0], &s.data.0[0]);
+            let x = b.dinv[i][(0, 0)] * (b.uu[i][0] - dot6(u, &a.data.0[0]));
             b.ddq[iv] = x;
             b.tau[iv] = tau[iv];
-            a += s.column(0) * x;
+            a = V6::from(std::array::from_fn(|r| s0[r].mul_add(x, a[r])));
         } else {
             if parents[i].is_none() && k == 6 {
                 // Free root: oS is the base placement's motion transform X₀, invertible, so the joint

@@ -2,7 +2,7 @@ use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::{universal_bias, universal_first_axis, JointType, Model};
-use crate::spatial::{rotate_about_principal_axis, rotation_about_axis, Motion, Se3, M6, V3};
+use crate::spatial::{cross_fma, rotate_about_principal_axis, rotation_about_axis, Motion, Se3, M6, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
 /// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
@@ -111,7 +111,7 @@ pub(crate) fn subspace_column_at(m: &Model, o: &Se3, s: &M6, i: usize, c: usize)
                 Some(k) => o.rot.column(k).into_owned(),
                 None => o.rot * V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]),
             };
-            Motion::new(o.trans.cross(&w), w)
+            Motion::new(cross_fma(&o.trans, &w), w)
         }
         JointType::Prismatic => Motion::new(o.rot * V3::new(s[(0, 0)], s[(1, 0)], s[(2, 0)]), V3::zeros()),
         _ => o.act_motion(&Motion::from_v6(&s.column(c).into_owned())),
