@@ -2,9 +2,9 @@ use super::gravity_acceleration;
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::{FfError, Result};
-use crate::kinematics::{forward_kinematics_unchecked, joint_bias, world_subspace_column};
+use crate::kinematics::{forward_kinematics_unchecked, joint_bias_at, subspace_column_at};
 use crate::model::{JointType, Model};
-use crate::spatial::{Force, Motion, M6, V6};
+use crate::spatial::{Force, Motion, Se3, M6, V6};
 use nalgebra::Matrix3;
 
 /// Joints whose motion is imposed: `mask[i]` for body i's joint, with accelerations taken from
@@ -79,47 +79,54 @@ pub(crate) fn hybrid_aba_placed_unchecked(
     // Pass 1: subspaces, twists, velocity-product accelerations and bias forces, inertial frame.
     // Each body's momentum oIᵢ vᵢ is formed here anyway, so the totals come for free.
     let (mut h_total, mut ke) = (Force::ZERO, 0.0);
+    // Every per-body buffer as a slice of exactly n entries held in a register: indexing by i < n needs no bounds
+    // check (through `d` each access re-reads the vector's length, which any store to a buffer might have changed).
+    let (o_mi, s_all) = (&d.o_mi[..n], &d.s[..n]);
+    let (os, ov, oc) = (&mut d.os[..n], &mut d.ov[..n], &mut d.oc[..n]);
+    let (ias, ofs) = (&mut d.ia[..n], &mut d.of[..n]);
+    let (jts, parents, idx_v, nvs, inertias) =
+        (&m.joint_types[..n], &m.parents[..n], &m.idx_v[..n], &m.nvs[..n], &m.inertias[..n]);
     for i in 0..n {
-        let omi = d.o_mi[i];
-        let iv = m.idx_v[i];
+        let omi = o_mi[i];
+        let iv = idx_v[i];
         // Joint twist oS q̇, specialised by joint type: a revolute joint's child-frame subspace is [0; a]
         // (oS = [p × R a; R a]) and a prismatic one's [a; 0] (oS = [R a; 0]), so neither needs the
         // general 6-column frame change; a free root's oS is the base placement's motion transform
         // itself, applied to the base twist in one step (its columns are not needed, see pass 3).
-        let vj = match m.joint_types[i] {
+        let vj = match jts[i] {
             JointType::Revolute | JointType::Prismatic => {
-                let col = world_subspace_column(m, d, i, 0);
-                d.os[i].set_column(0, &col.to_v6());
+                let col = subspace_column_at(m, &omi, &s_all[i], i, 0);
+                os[i].set_column(0, &col.to_v6());
                 col * v[iv]
             }
-            JointType::Free if m.parents[i].is_none() && !is_presc(i) => {
+            JointType::Free if parents[i].is_none() && !is_presc(i) => {
                 omi.act_motion(&Motion::from_slice(&v[iv..iv + 6]))
             }
             JointType::FixedBase | JointType::Fixed => Motion::ZERO,
             _ => {
                 let mut vj = Motion::ZERO;
-                for c in 0..m.nvs[i] {
-                    let s = omi.act_motion(&Motion::from_v6(&d.s[i].column(c).into_owned()));
-                    d.os[i].set_column(c, &s.to_v6());
+                for c in 0..nvs[i] {
+                    let s = omi.act_motion(&Motion::from_v6(&s_all[i].column(c).into_owned()));
+                    os[i].set_column(c, &s.to_v6());
                     vj += s * v[iv + c];
                 }
                 vj
             }
         };
-        let vi = match m.parents[i] {
-            Some(p) => d.ov[p] + vj,
+        let vi = match parents[i] {
+            Some(p) => ov[p] + vj,
             None => vj,
         };
-        d.ov[i] = vi;
+        ov[i] = vi;
         // d/dt(oS q̇) = v × (oS q̇) + o(Ṡ q̇); the second term is non-zero for universal joints only, so the
         // others skip its frame change (measured: ~8 % of ABA on `naveen_dual_arm`).
-        d.oc[i] = vi.cross_motion(&vj);
-        if m.joint_types[i] == JointType::Universal {
-            let bias = omi.act_motion(&joint_bias(m, d, i, v));
-            d.oc[i] += bias;
+        oc[i] = vi.cross_motion(&vj);
+        if jts[i] == JointType::Universal {
+            let bias = omi.act_motion(&joint_bias_at(m, &s_all[i], i, v));
+            oc[i] += bias;
         }
-        let oi = m.inertias[i].transformed(&omi);
-        d.ia[i] = oi.to_matrix();
+        let oi = inertias[i].transformed(&omi);
+        ias[i] = oi.to_matrix();
         let hi = oi.mul_motion(&vi);
         h_total += hi;
         ke += 0.5 * vi.dot(&hi);
@@ -127,46 +134,58 @@ pub(crate) fn hybrid_aba_placed_unchecked(
         if let Some(fe) = fext {
             f -= omi.act_force(&Force::from_slice(&fe[6 * i..6 * i + 6]));
         }
-        d.of[i] = f;
+        ofs[i] = f;
     }
     d.aba_momentum = h_total;
     d.aba_kinetic_energy = ke;
 
-    // Pass 2: articulated inertias and bias forces, leaves to root.
+    // Pass 2: articulated inertias and bias forces, leaves to root (the buffers as n-entry slices, see pass 1).
+    let mut b = AbaBufs::of(d, n);
     for i in (0..n).rev() {
-        let k = m.nvs[i];
-        let iv = m.idx_v[i];
-        let parent = m.parents[i];
+        let k = nvs[i];
+        let iv = idx_v[i];
+        let parent = parents[i];
         if k > 0 && !is_presc(i) {
-            let s = &d.os[i];
-            let pa6 = d.of[i].to_v6();
+            let s = &b.os[i];
+            let pa6 = b.of[i].to_v6();
             if k == 1 {
                 // Single-DoF joint: rank-one update, fused into the parent's accumulation
-                // (I^a = I^A − u uᵀ/d and I^a c = I^A c − u (u·c)/d, with no 6×6 temporaries).
+                // (I^a = I^A − u uᵀ/d and I^a c = I^A c − u (u·c)/d, with no 6×6 temporaries), RBDA Table 7.1.
+                // Written on nalgebra's column-major arrays with fixed bounds and fused multiply-adds, U and Iᴬc in
+                // one sweep and the parent's update in one loop: fewer instructions than nalgebra's 6×6 products,
+                // `+=` and `ger` (callgrind).
                 let s0 = s.column(0).into_owned();
-                let (lo, hi) = d.ia.split_at_mut(i);
-                let ia = &hi[0];
-                let u = ia * s0;
-                let dd = s0.dot(&u);
+                let s0a: [f64; 6] = s0.into();
+                let oc: [f64; 6] = b.oc[i].to_v6().into();
+                let (lo, hi) = b.ia.split_at_mut(i);
+                let ia = &hi[0].data.0;
+                // U = Iᴬ S and Iᴬ c in one sweep over the columns of Iᴬ
+                let (u, iac) = mat6_mul2(ia, &s0a, &oc);
+                let dd = dot6(&s0a, &u);
                 if !(dd > 0.0) || !dd.is_finite() {
                     return Err(singular(m, d, i, v));
                 }
                 let uu = tau[iv] - s0.dot(&pa6);
-                d.u[i].set_column(0, &u);
-                d.dinv[i][(0, 0)] = 1.0 / dd;
-                d.uu[i][0] = uu;
+                b.u[i].set_column(0, &V6::from(u));
+                b.dinv[i][(0, 0)] = 1.0 / dd;
+                b.uu[i][0] = uu;
                 if let Some(p) = parent {
-                    let oc = d.oc[i].to_v6();
-                    let pa = pa6 + ia * oc + u * ((uu - u.dot(&oc)) / dd);
-                    let iap = &mut lo[p];
-                    *iap += ia;
-                    iap.ger(-1.0 / dd, &u, &u, 1.0);
-                    d.of[p] += Force::from_v6(&pa);
+                    let coef = (uu - dot6(&u, &oc)) / dd;
+                    let pa: [f64; 6] = std::array::from_fn(|r| pa6[r] + iac[r] + u[r] * coef);
+                    let iap = &mut lo[p].data.0;
+                    let alpha = -1.0 / dd;
+                    for c in 0..6 {
+                        let uc = u[c] * alpha;
+                        for r in 0..6 {
+                            iap[c][r] += u[r].mul_add(uc, ia[c][r]);
+                        }
+                    }
+                    b.of[p] += Force::from_slice(&pa);
                 }
                 continue;
             }
             // Multi-DoF joint (k = 2: cylindrical; 3: spherical or planar; 6: free).
-            let ia = d.ia[i];
+            let ia = b.ia[i];
             if k == 6 {
                 // Only the base can have a free joint (the model builder enforces it), so there is no
                 // reduction to pass on, and pass 3 solves the root's articulated equation in closed form.
@@ -181,89 +200,131 @@ pub(crate) fn hybrid_aba_placed_unchecked(
                 _ => unreachable!("joints have 0, 1, 2, 3 or 6 velocity coordinates"),
             };
             ok?;
+            // the rare multi-DoF step took `d` whole: borrow the slices again
+            b = AbaBufs::of(d, n);
         } else if let Some(p) = parent {
             // Fixed or prescribed joint: the child moves with a known relative acceleration.
-            let mut ac = d.oc[i].to_v6();
+            let mut ac = b.oc[i].to_v6();
             if let (true, Some(pr)) = (k > 0, presc) {
                 for c in 0..k {
-                    ac += d.os[i].column(c) * pr.ddq[iv + c];
+                    ac += b.os[i].column(c) * pr.ddq[iv + c];
                 }
             }
-            let pa = d.of[i].to_v6() + d.ia[i] * ac;
-            let ia = d.ia[i];
-            d.ia[p] += ia;
-            d.of[p] += Force::from_v6(&pa);
+            let pa = b.of[i].to_v6() + b.ia[i] * ac;
+            let ia = b.ia[i];
+            b.ia[p] += ia;
+            b.of[p] += Force::from_v6(&pa);
         }
     }
 
     // Pass 3: accelerations, root to leaves.
     let ag = gravity_acceleration(m).to_v6();
     for i in 0..n {
-        let k = m.nvs[i];
-        let iv = m.idx_v[i];
-        let s = &d.os[i];
-        let mut a = match m.parents[i] {
-            Some(p) => d.oa[p].to_v6(),
+        let k = nvs[i];
+        let iv = idx_v[i];
+        let s = &b.os[i];
+        let mut a = match parents[i] {
+            Some(p) => b.oa[p].to_v6(),
             None => ag,
-        } + d.oc[i].to_v6();
+        } + b.oc[i].to_v6();
         if k == 0 {
         } else if let (true, Some(p)) = (is_presc(i), presc) {
             let ddq = p.ddq;
             for c in 0..k {
                 a += s.column(c) * ddq[iv + c];
             }
-            let f: V6 = d.ia[i] * a + d.of[i].to_v6();
+            let f: V6 = b.ia[i] * a + b.of[i].to_v6();
             for c in 0..k {
-                d.ddq[iv + c] = ddq[iv + c];
-                d.tau[iv + c] = s.column(c).dot(&f);
+                b.ddq[iv + c] = ddq[iv + c];
+                b.tau[iv + c] = s.column(c).dot(&f);
             }
         } else if k == 1 {
             // Single DoF: q̈ = (u − Uᵀ a) / D, then a += oS q̈ (RBDA eq. 7.45, scalar D⁻¹).
-            let u = &d.u[i];
-            let x = d.dinv[i][(0, 0)] * (d.uu[i][0] - u.column(0).dot(&a));
-            d.ddq[iv] = x;
-            d.tau[iv] = tau[iv];
-            a += s.column(0) * x;
+            let (u, s0) = (&b.u[i].data.0[0], &s.data.0[0]);
+            let x = b.dinv[i][(0, 0)] * (b.uu[i][0] - dot6(u, &a.data.0[0]));
+            b.ddq[iv] = x;
+            b.tau[iv] = tau[iv];
+            a = V6::from(std::array::from_fn(|r| s0[r].mul_add(x, a[r])));
         } else {
-            if m.parents[i].is_none() && k == 6 {
+            if parents[i].is_none() && k == 6 {
                 // Free root: oS is the base placement's motion transform X₀, invertible, so the joint
                 // equation τ₀ = X₀ᵀ (Iᴬ a₀ + pᴬ) gives the root acceleration from one 6×6 SPD solve,
                 // Iᴬ a₀ = X₀⁻ᵀ τ₀ − pᴬ, and then q̈₀ = X₀⁻¹ (a₀ − a_g − c₀) (RBDA §7.3 with S = X₀; this
                 // avoids forming U = Iᴬ X₀ and D = X₀ᵀ U, two 6×6×6 products).
-                let omi = d.o_mi[i];
-                let rhs0 = omi.act_force(&Force::from_slice(&tau[iv..iv + 6])) - d.of[i];
-                let a0 = solve_spd6(&d.ia[i], &rhs0.to_v6()).ok_or_else(|| singular(m, d, i, v))?;
+                let omi = b.o_mi[i];
+                let rhs0 = omi.act_force(&Force::from_slice(&tau[iv..iv + 6])) - b.of[i];
+                let Some(a0) = solve_spd6(&b.ia[i], &rhs0.to_v6()) else {
+                    return Err(singular(m, d, i, v));
+                };
                 let qdd = omi.inv_act_motion(&Motion::from_v6(&(a0 - a)));
-                qdd.write(&mut d.ddq[iv..iv + 6]);
-                d.tau[iv..iv + 6].copy_from_slice(&tau[iv..iv + 6]);
-                d.oa[i] = Motion::from_v6(&a0);
+                qdd.write(&mut b.ddq[iv..iv + 6]);
+                b.tau[iv..iv + 6].copy_from_slice(&tau[iv..iv + 6]);
+                b.oa[i] = Motion::from_v6(&a0);
                 continue;
             }
             let mut rhs = [0.0; 6];
             for c in 0..k {
-                rhs[c] = d.uu[i][c] - d.u[i].column(c).dot(&a);
+                rhs[c] = b.uu[i][c] - b.u[i].column(c).dot(&a);
             }
-            if m.parents[i].is_none() && k > 1 {
+            if parents[i].is_none() && k > 1 {
                 // Root with several DoF: d.dinv holds D itself (see pass 2).
-                let x = solve_spd(&d.dinv[i], k, &rhs).ok_or_else(|| singular(m, d, i, v))?;
+                let Some(x) = solve_spd(&b.dinv[i], k, &rhs) else {
+                    return Err(singular(m, d, i, v));
+                };
                 for r in 0..k {
-                    d.ddq[iv + r] = x[r];
-                    d.tau[iv + r] = tau[iv + r];
+                    b.ddq[iv + r] = x[r];
+                    b.tau[iv + r] = tau[iv + r];
                     a += s.column(r) * x[r];
                 }
-                d.oa[i] = Motion::from_v6(&a);
+                b.oa[i] = Motion::from_v6(&a);
                 continue;
             }
             for r in 0..k {
-                let x: f64 = (0..k).map(|c| d.dinv[i][(r, c)] * rhs[c]).sum();
-                d.ddq[iv + r] = x;
-                d.tau[iv + r] = tau[iv + r];
+                let x: f64 = (0..k).map(|c| b.dinv[i][(r, c)] * rhs[c]).sum();
+                b.ddq[iv + r] = x;
+                b.tau[iv + r] = tau[iv + r];
                 a += s.column(r) * x;
             }
         }
-        d.oa[i] = Motion::from_v6(&a);
+        b.oa[i] = Motion::from_v6(&a);
     }
     Ok(())
+}
+
+/// The buffers passes 2 and 3 index, as slices of exactly n entries (ddq, tau: nv) borrowed from `Data` once:
+/// local slices keep their lengths in registers, so `x[i]` with `i < n` needs no bounds check, where `d.x[i]`
+/// re-reads the vector's length after every store to a buffer.
+struct AbaBufs<'a> {
+    o_mi: &'a [Se3],
+    os: &'a [M6],
+    oc: &'a [Motion],
+    of: &'a mut [Force],
+    oa: &'a mut [Motion],
+    ia: &'a mut [M6],
+    u: &'a mut [M6],
+    dinv: &'a mut [M6],
+    uu: &'a mut [[f64; 6]],
+    ddq: &'a mut [f64],
+    tau: &'a mut [f64],
+}
+
+impl<'a> AbaBufs<'a> {
+    #[inline(always)]
+    fn of(d: &'a mut Data, n: usize) -> Self {
+        AbaBufs {
+            o_mi: &d.o_mi[..n],
+            os: &d.os[..n],
+            oc: &d.oc[..n],
+            of: &mut d.of[..n],
+            oa: &mut d.oa[..n],
+            ia: &mut d.ia[..n],
+            u: &mut d.u[..n],
+            dinv: &mut d.dinv[..n],
+            uu: &mut d.uu[..n],
+            ddq: &mut d.ddq[..],
+            tau: &mut d.tau[..],
+        }
+    }
 }
 
 /// Pass-2 step of a K-DoF joint (Featherstone, RBDA §7.3, eqs. 7.43–7.45 in inertial coordinates):
@@ -296,6 +357,26 @@ fn reduce_multi_dof<const K: usize>(m: &Model, d: &mut Data, i: usize, tau: &[f6
     d.ia[p] += ia_a;
     d.of[p] += Force::from_v6(&pa);
     Ok(())
+}
+
+/// `(A x, A y)` for a column-major 6×6 `A`, one pass over its columns.
+#[inline(always)]
+fn mat6_mul2(a: &[[f64; 6]; 6], x: &[f64; 6], y: &[f64; 6]) -> ([f64; 6], [f64; 6]) {
+    // the first column starts the sums (no additions to zero); fused multiply-adds for the rest
+    let mut ax: [f64; 6] = std::array::from_fn(|r| a[0][r] * x[0]);
+    let mut ay: [f64; 6] = std::array::from_fn(|r| a[0][r] * y[0]);
+    for c in 1..6 {
+        for r in 0..6 {
+            ax[r] = a[c][r].mul_add(x[c], ax[r]);
+            ay[r] = a[c][r].mul_add(y[c], ay[r]);
+        }
+    }
+    (ax, ay)
+}
+
+#[inline(always)]
+fn dot6(a: &[f64; 6], b: &[f64; 6]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
 }
 
 /// The error for a joint whose articulated inertia cannot be inverted. An overflow or a NaN upstream makes it look
@@ -360,46 +441,82 @@ fn solve_spd(dm: &M6, k: usize, b: &[f64; 6]) -> Option<[f64; 6]> {
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
-/// Solve `A x = b` for a symmetric positive-definite 6×6 `A` (lower triangle read) by an unrolled Cholesky
-/// factorisation `A = L Lᵀ`; `None` if `A` is not numerically positive definite or the result is not finite.
-/// Fixed loop bounds let the compiler unroll it completely (nalgebra's general Cholesky keeps its loops).
+/// Solve `A x = b` for a symmetric positive-definite 6×6 `A` (lower triangle read) by a Cholesky factorisation
+/// `A = L Lᵀ`; `None` if `A` is not numerically positive definite or the result is not finite.
+/// One const-generic step per column: every loop has a compile-time trip count and every index is a constant, so
+/// the whole solve is straight-line code without bounds checks (with run-time triangular bounds the compiler kept
+/// the loops and their checks: about a tenth of ABA on `naveen_dual_arm`). Same operations in the same order as
+/// the textbook loops, so the same result to the bit.
 #[inline]
 fn solve_spd6(a: &M6, b: &V6) -> Option<V6> {
-    let mut l = [[0.0f64; 6]; 6];
-    for j in 0..6 {
-        let mut djj = a[(j, j)];
-        for k in 0..j {
-            djj -= l[j][k] * l[j][k];
-        }
-        if !(djj > 0.0) {
-            return None;
-        }
-        let ljj = djj.sqrt();
-        l[j][j] = ljj;
-        let inv = 1.0 / ljj;
-        for i in j + 1..6 {
-            let mut x = a[(i, j)];
-            for k in 0..j {
-                x -= l[i][k] * l[j][k];
-            }
-            l[i][j] = x * inv;
-        }
+    let a = &a.data.0; // column-major: a[c][r] = A(r, c)
+    let mut l = [[0.0f64; 6]; 6]; // l[i][j] = L(i, j), j <= i
+    let ok = chol_col::<0>(a, &mut l)
+        && chol_col::<1>(a, &mut l)
+        && chol_col::<2>(a, &mut l)
+        && chol_col::<3>(a, &mut l)
+        && chol_col::<4>(a, &mut l)
+        && chol_col::<5>(a, &mut l);
+    if !ok {
+        return None;
     }
     let mut y = [0.0f64; 6];
-    for i in 0..6 {
-        let mut x = b[i];
-        for k in 0..i {
-            x -= l[i][k] * y[k];
-        }
-        y[i] = x / l[i][i];
+    fwd_row::<0>(&l, b, &mut y);
+    fwd_row::<1>(&l, b, &mut y);
+    fwd_row::<2>(&l, b, &mut y);
+    fwd_row::<3>(&l, b, &mut y);
+    fwd_row::<4>(&l, b, &mut y);
+    fwd_row::<5>(&l, b, &mut y);
+    let mut x = [0.0f64; 6];
+    back_row::<5>(&l, &y, &mut x);
+    back_row::<4>(&l, &y, &mut x);
+    back_row::<3>(&l, &y, &mut x);
+    back_row::<2>(&l, &y, &mut x);
+    back_row::<1>(&l, &y, &mut x);
+    back_row::<0>(&l, &y, &mut x);
+    x.iter().all(|v| v.is_finite()).then(|| V6::from(x))
+}
+
+/// Column J of the Cholesky factor: `L(J,J) = √(A(J,J) − Σₖ L(J,k)²)`, `L(i,J) = (A(i,J) − Σₖ L(i,k) L(J,k)) / L(J,J)`
+/// for i > J (k < J); false if the pivot is not positive.
+#[inline(always)]
+fn chol_col<const J: usize>(a: &[[f64; 6]; 6], l: &mut [[f64; 6]; 6]) -> bool {
+    let mut djj = a[J][J];
+    for k in 0..J {
+        djj -= l[J][k] * l[J][k];
     }
-    let mut x = V6::zeros();
-    for i in (0..6).rev() {
-        let mut s = y[i];
-        for k in i + 1..6 {
-            s -= l[k][i] * x[k];
-        }
-        x[i] = s / l[i][i];
+    if !(djj > 0.0) {
+        return false;
     }
-    x.iter().all(|v| v.is_finite()).then_some(x)
+    let ljj = djj.sqrt();
+    l[J][J] = ljj;
+    let inv = 1.0 / ljj;
+    for i in J + 1..6 {
+        let mut x = a[J][i];
+        for k in 0..J {
+            x -= l[i][k] * l[J][k];
+        }
+        l[i][J] = x * inv;
+    }
+    true
+}
+
+/// Row I of `L y = b`.
+#[inline(always)]
+fn fwd_row<const I: usize>(l: &[[f64; 6]; 6], b: &V6, y: &mut [f64; 6]) {
+    let mut x = b[I];
+    for k in 0..I {
+        x -= l[I][k] * y[k];
+    }
+    y[I] = x / l[I][I];
+}
+
+/// Row I of `Lᵀ x = y` (rows above I already solved).
+#[inline(always)]
+fn back_row<const I: usize>(l: &[[f64; 6]; 6], y: &[f64; 6], x: &mut [f64; 6]) {
+    let mut s = y[I];
+    for k in I + 1..6 {
+        s -= l[k][I] * x[k];
+    }
+    x[I] = s / l[I][I];
 }

@@ -2,7 +2,7 @@ use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::{universal_bias, universal_first_axis, JointType, Model};
-use crate::spatial::{rotation_about_axis, Motion, Se3, V3};
+use crate::spatial::{cross_fma, rotate_about_principal_axis, rotation_about_axis, Motion, Se3, M6, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
 /// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
@@ -15,11 +15,27 @@ pub fn forward_kinematics(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
 
 /// `forward_kinematics` without the argument check (`q` checked and normalised by the caller).
 pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
-    for i in 0..m.nbodies() {
-        d.li_mi[i] = joint_placement(m, d, i, q);
-        d.o_mi[i] = match m.parents[i] {
-            Some(p) => d.o_mi[p].compose(&d.li_mi[i]),
-            None => d.li_mi[i],
+    let n = m.nbodies();
+    // The model's per-body vectors have n entries (the builder makes them so); said once, it lets the compiler
+    // drop the bounds checks of the loop below. The Data buffers as n-entry slices: their lengths stay in
+    // registers instead of being re-read after every store.
+    assert!(
+        m.parents.len() == n
+            && m.idx_q.len() == n
+            && m.nqs.len() == n
+            && m.joint_types.len() == n
+            && m.placements.len() == n
+            && m.axes.len() == n
+            && m.axes2.len() == n
+            && m.principal_revolute().len() == n
+    );
+    let (li_mi, o_mi, s) = (&mut d.li_mi[..n], &mut d.o_mi[..n], &mut d.s[..n]);
+    for i in 0..n {
+        let li = joint_placement_at(m, &mut s[i], i, q);
+        li_mi[i] = li;
+        o_mi[i] = match m.parents[i] {
+            Some(p) => o_mi[p].compose(&li),
+            None => li,
         };
     }
 }
@@ -28,17 +44,28 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
 /// joint: one step of `forward_kinematics`.
 #[inline(always)]
 pub(crate) fn joint_placement(m: &Model, d: &mut Data, i: usize, q: &[f64]) -> Se3 {
+    joint_placement_at(m, &mut d.s[i], i, q)
+}
+
+/// `joint_placement` with body i's subspace buffer `s` (`d.s[i]`) given.
+#[inline(always)]
+pub(crate) fn joint_placement_at(m: &Model, s: &mut M6, i: usize, q: &[f64]) -> Se3 {
     let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
     let jt = m.joint_types[i];
     if jt == JointType::Universal {
         let s1 = universal_first_axis(&m.axes[i], &m.axes2[i], qi[1]);
-        d.s[i].fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
+        s.fixed_view_mut::<3, 1>(3, 0).copy_from(&s1);
     }
     match jt {
         // a rotation about the joint origin leaves the placement's translation as it is: one 3×3 product
+        // about a principal axis eₖ of the joint frame, `P R(eₖ, q)` only mixes two columns of P: 12 products
+        // instead of Rodrigues' formula and a dense 3×3 product (what CRBA does too)
         JointType::Revolute => {
             let p = &m.placements[i];
-            Se3::new(p.rot * rotation_about_axis(&m.axes[i], qi[0]), p.trans)
+            match m.principal_revolute()[i] {
+                Some(k) => Se3::new(rotate_about_principal_axis(&p.rot, k, qi[0]), p.trans),
+                None => Se3::new(p.rot * rotation_about_axis(&m.axes[i], qi[0]), p.trans),
+            }
         }
         _ => m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi)),
     }
@@ -70,12 +97,21 @@ pub(crate) fn joint_velocity(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motio
 /// prismatic one's [a; 0] gives `[R a; 0]`: one 3×3 product instead of the general motion transform.
 #[inline(always)]
 pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> Motion {
-    let o = &d.o_mi[i];
-    let s = &d.s[i];
+    subspace_column_at(m, &d.o_mi[i], &d.s[i], i, c)
+}
+
+/// `world_subspace_column` from body i's placement `o` and child-frame subspace `s` (for callers that hold
+/// other fields of `Data` borrowed).
+#[inline(always)]
+pub(crate) fn subspace_column_at(m: &Model, o: &Se3, s: &M6, i: usize, c: usize) -> Motion {
     match m.joint_types[i] {
         JointType::Revolute => {
-            let w = o.rot * V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]);
-            Motion::new(o.trans.cross(&w), w)
+            // about a principal axis eₖ, R a is column k of R (no product)
+            let w = match m.principal_revolute()[i] {
+                Some(k) => o.rot.column(k).into_owned(),
+                None => o.rot * V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]),
+            };
+            Motion::new(cross_fma(&o.trans, &w), w)
         }
         JointType::Prismatic => Motion::new(o.rot * V3::new(s[(0, 0)], s[(1, 0)], s[(2, 0)]), V3::zeros()),
         _ => o.act_motion(&Motion::from_v6(&s.column(c).into_owned())),
@@ -86,11 +122,17 @@ pub(crate) fn world_subspace_column(m: &Model, d: &Data, i: usize, c: usize) -> 
 /// eq. 3.41 `c_J`), after `forward_kinematics`.
 #[inline]
 pub(crate) fn joint_bias(m: &Model, d: &Data, i: usize, qd: &[f64]) -> Motion {
+    joint_bias_at(m, &d.s[i], i, qd)
+}
+
+/// `joint_bias` from body i's current child-frame subspace `s` (`d.s[i]`).
+#[inline]
+pub(crate) fn joint_bias_at(m: &Model, s: &M6, i: usize, qd: &[f64]) -> Motion {
     if m.joint_types[i] != JointType::Universal {
         return Motion::ZERO;
     }
     let k = m.idx_v[i];
-    let s1 = V3::new(d.s[i][(3, 0)], d.s[i][(4, 0)], d.s[i][(5, 0)]);
+    let s1 = V3::new(s[(3, 0)], s[(4, 0)], s[(5, 0)]);
     Motion::new(V3::zeros(), universal_bias(&s1, &m.axes2[i], qd[k], qd[k + 1]))
 }
 

@@ -1,4 +1,4 @@
-use super::{skew, Force, Motion, Se3, M3, M6, V3};
+use super::{cross_fma, skew, Force, Motion, Se3, M3, M6, V3};
 
 /// Rigid-body inertia in the parameters the whole project uses (ARCHITECTURE.md): mass, first
 /// moment `h = m c` and the rotational inertia `i_o` about the body-frame origin, all in body axes.
@@ -65,7 +65,14 @@ impl Inertia {
     /// Spatial momentum (about the body origin, body axes) of a body moving with twist `v`.
     #[inline]
     pub fn mul_motion(&self, v: &Motion) -> Force {
-        Force { lin: v.lin * self.mass - self.h.cross(&v.ang), ang: self.i_o * v.ang + self.h.cross(&v.lin) }
+        // fused multiply-adds throughout (ABA forms one momentum per body)
+        let (m, i, w) = (self.mass, &self.i_o, &v.ang);
+        let (hw, hv) = (cross_fma(&self.h, w), cross_fma(&self.h, &v.lin));
+        let iw = |r: usize| i[(r, 2)].mul_add(w.z, i[(r, 1)].mul_add(w.y, i[(r, 0)].mul_add(w.x, hv[r])));
+        Force {
+            lin: V3::new(v.lin.x.mul_add(m, -hw.x), v.lin.y.mul_add(m, -hw.y), v.lin.z.mul_add(m, -hw.z)),
+            ang: V3::new(iw(0), iw(1), iw(2)),
+        }
     }
 
     /// `mul_motion` as a linear map of the parameters: column k is the momentum contributed by
@@ -110,23 +117,32 @@ impl Inertia {
     /// The same inertia seen from the parent frame of `x` (x places this body's frame in the parent).
     ///
     /// Parallel-axis shift by `p` in the form `I' = R I Rᵀ − [p][h_r] − [h_r + m p][p]`, expanded with
-    /// `[a][b] = b aᵀ − (a·b) 1` into `R I Rᵀ − (h_r pᵀ + p h_rᵀ) + (2 p·h_r + m |p|²) 1 − m p pᵀ`: only the six
-    /// independent entries of the symmetric result are computed (the skew-matrix products cost 54 multiplications
-    /// by zero, which the compiler may not drop for floats). Featherstone, RBDA (2008), eq. 2.63.
+    /// `[a][b] = b aᵀ − (a·b) 1` into `R I Rᵀ − h_r pᵀ − p h'ᵀ + (p·(h_r + h')) 1` with `h' = h_r + m p` (the
+    /// transformed first moment): only the six independent entries of the symmetric result are computed, each as one
+    /// chain of fused multiply-adds (the skew-matrix products would cost 54 multiplications by zero, which the
+    /// compiler may not drop for floats). Featherstone, RBDA (2008), eq. 2.63.
     #[inline]
     pub fn transformed(&self, x: &Se3) -> Inertia {
-        let r = &x.rot;
-        let p = x.trans;
-        let m = self.mass;
-        let h_r = r * self.h;
-        // R I Rᵀ on the upper triangle: A = R I, then (A Rᵀ)_jk = A_j · R_k (rows), j ≤ k.
-        let a = r * self.i_o;
-        let e = |j: usize, k: usize| a[(j, 0)] * r[(k, 0)] + a[(j, 1)] * r[(k, 1)] + a[(j, 2)] * r[(k, 2)];
-        let diag = 2.0 * p.dot(&h_r) + m * p.norm_squared();
-        let s = |j: usize, k: usize| -(h_r[j] * p[k] + p[j] * h_r[k]) - m * p[j] * p[k];
-        let (xx, yy, zz) = (e(0, 0) + s(0, 0) + diag, e(1, 1) + s(1, 1) + diag, e(2, 2) + s(2, 2) + diag);
-        let (xy, xz, yz) = (e(0, 1) + s(0, 1), e(0, 2) + s(0, 2), e(1, 2) + s(1, 2));
-        Inertia { mass: m, h: h_r + p * m, i_o: M3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) }
+        let (r, io, m) = (&x.rot, &self.i_o, self.mass);
+        let (p, h) = (&x.trans, &self.h);
+        // h_r = R h
+        let hr = |j: usize| r[(j, 2)].mul_add(h.z, r[(j, 1)].mul_add(h.y, r[(j, 0)] * h.x));
+        let h_r = [hr(0), hr(1), hr(2)];
+        let pa = [p.x, p.y, p.z];
+        let hp: [f64; 3] = std::array::from_fn(|j| pa[j].mul_add(m, h_r[j]));
+        // A = R I (row j of R times column c of I)
+        let a =
+            |j: usize, c: usize| r[(j, 2)].mul_add(io[(2, c)], r[(j, 1)].mul_add(io[(1, c)], r[(j, 0)] * io[(0, c)]));
+        let ar: [[f64; 3]; 3] = std::array::from_fn(|j| [a(j, 0), a(j, 1), a(j, 2)]);
+        let diag = pa[0].mul_add(h_r[0] + hp[0], pa[1].mul_add(h_r[1] + hp[1], pa[2] * (h_r[2] + hp[2])));
+        // (A Rᵀ)(j, k) − h_r,j p_k − p_j h'_k, j ≤ k
+        let e = |j: usize, k: usize| {
+            let rak = ar[j][2].mul_add(r[(k, 2)], ar[j][1].mul_add(r[(k, 1)], ar[j][0] * r[(k, 0)]));
+            (-pa[j]).mul_add(hp[k], (-h_r[j]).mul_add(pa[k], rak))
+        };
+        let (xx, yy, zz) = (e(0, 0) + diag, e(1, 1) + diag, e(2, 2) + diag);
+        let (xy, xz, yz) = (e(0, 1), e(0, 2), e(1, 2));
+        Inertia { mass: m, h: V3::new(hp[0], hp[1], hp[2]), i_o: M3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz) }
     }
 
     /// Sum of two inertias expressed in the same frame (a composite body).

@@ -28,9 +28,23 @@ impl Se3 {
         Se3 { rot, trans }
     }
     /// Composition: (self * other) places C in A when self places B in A and other places C in B.
+    /// Column by column with fused multiply-adds on 3-vectors padded to four lanes (every step one vector
+    /// operation; forward kinematics does one per body).
     #[inline]
     pub fn compose(&self, o: &Se3) -> Se3 {
-        Se3 { rot: self.rot * o.rot, trans: self.rot * o.trans + self.trans }
+        type L4 = [f64; 4];
+        let r = &self.rot;
+        let c = |k: usize| -> L4 { [r[(0, k)], r[(1, k)], r[(2, k)], 0.0] };
+        let (r0, r1, r2) = (c(0), c(1), c(2));
+        // R v + b, lane by lane
+        let mv = |v: &V3, b: L4| -> L4 {
+            std::array::from_fn(|l| r2[l].mul_add(v.z, r1[l].mul_add(v.y, r0[l].mul_add(v.x, b[l]))))
+        };
+        let z = [0.0; 4];
+        let col = |k: usize| mv(&V3::new(o.rot[(0, k)], o.rot[(1, k)], o.rot[(2, k)]), z);
+        let (a, b, e) = (col(0), col(1), col(2));
+        let t = mv(&o.trans, [self.trans.x, self.trans.y, self.trans.z, 0.0]);
+        Se3 { rot: M3::new(a[0], b[0], e[0], a[1], b[1], e[1], a[2], b[2], e[2]), trans: V3::new(t[0], t[1], t[2]) }
     }
     /// The placement of A in B.
     #[inline]

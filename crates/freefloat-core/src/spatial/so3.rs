@@ -132,10 +132,13 @@ pub fn rotate_about_principal_axis(r: &M3, k: usize, angle: f64) -> M3 {
 
 #[inline(always)]
 fn mix_columns<const A: usize, const B: usize>(r: &M3, s: f64, c: f64) -> M3 {
-    let (ca, cb) = (r.column(A).into_owned(), r.column(B).into_owned());
     let mut out = *r;
-    out.set_column(A, &(ca * c + cb * s));
-    out.set_column(B, &(cb * c - ca * s));
+    // c eₐ-column + s e_b-column and c e_b-column − s eₐ-column, one fused multiply-add per entry
+    for row in 0..3 {
+        let (a, b) = (r[(row, A)], r[(row, B)]);
+        out[(row, A)] = a.mul_add(c, b * s);
+        out[(row, B)] = b.mul_add(c, -(a * s));
+    }
     out
 }
 

@@ -104,16 +104,32 @@ macro_rules! vec6_ops {
 vec6_ops!(Motion);
 vec6_ops!(Force);
 
+/// `a × b` with one fused multiply-add per entry (`a_j b_k − a_k b_j` as `fma(a_j, b_k, −a_k b_j)`).
+#[inline(always)]
+pub(crate) fn cross(a: &V3, b: &V3) -> V3 {
+    V3::new(a.y.mul_add(b.z, -(a.z * b.y)), a.z.mul_add(b.x, -(a.x * b.z)), a.x.mul_add(b.y, -(a.y * b.x)))
+}
+
+/// `a × b + c × d`, fused: two products of each pair folded into multiply-adds.
+#[inline(always)]
+fn cross2(a: &V3, b: &V3, c: &V3, d: &V3) -> V3 {
+    V3::new(
+        a.y.mul_add(b.z, c.y.mul_add(d.z, -(a.z * b.y)) - c.z * d.y),
+        a.z.mul_add(b.x, c.z.mul_add(d.x, -(a.x * b.z)) - c.x * d.z),
+        a.x.mul_add(b.y, c.x.mul_add(d.y, -(a.y * b.x)) - c.y * d.x),
+    )
+}
+
 impl Motion {
     /// Motion cross product `self ×m other` (derivative of a moving twist).
     #[inline]
     pub fn cross_motion(&self, m: &Motion) -> Motion {
-        Motion { lin: self.ang.cross(&m.lin) + self.lin.cross(&m.ang), ang: self.ang.cross(&m.ang) }
+        Motion { lin: cross2(&self.ang, &m.lin, &self.lin, &m.ang), ang: cross(&self.ang, &m.ang) }
     }
     /// Force cross product `self ×* f` (rate of change of a momentum carried by a moving frame).
     #[inline]
     pub fn cross_force(&self, f: &Force) -> Force {
-        Force { lin: self.ang.cross(&f.lin), ang: self.ang.cross(&f.ang) + self.lin.cross(&f.lin) }
+        Force { lin: cross(&self.ang, &f.lin), ang: cross2(&self.ang, &f.ang, &self.lin, &f.lin) }
     }
     /// Power of a wrench on this twist.
     #[inline]
