@@ -537,7 +537,11 @@ fn orbital_dual_forces() {
         assert!(close3(&g.r.v, &(-rb * (mi.mass() * MU_EARTH / rb.norm().powi(3))), 1e-14) && g.d.v == V3::zeros());
         // (2.67) = (2.68) = 0 + ε 3μ r × Īr / ‖r‖⁵ (2.63)
         let tau = rb.cross(&(mi.i_com() * rb)) * (3.0 * MU_EARTH / rb.norm().powi(5));
-        for gg in [gravity_gradient(&mi, &rb, MU_EARTH), gravity_gradient_old(&mi, &rb, MU_EARTH)] {
+        // (2.67) as the thesis writes it, in the dual algebra: `gravity_gradient` forms it with the zero parts of
+        // the dual cross product dropped, so the full product is checked here
+        let rd = DualQuat::vector(&V3::zeros(), &rb);
+        let dual_form = rd.swap().cross(&mi.apply(&rd)).scale(3.0 * MU_EARTH / rb.norm().powi(5));
+        for gg in [dual_form, gravity_gradient(&mi, &rb, MU_EARTH), gravity_gradient_old(&mi, &rb, MU_EARTH)] {
             assert!(gg.r.v.amax() == 0.0 && close3(&gg.d.v, &tau, 1e-12) && gg.is_vector(0.0));
         }
         // J2 (2.64) is the gradient of the J2 potential −μ J2 Re² (3z²/r² − 1)/(2 r³)

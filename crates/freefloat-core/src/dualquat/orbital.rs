@@ -28,10 +28,15 @@ pub fn gravity_gradient(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
 /// (2.67) from the inertia about the CoM alone: `M ⋆ r̂` with `r̂ = 0 + ε r` only reads the `Ī` block of `M`
 /// (`M ⋆ r̂ = 0 + ε Ī r`), so the mass (and an invertible `Ī`, which `DualInertia` demands) is not needed. The
 /// simulator uses this form for every body, including point masses and thin rods.
+///
+/// The dual cross product is formed with its zero parts dropped: `(r̂)^s = r + ε0` and `M ⋆ r̂ = 0 + ε Ī r`, so
+/// `(r + ε0) × (0 + ε Ī r) = r × 0 + ε (r × Ī r + 0 × 0) = 0 + ε r × (Ī r)`: one cross product instead of the
+/// general dual one (the simulator evaluates this for every body at every stage). `dualquat` tests check it
+/// against the old form (2.68) and the CoM-frame closed form (2.63).
 pub fn gravity_gradient_of(i_com: &M3, r_b: &V3, mu: f64) -> DualQuat {
-    let rd = DualQuat::vector(&V3::zeros(), r_b);
-    let m_rd = DualQuat::vector(&V3::zeros(), &(i_com * r_b));
-    rd.swap().cross(&m_rd).scale(3.0 * mu / r_b.norm().powi(5))
+    let r2 = r_b.norm_squared();
+    let k = 3.0 * mu / (r2 * r2 * r2.sqrt());
+    DualQuat::vector(&V3::zeros(), &(r_b.cross(&(i_com * r_b)) * k))
 }
 
 /// Differential point-mass gravity `g(R + r) − g(R)`, `g(x) = −μ x/‖x‖³` (2.62), for a point at `r` from a
