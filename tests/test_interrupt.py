@@ -264,8 +264,10 @@ def test_ctrl_c_stops_one_excitation_objective_batch_within_a_second(design):
     # the same call, small, still completes and agrees with the one-path evaluation
     one = d._objective(q[None], qd[None])
     two = d._objective(np.stack([q, q]), np.stack([qd, qd]))
-    # (one path gets both threads, two paths one each: the Gram sums differ in rounding only)
-    np.testing.assert_allclose(two["objective"], np.repeat(one["objective"], 2), rtol=1e-12)
+    # (one path gets both threads, two paths one each: the Gram sums differ in summation order only, and the
+    # objective, a condition-number measure of about 2e3 here, amplifies that rounding: 1e-12 was met until the
+    # kinematics took fused multiply-adds, 9.8e-12 after, on the CI machine)
+    np.testing.assert_allclose(two["objective"], np.repeat(one["objective"], 2), rtol=1e-10)
 
 
 def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
