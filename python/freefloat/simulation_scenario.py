@@ -195,7 +195,9 @@ def _torque_table(spec: str, m: Model, source: str, base_dir: Path | None):
     bad = np.flatnonzero(np.diff(t) <= 0)
     if bad.size:
         r = int(bad[0]) + 1
-        raise InputError(f"{where}: time is not strictly increasing at row {r} (t = {t[r]!r} after {t[r - 1]!r})")
+        # rows counted from 0 as the telemetry reader counts them; in a CSV, row k is line k + 2 (the header is 1)
+        line = f" (line {r + 2})" if p.suffix.lower() == ".csv" else ""
+        raise InputError(f"{where}: time is not strictly increasing at row {r}{line}: t = {t[r]!r} after {t[r - 1]!r}")
     tau = np.zeros((t.size, m.nv))
     for c in driven:
         tau[:, labels.index(c[4:])] = cols[c]
