@@ -3,7 +3,7 @@ use crate::data::Data;
 use crate::error::Result;
 use crate::kinematics::{joint_placement, world_subspace_column};
 use crate::model::{JointType, Model};
-use crate::spatial::{rotate_about_principal_axis, Motion, Se3, V3};
+use crate::spatial::{Motion, Se3, V3};
 
 /// Joint-space inertia matrix by the composite-rigid-body algorithm, into `d.mass_matrix` (full,
 /// symmetric). Works in one frame for every body (the inertial frame, or the base frame under a free root):
@@ -41,22 +41,15 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
         d.mass_matrix = nalgebra::DMatrix::zeros(nv, nv);
     }
     let free_root = n > 0 && m.joint_types[0] == JointType::Free;
-    let principal = m.principal_revolute();
     for i in 0..n {
         if i == 0 && free_root {
             d.o_mi[0] = Se3::identity();
             d.ic[0] = m.inertias[0];
             continue;
         }
-        // revolute joints about a principal axis of their frame: the rotation and subspace products specialised
-        let k = principal[i];
-        let li = match k {
-            Some(k) => {
-                let p = &m.placements[i];
-                Se3::new(rotate_about_principal_axis(&p.rot, k, q[m.idx_q[i]]), p.trans)
-            }
-            None => joint_placement(m, d, i, q),
-        };
+        // (revolute joints about a principal axis of their frame take the specialised rotation and subspace
+        // column inside `joint_placement` and `world_subspace_column`, as forward kinematics and ABA do)
+        let li = joint_placement(m, d, i, q);
         d.li_mi[i] = li;
         let o = match m.parents[i] {
             Some(0) if free_root => li,
@@ -65,18 +58,9 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
         };
         d.o_mi[i] = o;
         d.ic[i] = m.inertias[i].transformed(&o);
-        match k {
-            // [p × R eₖ; R eₖ]: the world subspace of `world_subspace_column` with R a = column k of R
-            Some(k) => {
-                let w = o.rot.column(k).into_owned();
-                d.os[i].set_column(0, &Motion::new(o.trans.cross(&w), w).to_v6());
-            }
-            None => {
-                for c in 0..m.nvs[i] {
-                    let s = world_subspace_column(m, d, i, c);
-                    d.os[i].set_column(c, &s.to_v6());
-                }
-            }
+        for c in 0..m.nvs[i] {
+            let s = world_subspace_column(m, d, i, c);
+            d.os[i].set_column(c, &s.to_v6());
         }
     }
     // Entries of bodies that are not on one path from the root are zero; the sweep writes all the others. Filled
