@@ -159,7 +159,7 @@ def _torque_table(spec: str, m: Model, source: str, base_dir: Path | None):
     tau.<coordinate> per driven coordinate (`Model.v_labels()`, as a trajectory file names them; absent
     coordinates get zero). A trajectory file's other columns are ignored, any other column is refused."""
     from .io import scenario_files
-    from .io.telemetry import check_finite, read_columns
+    from .io.telemetry import check_finite, check_increasing, read_columns
 
     p = Path(spec)
     if base_dir is not None and not p.is_absolute():
@@ -192,12 +192,7 @@ def _torque_table(spec: str, m: Model, source: str, base_dir: Path | None):
         raise InputError(f"{where}: the table has no rows")
     if t[0] > 0.0:
         raise InputError(f"{where}: the first row is at t = {t[0]!r} s; the table must start at t = 0 (the run start)")
-    bad = np.flatnonzero(np.diff(t) <= 0)
-    if bad.size:
-        r = int(bad[0]) + 1
-        # rows counted from 0 as the telemetry reader counts them; in a CSV, row k is line k + 2 (the header is 1)
-        line = f" (line {r + 2})" if p.suffix.lower() == ".csv" else ""
-        raise InputError(f"{where}: time is not strictly increasing at row {r}{line}: t = {t[r]!r} after {t[r - 1]!r}")
+    check_increasing(t, where, first_line=2 if p.suffix.lower() == ".csv" else None)  # a CSV's header is line 1
     tau = np.zeros((t.size, m.nv))
     for c in driven:
         tau[:, labels.index(c[4:])] = cols[c]

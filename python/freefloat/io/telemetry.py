@@ -280,13 +280,21 @@ def check_finite(cols: dict, names: list, where: str) -> None:
             )
 
 
-def _check_time(t: np.ndarray, where: str) -> None:
-    if t.size < 2:
-        return
+def check_increasing(t: np.ndarray, where: str, first_line: int | None = None) -> None:
+    """InputError naming the first row (counted from 0) whose time is not later than the one before; with
+    `first_line` (the file line of row 0, 2 for a CSV with its header) also that row's line."""
     dt = np.diff(t)
     if np.any(dt <= 0):
         r = int(np.argmax(dt <= 0)) + 1
-        raise InputError(f"{where}: time is not strictly increasing at row {r} (t = {t[r]!r} after {t[r - 1]!r})")
+        line = f", line {r + first_line}" if first_line is not None else ""
+        raise InputError(f"{where}: time is not strictly increasing at row {r}{line} (t = {t[r]!r} after {t[r - 1]!r})")
+
+
+def _check_time(t: np.ndarray, where: str) -> None:
+    if t.size < 2:
+        return
+    check_increasing(t, where)
+    dt = np.diff(t)
     med = float(np.median(dt))
     gap = dt > GAP_FACTOR * med
     if gap.any():
