@@ -192,6 +192,7 @@ def test_bad_torques_blocks_are_named(tmp_path, torques, words):
         ("t,tau.rw\n0,0.1\n0.5,abc\n", "column 'tau.rw' row 1 (line 3): 'abc' is not a number"),
         ("t,rw\n0,0.1\n", "did you mean 'tau.rw'"),
         ("t,tau.rw\n0.1,0.1\n0.5,0\n", "must start at t = 0"),
+        ("t,tau.rw\n-0.1,0.1\n0.5,0\n", "must start at t = 0"),
         ("t,tau.rw\n0,0.1\n0,0\n", "not strictly increasing at row 1, line 3"),
         ("t,q.x\n0,0.1\n", "no tau.<coordinate> column"),
         ("time,tau.rw\n0,0.1\n", "no column 't'"),
