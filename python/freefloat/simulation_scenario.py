@@ -191,7 +191,9 @@ def _torque_table(spec: str, m: Model, source: str, base_dir: Path | None):
     if t.size == 0:
         raise InputError(f"{where}: the table has no rows")
     if t[0] != 0.0:
-        raise InputError(f"{where}: the first row is at t = {t[0]!r} s; the table must start at t = 0 (the run start)")
+        raise InputError(
+            f"{where}: the first row is at t = {float(t[0])!r} s; the table must start at t = 0 (the run start)"
+        )
     check_increasing(t, where, first_line=2 if p.suffix.lower() == ".csv" else None)  # a CSV's header is line 1
     tau = np.zeros((t.size, m.nv))
     for c in driven:

@@ -287,7 +287,9 @@ def check_increasing(t: np.ndarray, where: str, first_line: int | None = None) -
     if np.any(dt <= 0):
         r = int(np.argmax(dt <= 0)) + 1
         line = f", line {r + first_line}" if first_line is not None else ""
-        raise InputError(f"{where}: time is not strictly increasing at row {r}{line} (t = {t[r]!r} after {t[r - 1]!r})")
+        raise InputError(
+            f"{where}: time is not strictly increasing at row {r}{line} (t = {float(t[r])!r} after {float(t[r - 1])!r})"
+        )
 
 
 def _check_time(t: np.ndarray, where: str) -> None:
@@ -300,8 +302,8 @@ def _check_time(t: np.ndarray, where: str) -> None:
     if gap.any():
         r = int(np.argmax(gap)) + 1
         raise InputError(
-            f"{where}: gap in time before row {r}: step {dt[r - 1]:.6g} s from t = {t[r - 1]!r} to {t[r]!r} "
-            f"is more than {GAP_FACTOR}× the median step {med:.6g} s ({int(gap.sum())} gap(s))"
+            f"{where}: gap in time before row {r}: step {dt[r - 1]:.6g} s from t = {float(t[r - 1])!r} to "
+            f"{float(t[r])!r} is more than {GAP_FACTOR}× the median step {med:.6g} s ({int(gap.sum())} gap(s))"
         )
 
 
