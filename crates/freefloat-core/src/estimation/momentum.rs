@@ -1,14 +1,14 @@
 //! Identification from momentum (Naveen, Shah, Misra, eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
 
 use super::analysis::{check_rank, finish};
-use super::gram::GramLs;
+use super::gram::{gram_update, GramLs};
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
 use crate::interrupt::{supervise, Hook};
 use crate::kinematics::forward_velocities_unchecked;
 use crate::model::Model;
-use crate::regressors::momentum_regressor_from_data_unchecked;
+use crate::regressors::body_momentum_columns;
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -93,31 +93,46 @@ struct BlockBuilder<'a> {
     m: &'a Model,
     p: &'a MomentumProblem<'a>,
     d: Data,
-    /// the 6 × 10·nbodies regressor of one sample, column-major
-    k: Vec<f64>,
     qbuf: Vec<f64>,
     block: DMatrix<f64>,
-    /// (column, parameter) of the known, nonzero standard parameters
-    known: Vec<(usize, f64)>,
+    /// the bodies that have a column to keep or a known, nonzero parameter, in body order
+    bodies: Vec<BodyColumns>,
     sw: [f64; 6],
+}
+
+/// What the block builder takes from one body's ten regressor columns.
+struct BodyColumns {
+    body: usize,
+    /// (column k of the body, block column j) of the unknowns
+    kept: Vec<(usize, usize)>,
+    /// (column k of the body, parameter) of the known, nonzero standard parameters (moved to the right-hand side)
+    known: Vec<(usize, f64)>,
 }
 
 impl<'a> BlockBuilder<'a> {
     fn new(m: &'a Model, p: &'a MomentumProblem<'a>) -> Self {
         let n = p.unknown_cols.len();
-        let known = (0..p.known_params.len())
-            .filter(|c| p.known_params[*c] != 0.0 && !p.unknown_cols.contains(c))
-            .map(|c| (c, p.known_params[c]))
+        let bodies = (0..m.nbodies())
+            .map(|i| BodyColumns {
+                body: i,
+                kept: (0..10)
+                    .filter_map(|k| p.unknown_cols.iter().position(|&c| c == 10 * i + k).map(|j| (k, j)))
+                    .collect(),
+                known: (0..10)
+                    .map(|k| (k, p.known_params[10 * i + k]))
+                    .filter(|&(k, pk)| pk != 0.0 && !p.unknown_cols.contains(&(10 * i + k)))
+                    .collect(),
+            })
+            .filter(|b| !b.kept.is_empty() || !b.known.is_empty())
             .collect();
         let sw = p.weights.map_or([1.0; 6], |w| w.map(f64::sqrt));
         BlockBuilder {
             m,
             p,
             d: Data::new(m),
-            k: vec![0.0; 60 * m.nbodies()],
             qbuf: Vec::new(),
             block: DMatrix::zeros(6 * BLOCK_SAMPLES, n + 1),
-            known,
+            bodies,
             sw,
         }
     }
@@ -129,29 +144,31 @@ impl<'a> BlockBuilder<'a> {
     fn fill(&mut self, s: usize, slot: usize, cnt: usize) -> Result<()> {
         let (m, p) = (self.m, self.p);
         let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
-        let cols = 10 * m.nbodies();
-        let mut k = nalgebra::DMatrixViewMut::from_slice(&mut self.k, 6, cols); // column-major, as the block
-                                                                                // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
+        // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
         forward_velocities_unchecked(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv]);
-        momentum_regressor_from_data_unchecked(m, &self.d, &mut k);
         let n = p.unknown_cols.len();
-        // both K (6 × np) and the block are column-major: copy six contiguous numbers per column
-        let ks = &self.k[..];
         let cap = self.block.nrows();
         let bs = self.block.as_mut_slice();
         let (lin0, ang0) = (3 * slot, 3 * cnt + 3 * slot);
-        for (j, &c) in p.unknown_cols.iter().enumerate() {
-            let src = &ks[6 * c..6 * c + 6];
-            let col = &mut bs[j * cap..(j + 1) * cap];
-            for r in 0..3 {
-                col[lin0 + r] = self.sw[r] * src[r];
-                col[ang0 + r] = self.sw[r + 3] * src[r + 3];
-            }
-        }
+        let sw = self.sw;
         let mut y: [f64; 6] = std::array::from_fn(|r| p.h[6 * s + r]);
-        for &(c, pk) in &self.known {
-            for r in 0..6 {
-                y[r] -= ks[6 * c + r] * pk;
+        // Only the kept columns are written, straight into their block column (no full 6 × 10·nbodies regressor
+        // and no copy of it): the columns of the bodies in use, from the one formula (Naveen, Shah, Misra, eq. 10).
+        for b in &self.bodies {
+            let cols = body_momentum_columns(&self.d, b.body);
+            for &(k, j) in &b.kept {
+                let src = &cols[k];
+                let (lin, ang) = bs[j * cap..(j + 1) * cap].split_at_mut(ang0);
+                let (lin, ang) = (&mut lin[lin0..lin0 + 3], &mut ang[..3]);
+                for r in 0..3 {
+                    lin[r] = sw[r] * src[r];
+                    ang[r] = sw[r + 3] * src[r + 3];
+                }
+            }
+            for &(k, pk) in &b.known {
+                for r in 0..6 {
+                    y[r] -= cols[k][r] * pk;
+                }
             }
         }
         for r in 0..3 {
@@ -213,8 +230,7 @@ impl SplitGram {
         for (a, &j) in self.lin.iter().enumerate() {
             self.buf.view_mut((0, a), (half, 1)).copy_from(&block.view((0, j), (half, 1)));
         }
-        let b = self.buf.rows(0, half);
-        self.small.gemm_tr(1.0, &b, &b, 1.0);
+        gram_update(&mut self.small, &self.buf, 0, half);
     }
 
     fn finish(mut self) -> GramLs {

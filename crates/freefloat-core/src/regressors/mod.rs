@@ -6,12 +6,11 @@ mod dynamics;
 mod momentum;
 
 pub use dynamics::dynamics_regressor;
-pub(crate) use momentum::momentum_regressor_from_data_unchecked;
+pub(crate) use momentum::{body_momentum_columns, momentum_regressor_from_data_unchecked};
 pub use momentum::{momentum_regressor, momentum_regressor_from_data};
 
 use crate::error::Result;
 use crate::model::Model;
-use crate::spatial::Force;
 use nalgebra::{Dyn, Matrix, StorageMut};
 
 /// Any dynamically sized matrix the regressors can write into: a `DMatrix` or a view of one,
@@ -21,13 +20,4 @@ pub type RegressorOut<S> = Matrix<f64, Dyn, Dyn, S>;
 /// The output must be `rows` × 10·nbodies.
 fn check_out<S: StorageMut<f64, Dyn, Dyn>>(m: &Model, out: &RegressorOut<S>, rows: usize) -> Result<()> {
     crate::check::check_shape("out", out.nrows(), out.ncols(), (rows, 10 * m.nbodies()))
-}
-
-/// Write a force as rows 0..6 of column `col`.
-#[inline]
-fn write_column<S: StorageMut<f64, Dyn, Dyn>>(out: &mut RegressorOut<S>, col: usize, f: &Force) {
-    for r in 0..3 {
-        out[(r, col)] = f.lin[r];
-        out[(r + 3, col)] = f.ang[r];
-    }
 }

@@ -1,10 +1,10 @@
-use super::{check_out, write_column, RegressorOut};
+use super::{check_out, RegressorOut};
 use crate::check::{check_args, check_data, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
 use crate::kinematics::forward_velocities_unchecked;
 use crate::model::Model;
-use crate::spatial::{Force, V3};
+use crate::spatial::V3;
 use nalgebra::{Dyn, StorageMut};
 
 /// Momentum regressor `K` (6 × 10·nbodies): `momentum(q, v) == K · vec(P)`, momentum being
@@ -53,23 +53,40 @@ pub(crate) fn momentum_regressor_from_data_unchecked<S: StorageMut<f64, Dyn, Dyn
     d: &Data,
     out: &mut RegressorOut<S>,
 ) {
-    let z = V3::zeros();
     for i in 0..m.nbodies() {
-        let (rot, p) = (&d.o_mi[i].rot, d.o_mi[i].trans);
-        let (vb, wb) = (d.v[i].lin, d.v[i].ang);
-        let (vo, wo) = (rot * vb, rot * wb);
-        let r = [rot.column(0).into_owned(), rot.column(1).into_owned(), rot.column(2).into_owned()];
-        let c = 10 * i;
-        write_column(out, c, &Force::new(vo, p.cross(&vo)));
-        for k in 0..3 {
-            let lin = wo.cross(&r[k]);
-            write_column(out, c + 1 + k, &Force::new(lin, r[k].cross(&vo) + p.cross(&lin)));
+        for (k, col) in body_momentum_columns(d, i).iter().enumerate() {
+            for r in 0..6 {
+                out[(r, 10 * i + k)] = col[r];
+            }
         }
-        write_column(out, c + 4, &Force::new(z, r[0] * wb.x));
-        write_column(out, c + 5, &Force::new(z, r[0] * wb.y + r[1] * wb.x));
-        write_column(out, c + 6, &Force::new(z, r[1] * wb.y));
-        write_column(out, c + 7, &Force::new(z, r[0] * wb.z + r[2] * wb.x));
-        write_column(out, c + 8, &Force::new(z, r[1] * wb.z + r[2] * wb.y));
-        write_column(out, c + 9, &Force::new(z, r[2] * wb.z));
     }
+}
+
+/// Body i's ten columns of the momentum regressor, `[p; L]` each (see [`momentum_regressor`]), from `d.o_mi[i]`
+/// and the body twist `d.v[i]`: the one copy of Naveen, Shah, Misra's eq. 10, shared by the regressor and by the
+/// identification's block builder (which keeps only some columns and so writes them itself).
+#[inline]
+pub(crate) fn body_momentum_columns(d: &Data, i: usize) -> [[f64; 6]; 10] {
+    let (rot, p) = (&d.o_mi[i].rot, d.o_mi[i].trans);
+    let (vb, wb) = (d.v[i].lin, d.v[i].ang);
+    let (vo, wo) = (rot * vb, rot * wb);
+    let r = [rot.column(0).into_owned(), rot.column(1).into_owned(), rot.column(2).into_owned()];
+    let col = |lin: V3, ang: V3| [lin.x, lin.y, lin.z, ang.x, ang.y, ang.z];
+    let z = V3::zeros();
+    let h = |k: usize| {
+        let lin = wo.cross(&r[k]);
+        col(lin, r[k].cross(&vo) + p.cross(&lin))
+    };
+    [
+        col(vo, p.cross(&vo)),
+        h(0),
+        h(1),
+        h(2),
+        col(z, r[0] * wb.x),
+        col(z, r[0] * wb.y + r[1] * wb.x),
+        col(z, r[1] * wb.y),
+        col(z, r[0] * wb.z + r[2] * wb.x),
+        col(z, r[1] * wb.z + r[2] * wb.y),
+        col(z, r[2] * wb.z),
+    ]
 }

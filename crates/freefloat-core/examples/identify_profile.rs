@@ -1,0 +1,69 @@
+//! Fixed workloads for the two stages of momentum identification (Naveen, Shah, Misra, eqs. 26-27), for
+//! instruction counts (`valgrind --tool=callgrind`) and indicative wall times:
+//! - `pass MODEL SAMPLES`: the streaming regressor build (kinematics, the kept columns, the right-hand side) over
+//!   deterministic states, every column of the non-root bodies kept (no solve);
+//! - `gram REPS`: the Gram accumulation alone, one block of 64 samples (192 angular rows x 53 columns) REPS times.
+//!
+//! Build and run:
+//!
+//!     cargo build --release -p freefloat-core --example identify_profile
+//!     target/release/examples/identify_profile pass naveen_dual_arm 20000
+//!     target/release/examples/identify_profile gram 20000
+use freefloat_core::estimation::{momentum_regressor_pass, GramLs, MomentumProblem};
+use freefloat_core::model::builtin;
+use nalgebra::DMatrix;
+use std::time::Instant;
+
+/// A deterministic, well-mixed number in [-0.5, 0.5) (no randomness crate needed for a timing workload).
+fn mix(i: usize, j: usize) -> f64 {
+    ((i * 37 + j * 101) % 97) as f64 / 97.0 - 0.5
+}
+
+fn pass(model: &str, t: usize) {
+    let m = builtin::load(model).expect("built-in model");
+    let mut q = Vec::with_capacity(t * m.nq);
+    let mut v = Vec::with_capacity(t * m.nv);
+    for s in 0..t {
+        let mut qs = m.neutral();
+        for (k, x) in qs.iter_mut().enumerate() {
+            *x += 3.0 * mix(s, k);
+        }
+        let n = qs[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+        qs[3..7].iter_mut().for_each(|x| *x /= n);
+        q.extend_from_slice(&qs);
+        v.extend((0..m.nv).map(|k| mix(s + 7, k)));
+    }
+    let h: Vec<f64> = (0..6 * t).map(|k| mix(k, 3)).collect();
+    let unknown: Vec<usize> = (10..10 * m.nbodies()).collect();
+    let known = vec![0.0; 10 * m.nbodies()];
+    let p = MomentumProblem { q: &q, v: &v, h: &h, unknown_cols: &unknown, known_params: &known, weights: None };
+    let t0 = Instant::now();
+    let sum = momentum_regressor_pass(&m, &p).expect("regressor pass");
+    let dt = t0.elapsed().as_secs_f64();
+    println!("{:.1} ns per sample ({} columns), checksum {sum:.6e}", dt / t as f64 * 1e9, unknown.len());
+}
+
+fn gram(reps: usize) {
+    let (rows, n) = (192, 52);
+    let block = DMatrix::from_fn(2 * rows, n + 1, mix);
+    let mut g = GramLs::new(n);
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        g.add_augmented_range(&block, rows, rows);
+    }
+    let dt = t0.elapsed().as_secs_f64();
+    let (rss, yty) = g.rss_at(&nalgebra::DVector::zeros(n));
+    println!("{:.1} ns per sample (3 rows), checksum {rss:.6e} {yty:.6e}", dt / (reps * rows / 3) as f64 * 1e9);
+}
+
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    match (a.get(1).map(String::as_str), a.len()) {
+        (Some("pass"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number")),
+        (Some("gram"), 3) => gram(a[2].parse().expect("repetitions: a whole number")),
+        _ => {
+            eprintln!("usage: identify_profile pass <builtin model> <samples> | identify_profile gram <repetitions>");
+            std::process::exit(2);
+        }
+    }
+}
