@@ -109,9 +109,10 @@ pub(super) fn gram_update(g: &mut DMatrix<f64>, block: &DMatrix<f64>, start: usi
     assert!(start + rows <= cap && g.nrows() == n1 && g.ncols() == n1, "Gram update: shapes");
     // G += BᵀB by matrixmultiply's blocked kernel (packed panels, register tiles, FMA), which reads each entry of
     // B a few times; nalgebra's `gemm_tr` forms one dot product per entry of G and reads both columns from memory
-    // every time: 3.4× slower on a 192 × 53 block (examples/gram_profile.rs). Bᵀ is B itself with its strides
+    // every time: 3.4× slower on a 192 × 53 block (examples/identify_profile.rs gram). Bᵀ is B itself with its strides
     // swapped (no copy). G is symmetric and the full product costs about twice its triangle, but a triangle
-    // made of smaller products repacks the panels. (A hand-made transposed view fed to nalgebra's `gemm` once
+    // made of smaller products (2, 3, 4 column panels: 3, 6, 10 calls) measured 1.4-3× slower than the one full
+    // call: each call packs its panels afresh. (A hand-made transposed view fed to nalgebra's `gemm` once
     // read and wrote out of bounds inside nalgebra on some block sizes: the raw call below states its strides.)
     let (cap_s, n1_s) = (cap as isize, n1 as isize);
     // SAFETY: entry (r, c) of B is at offset r + c·cap from block[start, 0], r < rows and start + rows <= cap,
