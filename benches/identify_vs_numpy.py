@@ -12,8 +12,10 @@ freefloat: `freefloat.estimation.least_squares` - the engine streams over the sa
   402,000 x 52 matrix is never formed.  It keeps the normal equations only when the measured, equilibrated
   condition number is small (and refines on the true residual when it is not tiny), otherwise it re-streams
   through a Householder QR.
-numpy peer: body placements and twists from ff.forward_kinematics / ff.body_velocities, transposed once into
-  components-first arrays (not timed: the regressor algebra is what is compared), then
+numpy peer: body placements and twists either from ff.forward_kinematics / ff.body_velocities, transposed once
+  into components-first arrays and not timed (the rows `regressor` and `end_to_end`: the regressor algebra alone
+  is compared, freefloat doing its kinematics and the peer not), or from its own vectorised numpy kinematics,
+  timed (the rows `regressor_kin` and `end_to_end_kin`: both start from the measured q, v, h), then
   - build: only the 52 kept columns of all 67,000 samples, each with a few array operations over contiguous
     memory written straight into its slot of a column-ordered (52, 6, T) array (a Fortran-ordered 402,000 x 52
     matrix for LAPACK, no copy), the known wheels' momentum only for their nonzero parameters;
@@ -26,8 +28,9 @@ numpy peer: body placements and twists from ff.forward_kinematics / ff.body_velo
 Timed (wall clock, interleaved repeats, median and min-max):
   regressor : freefloat's streaming build pass (kinematics + kept columns + right-hand side, no solve)
               vs the peer's build of G and y;
-  end_to_end: freefloat least_squares (from Q, V, H) vs the peer's build + normal-equation solve.
-Both regressors and both estimates are checked to agree before anything is timed.
+  end_to_end: freefloat least_squares (from Q, V, H) vs the peer's build + normal-equation solve;
+  *_kin     : the same with the peer's kinematics timed (freefloat's rows are the same measurements).
+Both regressors, both estimates and both kinematics are checked to agree before anything is timed.
 
 Cores: by default both programs use every core (freefloat splits the samples over threads, OpenBLAS threads its
 products).  `--cores 1` re-runs the script pinned to one core with OPENBLAS_NUM_THREADS=1 (single-core numbers
@@ -62,7 +65,7 @@ from freefloat import estimation as est
 MODEL = "naveen_dual_arm"
 DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]
 NOISE = 0.1
-TARGETS = {"regressor": 5.0, "end_to_end": 10.0}
+TARGETS = {"regressor": 5.0, "end_to_end": 10.0, "regressor_kin": 5.0, "end_to_end_kin": 10.0}
 
 
 def multisine(m, seed=1):
@@ -121,15 +124,21 @@ def peer_inputs(fk, tw, H):
 
 
 class Kin:
-    """Per-body inertial-frame quantities of all samples at once: R's columns r_k, v_o = R v, ω_o = R ω, p × v_o."""
+    """Per-body inertial-frame quantities of all samples at once: R's columns r_k, v_o = R v, ω_o = R ω, p × v_o.
 
-    def __init__(self, fkT, twT):
-        self.p, self.v, self.w = fkT[:3], twT[:3], twT[3:]
-        self.r = quat_columns(fkT[3:])
-        r, v, w = self.r, self.v, self.w
+    p (3, nb, T) body origins; r the three columns of R, each (3, nb, T); v, w (3, nb, T) body twists in the body
+    frame."""
+
+    def __init__(self, p, r, v, w):
+        self.p, self.r, self.v, self.w = p, r, v, w
         self.vo = r[0] * v[0] + r[1] * v[1] + r[2] * v[2]
         self.wo = r[0] * w[0] + r[1] * w[1] + r[2] * w[2]
         self.pvo = cross(self.p, self.vo)
+
+    @classmethod
+    def from_placements(cls, fkT, twT):
+        """From freefloat's placements (7, nb, T: position, quaternion x y z w) and twists (6, nb, T)."""
+        return cls(fkT[:3], quat_columns(fkT[3:]), twT[:3], twT[3:])
 
     def column(self, c, out):
         """Column c (body c // 10, parameter c % 10) of the momentum regressor into out (6, T):
@@ -154,7 +163,108 @@ class Kin:
         return out
 
 
-def numpy_build(fkT, twT, H6, cols, known):
+def _comb(terms, out):
+    """out = Σ c·a over (c, a) in terms, the exact 0/1 geometry folded: zero coefficients are skipped, ±1 cost no
+    multiplication. At least one coefficient is nonzero."""
+    terms = [(c, a) for c, a in terms if c != 0.0]
+    c, a = terms[0]
+    if c == 1.0:
+        out[...] = a
+    elif c == -1.0:
+        np.negative(a, out=out)
+    else:
+        np.multiply(a, c, out=out)
+    for c, a in terms[1:]:
+        if c == 1.0:
+            out += a
+        elif c == -1.0:
+            out -= a
+        else:
+            out += c * a
+    return out
+
+
+class NumpyKinematics:
+    """The peer's own kinematics: body placements and twists of all samples at once in vectorised numpy, for the
+    rows where the peer starts, like freefloat, from the measured q and v (Featherstone, RBDA §4.1, joint by joint
+    from the root). Components first, samples last. The joint frames' geometry is read from the model once, with
+    its exact zeros and ones folded (a placement rotation that is a signed permutation costs no multiplication, a
+    zero offset no term). Handles what the benchmark robot has: a free root and revolute joints about a principal
+    axis of their frame."""
+
+    def __init__(self, m):
+        types, axes = list(m.joint_types), np.asarray(m.joint_axes, float)
+        if types[0] != "free" or any(t != "revolute" for t in types[1:]):
+            raise SystemExit(f"ABORT: the numpy kinematics handles a free root and revolute joints, not {types}")
+        self.nb, self.parents = m.nbodies, list(m.parents)
+        self.iq, self.iv = list(m.idx_q), list(m.idx_v)
+        self.joints = []
+        for i in range(1, self.nb):
+            hit = [k for k in range(3) if np.array_equal(axes[i], np.eye(3)[k])]
+            if not hit:
+                raise SystemExit(f"ABORT: joint {i} axis {axes[i]} is not a principal axis")
+            X = np.asarray(m.placements[i], float)
+            self.joints.append((i, X[:3, :3].copy(), X[:3, 3].copy(), hit[0]))
+
+    def __call__(self, Q, V):
+        """(p, r, v, w) as `Kin` takes them, from Q (T, nq) and V (T, nv)."""
+        QT, VT = np.ascontiguousarray(Q.T), np.ascontiguousarray(V.T)
+        T, nb = QT.shape[1], self.nb
+        p, r = np.empty((3, nb, T)), np.empty((3, 3, nb, T))  # r[k, a, i]: component a of column k of R_i
+        v, w = np.empty((3, nb, T)), np.empty((3, nb, T))
+        # the free root: position, rotation from the unit quaternion (x y z w), body-frame twist [v; ω]
+        p[:, 0] = QT[0:3]
+        rc = quat_columns(QT[3:7])
+        for k in range(3):
+            r[k, :, 0] = rc[k]
+        v[:, 0], w[:, 0] = VT[0:3], VT[3:6]
+        u = np.empty((3, T))
+        for i, R0, t0, k in self.joints:
+            par = self.parents[i]
+            c, s_ = np.cos(QT[self.iq[i]]), np.sin(QT[self.iq[i]])
+            rp = r[:, :, par]
+            # M = R_p R0 (column j = Σ_k R0[k, j] r_k), then R_i = M Rot_k(θ): columns a, b = the two others
+            # (cyclic) turn by θ, column k stays
+            M = np.empty((3, 3, T))
+            for j in range(3):
+                for a in range(3):
+                    _comb([(R0[kk, j], rp[kk, a]) for kk in range(3)], M[j, a])
+            a_, b_ = (k + 1) % 3, (k + 2) % 3
+            ri = r[:, :, i]
+            ri[k] = M[k]
+            np.multiply(M[a_], c, out=ri[a_])
+            ri[a_] += M[b_] * s_
+            np.multiply(M[b_], c, out=ri[b_])
+            ri[b_] -= M[a_] * s_
+            # p_i = p_p + R_p t0
+            p[:, i] = p[:, par]
+            for kk in range(3):
+                if t0[kk] != 0.0:
+                    p[:, i] += t0[kk] * rp[kk]
+            # twist: x_i = Rot_k(θ)ᵀ R0ᵀ x_p for ω, and for v after moving to the joint origin (v_p + ω_p × t0);
+            # then ω_i += e_k q̇ (a revolute joint's subspace is [0; e_k] in its own frame)
+            wp, vp = w[:, par], v[:, par]
+            u[0], u[1], u[2] = vp[0], vp[1], vp[2]
+            for a in range(3):
+                b1, b2 = (a + 1) % 3, (a + 2) % 3  # (ω × t)_a = ω_b1 t_b2 − ω_b2 t_b1
+                if t0[b2] != 0.0:
+                    u[a] += t0[b2] * wp[b1]
+                if t0[b1] != 0.0:
+                    u[a] -= t0[b1] * wp[b2]
+            for src, dst in ((wp, w[:, i]), (u, v[:, i])):
+                x = np.empty((3, T))
+                for j in range(3):
+                    _comb([(R0[kk, j], src[kk]) for kk in range(3)], x[j])
+                dst[k] = x[k]
+                np.multiply(x[a_], c, out=dst[a_])
+                dst[a_] += x[b_] * s_
+                np.multiply(x[b_], c, out=dst[b_])
+                dst[b_] -= x[a_] * s_
+            w[k, i] += VT[self.iv[i]]
+        return p, (r[0], r[1], r[2]), v, w
+
+
+def numpy_build(kin, H6, cols, known):
     """The minimal regressor and right-hand side of all samples at once: G (n, 6, T), y (6, T) = H - K_known P_known.
 
     Only the n kept columns are computed (not the 10 nb of the full regressor), each straight into its slot of
@@ -162,8 +272,7 @@ def numpy_build(fkT, twT, H6, cols, known):
     is what LAPACK and the BLAS want (A = G.reshape(n, 6T).T is a Fortran-ordered view, no copy): rows are
     ordered component-major (all samples' p_x, then p_y, ...), a row permutation of freefloat's sample-major
     order that changes no least-squares result."""
-    kin = Kin(fkT, twT)
-    G = np.empty((len(cols), 6, fkT.shape[2]))
+    G = np.empty((len(cols), 6, H6.shape[1]))
     for j, c in enumerate(cols):
         kin.column(c, G[j])
     y = H6.copy()
@@ -196,8 +305,8 @@ def solve_qr(G, y):
 SOLVERS = {"normal equations + cho_solve": solve_normal, "lstsq": solve_lstsq, "scipy qr economic": solve_qr}
 
 
-def numpy_identify(fkT, twT, H6, cols, known, solve=solve_normal):
-    return solve(*numpy_build(fkT, twT, H6, cols, known))
+def numpy_identify(kin, H6, cols, known, solve=solve_normal):
+    return solve(*numpy_build(kin, H6, cols, known))
 
 
 # ------------------------------------------------------------------------------------------------------ timing
@@ -264,13 +373,21 @@ def main():
     T = len(Q)
     cols, known = est.absolute_columns(mp), est.known_parameters(mp)
     fkT, twT, H6 = peer_inputs(ff.forward_kinematics(m, Q), ff.body_velocities(m, Q, V), H)
+    kin_ff = Kin.from_placements(fkT, twT)
+    np_kin = NumpyKinematics(m)
+    # the peer's own kinematics must reproduce freefloat's (placements, rotation columns, twists)
+    mine = np_kin(Q[:500], V[:500])
+    ref = (fkT[:3, :, :500], tuple(x[..., :500] for x in kin_ff.r), twT[:3, :, :500], twT[3:, :, :500])
+    kin_err = max(float(np.abs(np.asarray(a) - np.asarray(b)).max()) for a, b in zip(mine, ref))
+    if kin_err > 1e-12:
+        raise SystemExit(f"ABORT: the numpy kinematics differs from freefloat's by {kin_err:.2e}")
 
     # agreement first: the two regressors (the peer's rows permuted back to sample-major) and the estimates
     K_ff = ff.momentum_regressor(m, Q[:500], V[:500])[..., cols]
-    G, y = numpy_build(fkT[..., :500], twT[..., :500], H6[:, :500], cols, known)
+    G, y = numpy_build(Kin(*mine), H6[:, :500], cols, known)
     reg_err = float(np.abs(G.transpose(2, 1, 0) - K_ff).max() / np.abs(K_ff).max())
     r = est.least_squares(m, Q, V, H, mp)
-    G, y = numpy_build(fkT, twT, H6, cols, known)
+    G, y = numpy_build(kin_ff, H6, cols, known)
     routes = {}
     for name, solve in SOLVERS.items():
         t0 = time.perf_counter()
@@ -288,9 +405,11 @@ def main():
     stream_args = (m, Q, V, H, cols.tolist(), known)
     jobs = {
         "ff_regressor": lambda: ff._core.momentum_regressor_stream(*stream_args),
-        "np_regressor": lambda: numpy_build(fkT, twT, H6, cols, known),
+        "np_regressor": lambda: numpy_build(Kin.from_placements(fkT, twT), H6, cols, known),
+        "np_kin_regressor": lambda: numpy_build(Kin(*np_kin(Q, V)), H6, cols, known),
         "ff_end_to_end": lambda: est.least_squares(m, Q, V, H, mp),
-        "np_end_to_end": lambda: numpy_identify(fkT, twT, H6, cols, known),
+        "np_end_to_end": lambda: numpy_identify(Kin.from_placements(fkT, twT), H6, cols, known),
+        "np_kin_end_to_end": lambda: numpy_identify(Kin(*np_kin(Q, V)), H6, cols, known),
     }
     ts, cpu = interleaved(jobs, repeats)
     timings = {k: (statistics.median(v), min(v), max(v)) for k, v in ts.items()}
@@ -298,17 +417,23 @@ def main():
     ratios = {
         "regressor": timings["np_regressor"][0] / timings["ff_regressor"][0],
         "end_to_end": timings["np_end_to_end"][0] / timings["ff_end_to_end"][0],
+        "regressor_kin": timings["np_kin_regressor"][0] / timings["ff_regressor"][0],
+        "end_to_end_kin": timings["np_kin_end_to_end"][0] / timings["ff_end_to_end"][0],
     }
     load_after = os.getloadavg()
     cores = len(os.sched_getaffinity(0))
     labels = {
         "regressor": "regressor build (ff streaming pass / numpy kept columns of all samples)",
         "end_to_end": "end to end (regressor + solve; numpy: normal equations + cho_solve)",
+        "regressor_kin": "regressor build from q, v (the peer's own vectorised kinematics timed too)",
+        "end_to_end_kin": "end to end from q, v, h (the peer's own vectorised kinematics timed too)",
     }
     rows = []
     for key, (ffk, npk) in {
         "regressor": ("ff_regressor", "np_regressor"),
         "end_to_end": ("ff_end_to_end", "np_end_to_end"),
+        "regressor_kin": ("ff_regressor", "np_kin_regressor"),
+        "end_to_end_kin": ("ff_end_to_end", "np_kin_end_to_end"),
     }.items():
         rows.append(
             {
@@ -345,7 +470,7 @@ def main():
         "load_after": list(load_after),
         "freefloat_method": r.method,
         "condition_number": r.condition_number,
-        "agreement": {"regressor_max_rel": reg_err, "estimate_max_rel": est_err},
+        "agreement": {"regressor_max_rel": reg_err, "estimate_max_rel": est_err, "numpy_kinematics_max_abs": kin_err},
         "solve_routes": routes,
         "relative_error_percent": {"median": med, "max": mx},
         "seconds_all": ts,
@@ -361,7 +486,7 @@ def main():
         "",
         f"{MODEL}, {T:,} samples -> {6 * T:,} x {mp.n_min} minimal regressor; {res['states']}; noise sigma {NOISE}.",
         f"freefloat route: {r.method}; condition number {r.condition_number:.1f}; "
-        f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}; "
+        f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}, the peer's kinematics {kin_err:.1e}; "
         f"eqs. 38-39 errors: median {med:.3f} %, max {mx:.3f} %.",
         f"Median (min-max) of {repeats} interleaved repeats on {cores} core(s) (both programs use them all: "
         f"freefloat's threads, OpenBLAS threads {res['openblas_threads']}); git {res['git']}; load average "
