@@ -74,11 +74,18 @@ pub fn quat_from_rot(r: &M3) -> [f64; 4] {
 /// Quaternion of the rotation vector `phi` (axis * angle): exp(phi/2) in quaternion form.
 #[inline]
 pub fn quat_exp(phi: &V3) -> [f64; 4] {
-    let th = phi.norm();
-    let half = 0.5 * th;
-    // sin(th/2)/th, with its Taylor series near zero to keep full precision.
-    let k = if th < 1e-4 { 0.5 - th * th / 48.0 } else { half.sin() / th };
-    [k * phi.x, k * phi.y, k * phi.z, half.cos()]
+    let th2 = phi.norm_squared();
+    // Near zero (th < 1e-4, every integrator step of a slowly turning base) sin(th/2)/th and cos(th/2) by their
+    // Taylor series, exact to round-off there (the next terms, th⁴/3840 and th⁶/46080, are below 1e-19): no sqrt
+    // and no libm call. Otherwise one sincos of half the angle.
+    let (k, w) = if th2 < 1e-8 {
+        (0.5 - th2 / 48.0, 1.0 - th2 / 8.0 + th2 * th2 / 384.0)
+    } else {
+        let th = th2.sqrt();
+        let (s, c) = (0.5 * th).sin_cos();
+        (s / th, c)
+    };
+    [k * phi.x, k * phi.y, k * phi.z, w]
 }
 
 /// Rotation matrix about a unit axis by `angle` (Rodrigues): `R = c 1 + s [a]× + (1 − c) a aᵀ`, entry by entry
