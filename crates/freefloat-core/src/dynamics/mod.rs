@@ -7,7 +7,7 @@ pub mod derivatives;
 mod rnea;
 
 pub use aba::{aba, hybrid_aba, Prescribed};
-pub(crate) use aba::{hybrid_aba_placed_unchecked, hybrid_aba_unchecked};
+pub(crate) use aba::{hybrid_aba_placed_no_totals_unchecked, hybrid_aba_placed_unchecked, hybrid_aba_unchecked};
 pub use crba::crba;
 pub(crate) use crba::crba_unchecked;
 pub use rnea::rnea;

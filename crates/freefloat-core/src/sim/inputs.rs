@@ -88,6 +88,13 @@ impl TorqueSource<'_> {
 
     /// Forces at time `t` and state (q, v) into `out` (nv; a table's row length is checked).
     pub fn eval(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64]) -> Result<()> {
+        self.eval_near(t, q, v, out, &mut 0)
+    }
+
+    /// `eval` for a reader that moves along the table (the simulator): `row` is the table row found by the last
+    /// read, updated to this one's; the row of `t` is looked for from there (a stage is at most a few rows away)
+    /// instead of by a binary search over the whole table every time. Any `row` gives the same result.
+    pub(crate) fn eval_near(&mut self, t: f64, q: &[f64], v: &[f64], out: &mut [f64], row: &mut usize) -> Result<()> {
         match self {
             TorqueSource::Zero => out.fill(0.0),
             TorqueSource::Function(f) => {
@@ -109,21 +116,44 @@ impl TorqueSource<'_> {
                         ),
                     ));
                 }
-                // Index of the last sample at or before t (binary search: tables can be long).
-                let k = times.partition_point(|&x| x <= t + 1e-12 * t.abs().max(1.0)).saturating_sub(1);
+                let k = last_at_or_before(times, t + 1e-12 * t.abs().max(1.0), row);
                 let row = |k: usize| &values[k * nv..(k + 1) * nv];
                 if *hold == Hold::Zoh || k + 1 >= times.len() || t <= times[0] {
                     out.copy_from_slice(row(k));
                 } else {
                     let s = (t - times[k]) / (times[k + 1] - times[k]);
-                    for (j, o) in out.iter_mut().enumerate() {
-                        *o = (1.0 - s) * row(k)[j] + s * row(k + 1)[j];
+                    for ((o, a), b) in out.iter_mut().zip(row(k)).zip(row(k + 1)) {
+                        *o = (1.0 - s) * a + s * b;
                     }
                 }
             }
         }
         Ok(())
     }
+}
+
+/// Index of the last of the strictly increasing, non-empty `times` at or before `x` (0 if none is): what
+/// `times.partition_point(|&s| s <= x).saturating_sub(1)` returns, searched from `hint` (set to the answer) a few
+/// rows either way, then by that binary search (tables can be long) when the answer is farther.
+fn last_at_or_before(times: &[f64], x: f64, hint: &mut usize) -> usize {
+    let mut k = (*hint).min(times.len() - 1);
+    let mut moves = 0;
+    loop {
+        if times[k] > x && k > 0 {
+            k -= 1;
+        } else if k + 1 < times.len() && times[k + 1] <= x {
+            k += 1;
+        } else {
+            break;
+        }
+        moves += 1;
+        if moves > 8 {
+            k = times.partition_point(|&s| s <= x).saturating_sub(1);
+            break;
+        }
+    }
+    *hint = k;
+    k
 }
 
 /// A controller sampled every `period` seconds; its output (generalized forces, length nv) is held
@@ -145,4 +175,27 @@ pub struct Prescription<'a> {
     pub bodies: Vec<usize>,
     /// The prescribed motion.
     pub f: PrescriptionFn<'a>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn search_from_a_hint_finds_what_the_binary_search_finds() {
+        let times: Vec<f64> = (0..40).map(|k| 0.5 * k as f64 + 0.01 * (k * k) as f64).collect();
+        let xs: Vec<f64> = (-30..300).map(|j| 0.1 * j as f64).chain([times[5], times[39], 1e9, -1e9]).collect();
+        for start in [0, 3, 17, 39, 1000] {
+            let mut hint = start;
+            // forwards, backwards and jumping about
+            for &x in xs.iter().chain(xs.iter().rev()).chain(xs.iter().step_by(37)) {
+                let want = times.partition_point(|&s| s <= x).saturating_sub(1);
+                assert_eq!(last_at_or_before(&times, x, &mut hint), want, "x = {x}, from {start}");
+                assert_eq!(hint, want);
+            }
+        }
+        let one = [2.0];
+        assert_eq!(last_at_or_before(&one, 1.0, &mut 5), 0);
+        assert_eq!(last_at_or_before(&one, 3.0, &mut 0), 0);
+    }
 }

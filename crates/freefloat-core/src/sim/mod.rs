@@ -20,7 +20,7 @@ use crate::config::{
     tangent_rate_unchecked as tangent_rate,
 };
 use crate::data::Data;
-use crate::dynamics::{hybrid_aba_placed_unchecked, hybrid_aba_unchecked, Prescribed};
+use crate::dynamics::{hybrid_aba_placed_no_totals_unchecked, hybrid_aba_placed_unchecked, Prescribed};
 use crate::environment::{EnvWorkspace, Environment};
 use crate::error::{check_vec, FfError, Partial, Result};
 use crate::interrupt::Poller;
@@ -161,6 +161,8 @@ struct Stepper<'m, 'i> {
     mag0: Vec<f64>,
     mag1: Vec<f64>,
     evals: usize,
+    /// The torque table's row at the last read (where the next read starts looking, see `TorqueSource::eval_near`).
+    table_row: usize,
     /// The environment's workspace; its `fext` holds the per-body external wrenches of the current stage.
     env: Option<EnvWorkspace>,
 }
@@ -211,12 +213,23 @@ impl<'m, 'i> Stepper<'m, 'i> {
             mag0: vec![0.0; m.nv],
             mag1: vec![0.0; m.nv],
             evals: 0,
+            table_row: 0,
             env: None,
         })
     }
 
     /// Overwrite the prescribed joints' q, v with their prescription at time t.
+    #[inline]
     fn impose(&mut self, t: f64, q: &mut [f64], v: &mut [f64]) -> Result<()> {
+        // Inlined test, out-of-line work: most runs prescribe nothing, and the call cost more than the test.
+        if self.inputs.prescription.is_none() {
+            return Ok(());
+        }
+        self.impose_prescribed(t, q, v)
+    }
+
+    #[inline(never)]
+    fn impose_prescribed(&mut self, t: f64, q: &mut [f64], v: &mut [f64]) -> Result<()> {
         let Some(p) = self.inputs.prescription.as_mut() else { return Ok(()) };
         (p.f)(t, &mut self.presc_q, &mut self.presc_v, &mut self.presc_a)?;
         let m = self.m;
@@ -236,9 +249,12 @@ impl<'m, 'i> Stepper<'m, 'i> {
         self.impose(t, &mut qs, &mut vs)?;
         // The command: read at the step's start (stage 0) and held, or at every stage (see InputTiming).
         if s == 0 || self.inputs.timing == InputTiming::Stage || self.inputs.torques.continuous() {
-            self.inputs.torques.eval(t, &qs, &vs, &mut self.cmd)?;
-            for (x, h) in self.cmd.iter_mut().zip(&self.held) {
-                *x += h;
+            self.inputs.torques.eval_near(t, &qs, &vs, &mut self.cmd, &mut self.table_row)?;
+            if self.inputs.controller.is_some() {
+                // the controller's held output (zero without a controller: nothing to add)
+                for (x, h) in self.cmd.iter_mut().zip(&self.held) {
+                    *x += h;
+                }
             }
             self.act.command(&vs, &mut self.cmd);
         }
@@ -271,8 +287,18 @@ impl<'m, 'i> Stepper<'m, 'i> {
         let presc =
             self.inputs.prescription.as_ref().map(|_| Prescribed { mask: &self.presc_mask, ddq: &self.presc_a });
         match self.formulation {
-            Formulation::Aba if placed => hybrid_aba_placed_unchecked(ma, &mut self.d, &vs, &self.tau, fext, presc)?,
-            Formulation::Aba => hybrid_aba_unchecked(ma, &mut self.d, &qs, &vs, &self.tau, fext, presc)?,
+            Formulation::Aba => {
+                if !placed {
+                    forward_kinematics_unchecked(ma, &mut self.d, &qs);
+                }
+                // The momentum and kinetic energy are recorded only with a step's first stage (the state itself):
+                // the other stages skip summing them.
+                if s == 0 {
+                    hybrid_aba_placed_unchecked(ma, &mut self.d, &vs, &self.tau, fext, presc)?
+                } else {
+                    hybrid_aba_placed_no_totals_unchecked(ma, &mut self.d, &vs, &self.tau, fext, presc)?
+                }
+            }
             Formulation::DualQuaternion => {
                 // same outputs as hybrid ABA: all accelerations, and tau with the prescribed joints' needs
                 let (mask, ddq) = match presc {
@@ -336,28 +362,33 @@ impl<'m, 'i> Stepper<'m, 'i> {
     ) -> Result<(f64, f64)> {
         let m = self.m;
         let nv = m.nv;
+        // Every buffer as a slice of exactly nv entries: the loops below index them by k < nv without bounds checks
+        // (and without the zip chains they replaced).
+        let (q0, v0, v1) = (&q0[..m.nq], &v0[..nv], &mut v1[..nv]);
         for s in 1..tab.stages() {
             // Column-wise over the stages, skipping the tableau's zeros (RK4 has one non-zero a per stage):
             // the same sums in the same order as the full inner product (adding the skipped ±0 terms to the
             // running sum, which starts at +0, changes nothing), bit for bit.
-            self.dq.fill(0.0);
-            self.dv.fill(0.0);
-            for (j, &a) in tab.a[s].iter().enumerate().filter(|(_, a)| **a != 0.0) {
-                for ((dq, dv), (kq, kv)) in
-                    self.dq.iter_mut().zip(self.dv.iter_mut()).zip(self.kq[j].iter().zip(&self.kv[j]))
-                {
-                    *dq += a * kq;
-                    *dv += a * kv;
+            let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
+            dq.fill(0.0);
+            dv.fill(0.0);
+            for (j, &a) in tab.a[s].iter().enumerate() {
+                if a == 0.0 {
+                    continue;
+                }
+                let (kq, kv) = (&self.kq[j][..nv], &self.kv[j][..nv]);
+                for k in 0..nv {
+                    dq[k] += a * kq[k];
+                    dv[k] += a * kv[k];
                 }
             }
-            for (dq, dv) in self.dq.iter_mut().zip(self.dv.iter_mut()) {
-                *dq *= h;
-                *dv *= h;
-            }
-            retract(m, q0, &self.dq, &mut self.qs);
+            let vs = &mut self.vs[..nv];
             for k in 0..nv {
-                self.vs[k] = v0[k] + self.dv[k];
+                dq[k] *= h;
+                dv[k] *= h;
+                vs[k] = v0[k] + dv[k];
             }
+            retract(m, q0, dq, &mut self.qs);
             for k in 0..self.mp.len() {
                 self.mps[k] =
                     self.mp[k] + h * tab.a[s].iter().enumerate().map(|(j, a)| a * self.kmp[j][k]).sum::<f64>();
@@ -365,26 +396,34 @@ impl<'m, 'i> Stepper<'m, 'i> {
             self.eval(t + tab.c[s] * h, s)?;
             dexpinv(m, &self.dq, &mut self.kq[s]);
         }
+        // The weighted sum of the stages, column-wise in the same order as the inner product over j (the
+        // tableau's zero weights skipped, as above): bit for bit the same sums.
+        let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
+        dq.fill(0.0);
+        dv.fill(0.0);
         let mut w1 = w0;
-        for k in 0..nv {
-            let (mut sq, mut sv) = (0.0, 0.0);
-            for (j, b) in tab.b.iter().enumerate() {
-                sq += b * self.kq[j][k];
-                sv += b * self.kv[j][k];
+        for (j, &b) in tab.b.iter().enumerate() {
+            if b == 0.0 {
+                continue;
             }
-            self.dq[k] = h * sq;
-            self.dv[k] = h * sv;
+            let (kq, kv) = (&self.kq[j][..nv], &self.kv[j][..nv]);
+            for k in 0..nv {
+                dq[k] += b * kq[k];
+                dv[k] += b * kv[k];
+            }
         }
         for (j, b) in tab.b.iter().enumerate() {
             w1 += h * b * self.kw[j];
         }
+        for k in 0..nv {
+            dq[k] *= h;
+            dv[k] *= h;
+            v1[k] = v0[k] + dv[k];
+        }
         for k in 0..self.mp.len() {
             self.mp1[k] = self.mp[k] + h * tab.b.iter().enumerate().map(|(j, b)| b * self.kmp[j][k]).sum::<f64>();
         }
-        retract(m, q0, &self.dq, q1);
-        for k in 0..nv {
-            v1[k] = v0[k] + self.dv[k];
-        }
+        retract(m, q0, dq, q1);
         let mut err = 0.0;
         if let (Some(e), Some((rtol, atol))) = (tab.e, tol) {
             // Hairer's RMS error norm over the tangent coordinates of q and over v.
