@@ -3,48 +3,6 @@
 
 use super::{M3, V3};
 
-/// `(sin x, cos x)`, within about one unit in the last place of `f64::sin_cos` (checked in the tests), at half the
-/// instructions of the C library's: the joint rotations of forward kinematics take one per revolute joint per
-/// evaluation, 7 % of a simulation step (callgrind). `x` is reduced to `r = x - n π/2`, |r| <= π/4, with π/2 in
-/// two parts (the first product is exact in the fused multiply-add, so `r` carries one rounding), then the Taylor
-/// series of sin and cos on r (their next terms are below 1e-17 there); the quadrant n mod 4 picks the signs.
-/// Beyond |x| = 1e6 (where the two-part π/2 would not do) the library's.
-#[inline]
-pub fn sin_cos(x: f64) -> (f64, f64) {
-    // π/2 = PIO2_HI + PIO2_LO to about 2⁻¹⁰⁷ relative (PIO2_HI: π/2 rounded to double, PIO2_LO: the rest rounded)
-    const PIO2_HI: f64 = std::f64::consts::FRAC_PI_2;
-    const PIO2_LO: f64 = 6.123233995736766e-17;
-    if !(x.abs() < 1e6) {
-        return x.sin_cos(); // also inf and NaN
-    }
-    let n = (x * std::f64::consts::FRAC_2_PI).round_ties_even();
-    let r = (-n).mul_add(PIO2_LO, (-n).mul_add(PIO2_HI, x));
-    let z = r * r;
-    // sin r = r + r z (−1/3! + z (1/5! − …)), to the r¹⁷ term
-    let ps = -1.0 / 6.0
-        + z * (1.0 / 120.0
-            + z * (-1.0 / 5040.0
-                + z * (1.0 / 362880.0
-                    + z * (-1.0 / 39916800.0
-                        + z * (1.0 / 6227020800.0 + z * (-1.0 / 1307674368000.0 + z * (1.0 / 355687428096000.0)))))));
-    let sr = r + r * z * ps;
-    // cos r = 1 − z/2 + z² (1/4! − …), to the r¹⁶ term; the rounding of w = 1 − z/2 carried into the small part
-    let pc = 1.0 / 24.0
-        + z * (-1.0 / 720.0
-            + z * (1.0 / 40320.0
-                + z * (-1.0 / 3628800.0
-                    + z * (1.0 / 479001600.0 + z * (-1.0 / 87178291200.0 + z * (1.0 / 20922789888000.0))))));
-    let hz = 0.5 * z;
-    let w = 1.0 - hz;
-    let cr = w + (((1.0 - w) - hz) + z * z * pc);
-    match (n as i64) & 3 {
-        0 => (sr, cr),
-        1 => (cr, -sr),
-        2 => (-sr, -cr),
-        _ => (-cr, sr),
-    }
-}
-
 /// Hamilton product of two quaternions stored (x, y, z, w).
 #[inline]
 pub fn quat_mul(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
@@ -135,7 +93,7 @@ pub fn quat_exp(phi: &V3) -> [f64; 4] {
 /// made it a tenth of forward kinematics).
 #[inline]
 pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
-    let (s, c) = sin_cos(angle);
+    let (s, c) = angle.sin_cos();
     let t = 1.0 - c;
     let (x, y, z) = (axis.x, axis.y, axis.z);
     let (tx, ty, tz) = (t * x, t * y, t * z);
@@ -170,7 +128,7 @@ pub fn principal_axis(axis: &V3) -> Option<usize> {
 /// Rodrigues' formula and a dense 3×3 product.
 #[inline(always)]
 pub fn rotate_about_principal_axis(r: &M3, k: usize, angle: f64) -> M3 {
-    let (s, c) = sin_cos(angle);
+    let (s, c) = angle.sin_cos();
     // one monomorphised body per axis: the column indices are constants, not run-time arithmetic
     match k {
         0 => mix_columns::<1, 2>(r, s, c),
@@ -247,52 +205,4 @@ pub fn rot_to_rpy(r: &M3) -> V3 {
         return V3::new(0.0, pitch, yaw);
     }
     V3::new(r[(2, 1)].atan2(r[(2, 2)]), pitch, r[(1, 0)].atan2(r[(0, 0)]))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::sin_cos;
-
-    /// Distance in units in the last place between two finite doubles of the same sign (0 if equal).
-    fn ulps(a: f64, b: f64) -> u64 {
-        if a == b {
-            return 0;
-        }
-        let scale = a.abs().max(b.abs());
-        // below 1e-300 the spacing is not what matters: count in the spacing at the result's magnitude 1
-        ((a - b).abs() / (f64::EPSILON * scale.max(1e-300))).ceil() as u64
-    }
-
-    #[test]
-    fn sin_cos_is_the_library_s_to_about_one_ulp() {
-        // a deterministic spread: tiny, near multiples of π/2, up to the cut-over at 1e6, and beyond it
-        let mut xs = vec![0.0, -0.0, 1e-300, 1e-20, 1e-9, 0.1, 0.5, 1.0, 2.0, 3.0, 1e3, 12345.678, 999_999.9, 1e6, 3e7];
-        for k in -64..=64 {
-            let m = k as f64 * std::f64::consts::FRAC_PI_2;
-            xs.extend([m, m + 1e-12, m - 1e-7, m + 0.3, m - 0.785]);
-        }
-        let mut u: u64 = 0x9E37_79B9_7F4A_7C15;
-        for j in 0..200_000 {
-            u ^= u << 13;
-            u ^= u >> 7;
-            u ^= u << 17;
-            let f = (u >> 11) as f64 / (1u64 << 53) as f64; // [0, 1)
-            let span = [1.0, 10.0, 1e3, 1e6][j % 4];
-            xs.push((2.0 * f - 1.0) * span);
-        }
-        let mut worst = 0;
-        for &x in &xs {
-            let (s, c) = sin_cos(x);
-            let (s0, c0) = x.sin_cos();
-            // absolute against 1 where the value is small (near a zero of sin or cos the argument's own rounding
-            // decides the last bits), relative elsewhere
-            let e = ulps(s, s0)
-                .min(((s - s0).abs() / f64::EPSILON).ceil() as u64)
-                .max(ulps(c, c0).min(((c - c0).abs() / f64::EPSILON).ceil() as u64));
-            assert!(e <= 2, "x = {x:e}: ({s:e}, {c:e}) against ({s0:e}, {c0:e})");
-            worst = worst.max(e);
-        }
-        assert!(worst >= 1, "the comparison compares");
-        assert!(sin_cos(f64::NAN).0.is_nan() && sin_cos(f64::INFINITY).1.is_nan());
-    }
 }
