@@ -76,11 +76,11 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
                 None => li,
             };
             o_mi[i] = o;
-            ic[i] = m.inertias[i].transformed(&o);
             for c in 0..m.nvs[i] {
                 let sc = subspace_column_at(m, &o, &s[i], i, c);
                 os[i].set_column(c, &sc.to_v6());
             }
+            ic[i] = m.inertias[i].transformed(&o);
         }
     }
     // Entries of bodies that are not on one path from the root are zero; the sweep writes all the others. Filled
@@ -106,7 +106,9 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     for i in (0..n).rev() {
         // SAFETY (all `get_unchecked` below): i < n and every j visited is i or an ancestor of i, so j < n (the
         // builder orders bodies with parents[j] < j), and the per-body vectors have n entries (asserted above).
-        let ici = unsafe { *ic.get_unchecked(i) };
+        // body i's composite inertia, borrowed beside its ancestors' (all of smaller index): no copy of it
+        let (ic_anc, ic_rest) = ic.split_at_mut(i);
+        let ici = &ic_rest[0];
         if i == 0 && free_root {
             // Base block: oIc₀ is the whole system's inertia, already in base coordinates.
             let ib = ici.to_matrix();
@@ -146,8 +148,9 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
             }
         }
         if let Some(p) = unsafe { *m.parents.get_unchecked(i) } {
-            let icp = unsafe { ic.get_unchecked_mut(p) };
-            *icp = icp.add(&ici);
+            // SAFETY: the builder orders bodies with parents[i] < i, and ic_anc has i entries.
+            let icp = unsafe { ic_anc.get_unchecked_mut(p) };
+            *icp = icp.add(ici);
         }
     }
 }
