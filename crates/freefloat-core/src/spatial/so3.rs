@@ -86,7 +86,7 @@ pub fn quat_exp(phi: &V3) -> [f64; 4] {
 /// made it a tenth of forward kinematics).
 #[inline]
 pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = super::sin_cos(angle);
     let t = 1.0 - c;
     let (x, y, z) = (axis.x, axis.y, axis.z);
     let (tx, ty, tz) = (t * x, t * y, t * z);
