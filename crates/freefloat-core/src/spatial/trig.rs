@@ -19,11 +19,11 @@ const LIMIT: f64 = 1.0e6;
 #[inline]
 pub fn sin_cos(x: f64) -> (f64, f64) {
     let a = x.abs();
-    if a < 1.0e-9 {
-        // x − x³/6 rounds to x (x²/6 < 2⁻⁵⁵), and the sign of a zero is kept
-        return (x, 1.0);
-    }
     if a <= std::f64::consts::FRAC_PI_4 {
+        if a < 1.0e-9 {
+            // x − x³/6 rounds to x (x²/6 < 2⁻⁵⁵), and the sign of a zero is kept
+            return (x, 1.0);
+        }
         return kernel(x, 0.0);
     }
     if !(a <= LIMIT) {
@@ -39,13 +39,21 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
     let err = (r1 - (hi - bb)) + (-p2 - bb);
     let lo = err - n.mul_add(C3, e2);
     let (s, c) = kernel(hi, lo);
-    // n mod 4 (two's complement keeps it right for negative n)
-    match (n as i64) & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
-    }
+    // x = n π/2 + r: by n mod 4, (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s). Without branches (the quadrant of
+    // a joint angle is as good as random, and a mispredicted jump costs more than these integer operations): an odd
+    // n swaps the two (bit select), bit 1 of n flips the sine's sign and bit 1 of n + 1 the cosine's. Two's
+    // complement keeps the bits right for a negative n.
+    // x = n π/2 + r: by n mod 4, (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s). Without branches (the quadrant of
+    // a joint angle is as good as random, and a mispredicted jump costs more than these few operations): an odd n
+    // swaps the two (a bit select), then the signs come from a table (multiplications by ±1 are exact). Two's
+    // complement keeps n mod 4 right for a negative n.
+    const SIGN: [[f64; 2]; 4] = [[1.0, 1.0], [1.0, -1.0], [-1.0, -1.0], [-1.0, 1.0]];
+    let k = (n as i64 & 3) as usize;
+    let swap = 0u64.wrapping_sub((k & 1) as u64);
+    let (sb, cb) = (s.to_bits(), c.to_bits());
+    let s1 = f64::from_bits((sb & !swap) | (cb & swap));
+    let c1 = f64::from_bits((cb & !swap) | (sb & swap));
+    (s1 * SIGN[k][0], c1 * SIGN[k][1])
 }
 
 /// sin and cos of `hi + lo`, |hi| ≤ π/4 (slightly more after the rounding of n), |lo| ≤ ulp(hi).
