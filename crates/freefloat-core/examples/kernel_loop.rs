@@ -6,15 +6,17 @@
 //!
 //! Kernels: aba, rnea, crba, fk. Model: a built-in model name or a YAML model file. It cycles through 64
 //! configurations (so the branch predictor cannot learn one input) and prints a checksum so nothing is optimised
-//! away. Per-call instructions: (count of this run − count with 0 calls) / calls.
+//! away. Per-call instructions: (count of this run − count with 0 calls) / calls. With a fourth argument `wide`
+//! every joint coordinate is drawn in [-π, π] and the base quaternion at random instead (the benchmark's states:
+//! sincos takes its longer path above about 0.86 rad, which the near-neutral states never reach).
 use freefloat_core::dynamics::{aba, crba, rnea};
 use freefloat_core::kinematics::forward_kinematics;
 use freefloat_core::{Data, Model};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() != 4 {
-        eprintln!("usage: kernel_loop <aba|rnea|crba|fk> <builtin model name or model.yaml> <calls>");
+    if args.len() != 4 && !(args.len() == 5 && args[4] == "wide") {
+        eprintln!("usage: kernel_loop <aba|rnea|crba|fk> <builtin model name or model.yaml> <calls> [wide]");
         std::process::exit(2);
     }
     let m: Model = if args[2].ends_with(".yaml") || args[2].ends_with(".yml") {
@@ -25,12 +27,23 @@ fn main() {
     };
     let calls: usize = args[3].parse().expect("calls: a whole number");
     let mut d = Data::new(&m);
+    let wide = args.len() == 5;
+    // a fixed linear congruential sequence in [0, 1): the same states on every run
+    let mut seed: u64 = 0x2545_f491_4f6c_dd1d;
+    let mut unit = move || {
+        seed = seed.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1_442_695_040_888_963_407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
     // 64 configurations: neutral with each coordinate nudged by a deterministic pattern, quaternion renormalised
     let states: Vec<(Vec<f64>, Vec<f64>)> = (0..64)
         .map(|k| {
             let mut q = m.neutral();
             for (j, x) in q.iter_mut().enumerate() {
-                *x += 0.3 * (((k * 7 + j * 13) % 17) as f64 / 17.0 - 0.5);
+                *x += if wide {
+                    std::f64::consts::PI * (2.0 * unit() - 1.0)
+                } else {
+                    0.3 * (((k * 7 + j * 13) % 17) as f64 / 17.0 - 0.5)
+                };
             }
             if m.nq != m.nv {
                 let n = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();

@@ -1,7 +1,7 @@
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
-use crate::kinematics::{joint_placement, world_subspace_column};
+use crate::kinematics::{joint_placement_at, subspace_column_at};
 use crate::model::{JointType, Model};
 use crate::spatial::{Motion, Se3, V3};
 
@@ -31,7 +31,9 @@ pub fn crba(m: &Model, d: &mut Data, q: &[f64]) -> Result<()> {
 /// motion of the whole system), so the base is put at the origin. Its inertia then needs no change of frame, the
 /// base block is oIc₀ itself and the base rows of column i are Fᵢ as they are (RBDA §6.2's floating-base remark);
 /// the base's children are placed by their joint alone. Leaves `d.o_mi`, `d.ic` (composite inertias) and `d.os`
-/// (every joint but a free root) in that common frame; under a free root `d.li_mi[0]` is not written.
+/// (every joint but a free root) in that common frame. `d.li_mi` is not written (no caller reads it after the CRBA:
+/// the derivatives run ABA and post-capture control runs RNEA next, both of which redo forward kinematics; the
+/// Python `crba` reads only the matrix); call `forward_kinematics` for the parent-relative placements.
 pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     let n = m.nbodies();
     let nv = m.nv;
@@ -40,27 +42,47 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
         // writes below rely on the nv × nv shape, so make sure of it.
         d.mass_matrix = nalgebra::DMatrix::zeros(nv, nv);
     }
+    // The model's per-body vectors have n entries (the builder makes them so), as in `forward_kinematics`: said
+    // once, it lets the compiler drop the bounds checks of the forward sweep (the helpers index them by i < n).
+    // Data's per-body buffers as n-entry slices keep their lengths in registers instead of re-reading them after
+    // every store.
+    assert!(
+        m.parents.len() == n
+            && m.idx_q.len() == n
+            && m.nqs.len() == n
+            && m.nvs.len() == n
+            && m.joint_types.len() == n
+            && m.placements.len() == n
+            && m.axes.len() == n
+            && m.axes2.len() == n
+            && m.inertias.len() == n
+            && m.principal_revolute().len() == n
+    );
     let free_root = n > 0 && m.joint_types[0] == JointType::Free;
-    for i in 0..n {
-        if i == 0 && free_root {
-            d.o_mi[0] = Se3::identity();
-            d.ic[0] = m.inertias[0];
-            continue;
-        }
-        // (revolute joints about a principal axis of their frame take the specialised rotation and subspace
-        // column inside `joint_placement` and `world_subspace_column`, as forward kinematics and ABA do)
-        let li = joint_placement(m, d, i, q);
-        d.li_mi[i] = li;
-        let o = match m.parents[i] {
-            Some(0) if free_root => li,
-            Some(p) => d.o_mi[p].compose(&li),
-            None => li,
-        };
-        d.o_mi[i] = o;
-        d.ic[i] = m.inertias[i].transformed(&o);
-        for c in 0..m.nvs[i] {
-            let s = world_subspace_column(m, d, i, c);
-            d.os[i].set_column(c, &s.to_v6());
+    {
+        let (o_mi, ic, os, s) = (&mut d.o_mi[..n], &mut d.ic[..n], &mut d.os[..n], &mut d.s[..n]);
+        for i in 0..n {
+            if i == 0 && free_root {
+                o_mi[0] = Se3::identity();
+                ic[0] = m.inertias[0];
+                continue;
+            }
+            // (revolute joints about a principal axis of their frame take the specialised rotation and subspace
+            // column inside `joint_placement_at` and `subspace_column_at`, as forward kinematics and ABA do)
+            let li = joint_placement_at(m, &mut s[i], i, q);
+            let o = match m.parents[i] {
+                Some(0) if free_root => li,
+                Some(p) => o_mi[p].compose(&li),
+                None => li,
+            };
+            o_mi[i] = o;
+            // the subspace columns before the inertia: formed while `o` is still in registers (the other order
+            // spills it and reloads it, about 25 instructions a body on naveen_dual_arm_consistent, callgrind)
+            for c in 0..m.nvs[i] {
+                let sc = subspace_column_at(m, &o, &s[i], i, c);
+                os[i].set_column(c, &sc.to_v6());
+            }
+            ic[i] = m.inertias[i].transformed(&o);
         }
     }
     // Entries of bodies that are not on one path from the root are zero; the sweep writes all the others. Filled
@@ -86,7 +108,9 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     for i in (0..n).rev() {
         // SAFETY (all `get_unchecked` below): i < n and every j visited is i or an ancestor of i, so j < n (the
         // builder orders bodies with parents[j] < j), and the per-body vectors have n entries (asserted above).
-        let ici = unsafe { *ic.get_unchecked(i) };
+        // body i's composite inertia, borrowed beside its ancestors' (all of smaller index): no copy of it
+        let (ic_anc, ic_rest) = ic.split_at_mut(i);
+        let ici = &ic_rest[0];
         if i == 0 && free_root {
             // Base block: oIc₀ is the whole system's inertia, already in base coordinates.
             let ib = ici.to_matrix();
@@ -116,13 +140,8 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
                     unsafe { (os.get_unchecked(j), *m.idx_v.get_unchecked(j), *m.nvs.get_unchecked(j)) };
                 for r in 0..nvj {
                     let s = sj.fixed_view::<6, 1>(0, r);
-                    let x = s[0] * f.lin.x
-                        + s[1] * f.lin.y
-                        + s[2] * f.lin.z
-                        + s[3] * f.ang.x
-                        + s[4] * f.ang.y
-                        + s[5] * f.ang.z;
-                    put(cj + r, col, x);
+                    let sr = Motion::new(V3::new(s[0], s[1], s[2]), V3::new(s[3], s[4], s[5]));
+                    put(cj + r, col, sr.dot(&f));
                 }
                 match unsafe { *m.parents.get_unchecked(j) } {
                     Some(p) => j = p,
@@ -131,8 +150,9 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
             }
         }
         if let Some(p) = unsafe { *m.parents.get_unchecked(i) } {
-            let icp = unsafe { ic.get_unchecked_mut(p) };
-            *icp = icp.add(&ici);
+            // SAFETY: the builder orders bodies with parents[i] < i, and ic_anc has i entries.
+            let icp = unsafe { ic_anc.get_unchecked_mut(p) };
+            *icp = icp.add(ici);
         }
     }
 }

@@ -40,14 +40,8 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     }
 }
 
-/// Placement of body i in its parent at `q` (the whole configuration), also refreshing `d.s[i]` for a universal
-/// joint: one step of `forward_kinematics`.
-#[inline(always)]
-pub(crate) fn joint_placement(m: &Model, d: &mut Data, i: usize, q: &[f64]) -> Se3 {
-    joint_placement_at(m, &mut d.s[i], i, q)
-}
-
-/// `joint_placement` with body i's subspace buffer `s` (`d.s[i]`) given.
+/// Placement of body i in its parent at `q` (the whole configuration), also refreshing body i's subspace buffer
+/// `s` (`d.s[i]`) for a universal joint: one step of `forward_kinematics` (and of the CRBA's forward sweep).
 #[inline(always)]
 pub(crate) fn joint_placement_at(m: &Model, s: &mut M6, i: usize, q: &[f64]) -> Se3 {
     let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];

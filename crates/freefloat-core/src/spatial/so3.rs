@@ -93,7 +93,7 @@ pub fn quat_exp(phi: &V3) -> [f64; 4] {
 /// made it a tenth of forward kinematics).
 #[inline]
 pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = super::sin_cos(angle);
     let t = 1.0 - c;
     let (x, y, z) = (axis.x, axis.y, axis.z);
     let (tx, ty, tz) = (t * x, t * y, t * z);
@@ -128,7 +128,7 @@ pub fn principal_axis(axis: &V3) -> Option<usize> {
 /// Rodrigues' formula and a dense 3×3 product.
 #[inline(always)]
 pub fn rotate_about_principal_axis(r: &M3, k: usize, angle: f64) -> M3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = super::sin_cos(angle);
     // one monomorphised body per axis: the column indices are constants, not run-time arithmetic
     match k {
         0 => mix_columns::<1, 2>(r, s, c),

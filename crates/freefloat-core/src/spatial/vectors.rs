@@ -131,9 +131,11 @@ impl Motion {
     pub fn cross_force(&self, f: &Force) -> Force {
         Force { lin: cross(&self.ang, &f.lin), ang: cross2(&self.ang, &f.ang, &self.lin, &f.lin) }
     }
-    /// Power of a wrench on this twist.
+    /// Power of a wrench on this twist. Two independent chains of fused multiply-adds, one per half, joined
+    /// by one addition: a dependency chain of four operations instead of eleven (CRBA forms one per entry).
     #[inline]
     pub fn dot(&self, f: &Force) -> f64 {
-        self.lin.dot(&f.lin) + self.ang.dot(&f.ang)
+        let (a, b, c, e) = (&self.lin, &f.lin, &self.ang, &f.ang);
+        a.z.mul_add(b.z, a.y.mul_add(b.y, a.x * b.x)) + c.z.mul_add(e.z, c.y.mul_add(e.y, c.x * e.x))
     }
 }
