@@ -36,7 +36,14 @@ pub fn gravity_gradient(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
 pub fn gravity_gradient_of(i_com: &M3, r_b: &V3, mu: f64) -> DualQuat {
     let r2 = r_b.norm_squared();
     let k = 3.0 * mu / (r2 * r2 * r2.sqrt());
-    DualQuat::vector(&V3::zeros(), &(r_b.cross(&(i_com * r_b)) * k))
+    DualQuat::vector(&V3::zeros(), &gravity_gradient_torque(i_com, r_b, k))
+}
+
+/// The torque of (2.63) / (2.67) with its factor `k = 3μ/‖r‖⁵` given: `k r × (Ī r)`. The simulator forms k from
+/// the `1/‖r‖` it already has for the tidal force of the same body (one square root and division per body).
+#[inline]
+pub fn gravity_gradient_torque(i_com: &M3, r_b: &V3, k: f64) -> V3 {
+    r_b.cross(&(i_com * r_b)) * k
 }
 
 /// Differential point-mass gravity `g(R + r) − g(R)`, `g(x) = −μ x/‖x‖³` (2.62), for a point at `r` from a
@@ -47,9 +54,16 @@ pub fn gravity_gradient_of(i_com: &M3, r_b: &V3, mu: f64) -> DualQuat {
 /// −x(3 + 3x + x²)/(1 + (1 + x)^{3/2})` (Battin 1999, §8.4, the same device as his f(q)).
 pub fn tidal_acceleration(big_r: &V3, r: &V3, mu: f64) -> V3 {
     let d = big_r + r;
-    let x = (2.0 * big_r.dot(r) + r.norm_squared()) / big_r.norm_squared();
+    tidal_acceleration_from(big_r, r, 1.0 / big_r.norm_squared(), mu / d.norm().powi(3))
+}
+
+/// [`tidal_acceleration`] with `1/‖R‖²` and `μ/‖R + r‖³` given: the simulator computes the first once per
+/// evaluation for all bodies and shares the second's `1/‖R + r‖` with the body's gravity-gradient torque.
+#[inline]
+pub fn tidal_acceleration_from(big_r: &V3, r: &V3, inv_r2: f64, mu_d3: f64) -> V3 {
+    let x = (2.0 * big_r.dot(r) + r.norm_squared()) * inv_r2;
     let s = x * (3.0 + x * (3.0 + x)) / (1.0 + (1.0 + x) * (1.0 + x).sqrt());
-    -(r - big_r * s) * (mu / d.norm().powi(3))
+    -(r - big_r * s) * mu_d3
 }
 
 /// Gravity gradient, the "old" form of [50] (2.68): `3μ/‖r‖⁵ r̂ × (M ⋆ r̂^s)` with `r̂ = r + ε0`.

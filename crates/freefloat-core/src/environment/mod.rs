@@ -147,6 +147,9 @@ impl EnvWorkspace {
     /// origin by (2.40), `f + ε(τ + c × f)` with `c` the CoM in body axes.
     pub fn eval(&mut self, env: &Environment, m: &Model, d: &Data, t: f64) {
         let refst = self.reference(t);
+        let inv_r2 = refst.as_ref().map_or(0.0, |rs| 1.0 / rs.position.norm_squared());
+        // the reference point P in the frame: c0 + ċ0 t
+        let p_ref = self.c0 + self.cdot0 * t;
         self.fext.fill(0.0);
         for i in 0..m.nbodies() {
             let mass = m.inertias[i].mass;
@@ -156,28 +159,43 @@ impl EnvWorkspace {
                 self.mass[i] = mass;
             }
             let x = &d.o_mi[i];
-            let mut w = crate::dualquat::DualQuat::vector(&V3::zeros(), &V3::zeros());
+            // the dual force f + ετ about the CoM in body axes, summed over the effects as its two vectors
+            let (mut f, mut tau) = (V3::zeros(), V3::zeros());
+            let add = |f: &mut V3, tau: &mut V3, w: crate::dualquat::DualQuat| {
+                *f += w.r.v;
+                *tau += w.d.v;
+            };
             let mut any = false;
             if let (Some(o), Some(rs)) = (&env.orbit, &refst) {
                 if mass > 0.0 {
                     // the body's CoM relative to the reference point P
-                    let r = x.act_point(&self.com[i]) - self.c0 - self.cdot0 * t;
+                    let r = x.act_point(&self.com[i]) - p_ref;
                     if env.gravity_gradient {
-                        w = w + gravity_gradient::wrench(&x.rot, &rs.position, &r, mass, &self.i_com[i], o.central.mu);
+                        let (fg, tg) = gravity_gradient::wrench(
+                            &x.rot,
+                            &rs.position,
+                            inv_r2,
+                            &r,
+                            mass,
+                            &self.i_com[i],
+                            o.central.mu,
+                        );
+                        f += fg;
+                        tau += tg;
                         any = true;
                     }
                     if env.j2 {
-                        w = w + j2::wrench(&x.rot, &rs.position, &r, mass, &o.central);
+                        add(&mut f, &mut tau, j2::wrench(&x.rot, &rs.position, &r, mass, &o.central));
                         any = true;
                     }
                 }
             }
             if let Some(dist) = env.disturbance.as_ref().filter(|dd| dd.body == i) {
-                w = w + dist.wrench(&x.rot);
+                add(&mut f, &mut tau, dist.wrench(&x.rot));
                 any = true;
             }
             if any {
-                let (f, tau) = (w.r.v, w.d.v + self.com[i].cross(&w.r.v));
+                let tau = tau + self.com[i].cross(&f);
                 self.fext[6 * i..6 * i + 3].copy_from_slice(f.as_slice());
                 self.fext[6 * i + 3..6 * i + 6].copy_from_slice(tau.as_slice());
             }
