@@ -108,7 +108,7 @@ ONE_S = np.array([0, 0, 0, 0, 1.0, 0, 0, 0])
 
 
 class Peer:
-    """The closed loop of the thesis (digest §7) in numpy."""
+    """The closed loop of Valverde 2018, ch. 4 (adaptive pose tracking with concurrent learning) in numpy."""
 
     def __init__(self, sc, alpha):
         g = sc.gains
