@@ -123,6 +123,20 @@ def test_wrong_sizes_and_nan():
         ff.momentum(m, np.tile(q, (3, 1)), np.zeros((4, m.nv)))
     with pytest.raises(ff.InputError, match="cannot be read"):
         ff.momentum(m, "not numbers", v)
+    # an empty stack (a filter that selected nothing) is refused by name, in every batched kernel
+    Q0, V0 = np.zeros((0, m.nq)), np.zeros((0, m.nv))
+    for call in (
+        lambda: ff.aba(m, Q0, V0, V0),
+        lambda: ff.rnea(m, Q0, V0, V0),
+        lambda: ff.crba(m, Q0),
+        lambda: ff.momentum(m, Q0, V0),
+        lambda: ff.momentum_regressor(m, Q0, V0),
+    ):
+        with pytest.raises(ff.InputError, match=r"`q` has 0 samples"):
+            call()
+    # ... and a single sample broadcast against an empty stack names the stacked argument
+    with pytest.raises(ff.InputError, match=r"`tau` has 0 samples"):
+        ff.aba(m, q, v, V0)
     with pytest.raises(ff.InputError, match="fext"):
         ff.rnea(m, q, v, v, fext=np.zeros((2, 6)))
 

@@ -132,6 +132,13 @@ pub fn common_rows(batches: &[(&str, &Batch)]) -> PyResult<(usize, bool)> {
             }
         }
     }
+    if let Some((0, first)) = rows {
+        // an empty stack is almost always a filter or slice that selected nothing upstream: say so rather than
+        // return an empty result that fails later, far from its cause
+        return Err(input_err(format!(
+            "argument `{first}` has 0 samples (an empty stack): give at least one sample, as a 1-D array or as rows"
+        )));
+    }
     Ok(rows.map(|(r, _)| (r, true)).unwrap_or((1, false)))
 }
 

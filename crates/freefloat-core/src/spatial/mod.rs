@@ -8,7 +8,6 @@ mod inertia;
 pub mod lie;
 mod se3;
 mod so3;
-mod trig;
 mod vectors;
 
 pub use inertia::{m6_mul_motion, transform_inertia_to_parent, Inertia};
@@ -17,7 +16,6 @@ pub use so3::{
     principal_axis, quat_exp, quat_from_rot, quat_mul, quat_normalize, rot_from_quat, rot_to_rpy,
     rotate_about_principal_axis, rotation_about_axis, rpy_to_rot, so3_log, so3_right_jacobian_inv,
 };
-pub use trig::sin_cos;
 pub(crate) use vectors::cross as cross_fma;
 pub use vectors::{Force, Motion};
 
