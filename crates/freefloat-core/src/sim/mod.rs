@@ -345,6 +345,27 @@ impl<'m, 'i> Stepper<'m, 'i> {
         Ok(())
     }
 
+    /// `dq = Σⱼ wⱼ kqⱼ`, `dv = Σⱼ wⱼ kvⱼ` over the stages (a row of the tableau's a, or its b), column-wise and
+    /// skipping the zero weights (RK4 has one non-zero a per stage): the same sums in the same order as the full
+    /// inner product over j (adding the skipped ±0 terms to the running sum, which starts at +0, changes
+    /// nothing), bit for bit.
+    fn combine_stages(&mut self, w: &[f64]) {
+        let nv = self.m.nv;
+        let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
+        dq.fill(0.0);
+        dv.fill(0.0);
+        for (j, &wj) in w.iter().enumerate() {
+            if wj == 0.0 {
+                continue;
+            }
+            let (kq, kv) = (&self.kq[j][..nv], &self.kv[j][..nv]);
+            for k in 0..nv {
+                dq[k] += wj * kq[k];
+                dv[k] += wj * kv[k];
+            }
+        }
+    }
+
     /// One Runge-Kutta step from (t, q0, v0, w0). Stage 0 must already hold f(y0) (see `eval`).
     /// Writes the new state into q1, v1 and returns (w1, error norm or 0).
     #[allow(clippy::too_many_arguments)]
@@ -366,22 +387,8 @@ impl<'m, 'i> Stepper<'m, 'i> {
         // (and without the zip chains they replaced).
         let (q0, v0, v1) = (&q0[..m.nq], &v0[..nv], &mut v1[..nv]);
         for s in 1..tab.stages() {
-            // Column-wise over the stages, skipping the tableau's zeros (RK4 has one non-zero a per stage):
-            // the same sums in the same order as the full inner product (adding the skipped ±0 terms to the
-            // running sum, which starts at +0, changes nothing), bit for bit.
+            self.combine_stages(tab.a[s]);
             let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
-            dq.fill(0.0);
-            dv.fill(0.0);
-            for (j, &a) in tab.a[s].iter().enumerate() {
-                if a == 0.0 {
-                    continue;
-                }
-                let (kq, kv) = (&self.kq[j][..nv], &self.kv[j][..nv]);
-                for k in 0..nv {
-                    dq[k] += a * kq[k];
-                    dv[k] += a * kv[k];
-                }
-            }
             let vs = &mut self.vs[..nv];
             for k in 0..nv {
                 dq[k] *= h;
@@ -396,22 +403,9 @@ impl<'m, 'i> Stepper<'m, 'i> {
             self.eval(t + tab.c[s] * h, s)?;
             dexpinv(m, &self.dq, &mut self.kq[s]);
         }
-        // The weighted sum of the stages, column-wise in the same order as the inner product over j (the
-        // tableau's zero weights skipped, as above): bit for bit the same sums.
+        self.combine_stages(tab.b);
         let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
-        dq.fill(0.0);
-        dv.fill(0.0);
         let mut w1 = w0;
-        for (j, &b) in tab.b.iter().enumerate() {
-            if b == 0.0 {
-                continue;
-            }
-            let (kq, kv) = (&self.kq[j][..nv], &self.kv[j][..nv]);
-            for k in 0..nv {
-                dq[k] += b * kq[k];
-                dv[k] += b * kv[k];
-            }
-        }
         for (j, b) in tab.b.iter().enumerate() {
             w1 += h * b * self.kw[j];
         }
