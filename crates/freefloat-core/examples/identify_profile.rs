@@ -2,14 +2,18 @@
 //! instruction counts (`valgrind --tool=callgrind`) and indicative wall times:
 //! - `pass MODEL SAMPLES`: the streaming regressor build (kinematics, the kept columns, the right-hand side) over
 //!   deterministic states, every column of the non-root bodies kept (no solve);
-//! - `gram REPS`: the Gram accumulation alone, one block of 64 samples (192 angular rows x 53 columns) REPS times.
+//! - `identify MODEL SAMPLES`: the same states through the whole identification (`identify_momentum`: the pass
+//!   above with the Gram accumulation, then the solve);
+//! - `gram REPS`: the general Gram accumulation (`GramLs`, column-major blocks) alone, one block of 64 samples (192 angular rows x 53 columns) REPS times.
 //!
 //! Build and run:
 //!
 //!     cargo build --release -p freefloat-core --example identify_profile
 //!     target/release/examples/identify_profile pass naveen_dual_arm 20000
 //!     target/release/examples/identify_profile gram 20000
-use freefloat_core::estimation::{momentum_regressor_pass, GramLs, MomentumProblem};
+use freefloat_core::estimation::{
+    gram_rows_upper, identify_momentum, momentum_regressor_pass, GramLs, MomentumProblem, GRAM_TILE,
+};
 use freefloat_core::model::builtin;
 use nalgebra::DMatrix;
 use std::time::Instant;
@@ -19,7 +23,7 @@ fn mix(i: usize, j: usize) -> f64 {
     ((i * 37 + j * 101) % 97) as f64 / 97.0 - 0.5
 }
 
-fn pass(model: &str, t: usize) {
+fn pass(model: &str, t: usize, solve: bool) {
     let m = builtin::load(model).expect("built-in model");
     let mut q = Vec::with_capacity(t * m.nq);
     let mut v = Vec::with_capacity(t * m.nv);
@@ -38,7 +42,11 @@ fn pass(model: &str, t: usize) {
     let known = vec![0.0; 10 * m.nbodies()];
     let p = MomentumProblem { q: &q, v: &v, h: &h, unknown_cols: &unknown, known_params: &known, weights: None };
     let t0 = Instant::now();
-    let sum = momentum_regressor_pass(&m, &p).expect("regressor pass");
+    let sum = if solve {
+        identify_momentum(&m, &p).expect("identification").x.sum()
+    } else {
+        momentum_regressor_pass(&m, &p).expect("regressor pass")
+    };
     let dt = t0.elapsed().as_secs_f64();
     println!("{:.1} ns per sample ({} columns), checksum {sum:.6e}", dt / t as f64 * 1e9, unknown.len());
 }
@@ -53,16 +61,38 @@ fn gram(reps: usize) {
     }
     let dt = t0.elapsed().as_secs_f64();
     let (rss, yty) = g.rss_at(&nalgebra::DVector::zeros(n));
-    println!("{:.1} ns per sample (3 rows), checksum {rss:.6e} {yty:.6e}", dt / (reps * rows / 3) as f64 * 1e9);
+    println!("GramLs: {:.1} ns per sample (3 rows), checksum {rss:.6e} {yty:.6e}", dt / (reps * rows / 3) as f64 * 1e9);
+    // the same rows, row-major and padded, through the kernel of the identification's Gram pass
+    let w = (n + 1).next_multiple_of(GRAM_TILE);
+    let mut b = vec![0.0; rows * w];
+    for r in 0..rows {
+        for c in 0..=n {
+            b[r * w + c] = block[(rows + r, c)];
+        }
+    }
+    let mut acc = vec![0.0; w * w];
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        gram_rows_upper(&mut acc, &b, w, rows, w);
+    }
+    let dt = t0.elapsed().as_secs_f64();
+    println!(
+        "row kernel: {:.1} ns per sample (3 rows), checksum {:.6e}",
+        dt / (reps * rows / 3) as f64 * 1e9,
+        acc[n * w + n]
+    );
 }
 
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     match (a.get(1).map(String::as_str), a.len()) {
-        (Some("pass"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number")),
+        (Some("pass"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number"), false),
+        (Some("identify"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number"), true),
         (Some("gram"), 3) => gram(a[2].parse().expect("repetitions: a whole number")),
         _ => {
-            eprintln!("usage: identify_profile pass <builtin model> <samples> | identify_profile gram <repetitions>");
+            eprintln!(
+                "usage: identify_profile pass|identify <builtin model> <samples> | identify_profile gram <repetitions>"
+            );
             std::process::exit(2);
         }
     }

@@ -1,7 +1,7 @@
 //! Identification from momentum (Naveen, Shah, Misra, eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
 
 use super::analysis::{check_rank, finish};
-use super::gram::{gram_update, GramLs};
+use super::gram::{gram_rows_upper, GramLs, GRAM_TILE};
 use super::{LsResult, StreamingLs};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
@@ -15,6 +15,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// Samples per block: 64 samples = 384 rows × (n+1) columns (≈160 kB for n = 52), big enough for
 /// the blocked Gram product to run at full speed, small enough to stay in L2.
 const BLOCK_SAMPLES: usize = 64;
+/// Samples per block of the Gram pass ([`Layout::Rows`]): 8 samples are 24 linear and 24 angular rows, about
+/// 21 kB for n = 52, so the Gram kernel reads them from L1 right after they are written (64-sample blocks, 172 kB,
+/// went out to L2 in between).
+const ROW_BLOCK_SAMPLES: usize = 8;
 /// Normal equations are kept when the equilibrated κ is at most this: then κ²ε ≈ 2e-6, and one
 /// refinement step on the true residual brings the error down to the QR level (∝ κε).
 pub const GRAM_KAPPA_MAX: f64 = 1e5;
@@ -88,6 +92,34 @@ impl MomentumProblem<'_> {
     }
 }
 
+/// How a block `[A_b | y_b]` of up to 6·[`BLOCK_SAMPLES`] (or 6·[`ROW_BLOCK_SAMPLES`]) rows is laid out in memory.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Layout {
+    /// column-major, 6·BLOCK_SAMPLES rows × (n+1) columns in augmented order (the unknowns, then y): what the
+    /// streaming QR and the refinement pass read
+    Columns,
+    /// row-major, 6·ROW_BLOCK_SAMPLES rows padded to a multiple of [`GRAM_TILE`] (the padding left zero) and the columns permuted as
+    /// [`gram_slots`] says: what the Gram kernel reads without packing (stored as a (width × rows) column-major
+    /// matrix, which is the same memory)
+    Rows,
+}
+
+/// Block column of each augmented index (unknown j < n, y at n) in the [`Layout::Rows`] layout, and the padded
+/// width of the leading columns whose linear-momentum rows can be nonzero: y first, then the unknowns with a
+/// linear part (mass and first moments, `unknown_cols[j] % 10 <= 3`), then the inertia columns, whose linear rows
+/// are exactly zero (Naveen, Shah, Misra, eq. 10). The linear rows' Gram product then runs over the leading
+/// columns only (see [`SplitGram`]).
+fn gram_slots(p: &MomentumProblem) -> (Vec<usize>, usize) {
+    let n = p.unknown_cols.len();
+    let mut slot = vec![0; n + 1];
+    let linear: Vec<usize> = (0..n).filter(|&j| p.unknown_cols[j] % 10 <= 3).collect();
+    let rest = (0..n).filter(|&j| p.unknown_cols[j] % 10 > 3);
+    for (k, j) in linear.iter().copied().chain(rest).enumerate() {
+        slot[j] = k + 1;
+    }
+    (slot, (linear.len() + 1).next_multiple_of(GRAM_TILE))
+}
+
 /// Per-thread work buffers that turn samples into weighted blocks `[A_b | y_b]`.
 struct BlockBuilder<'a> {
     m: &'a Model,
@@ -95,6 +127,12 @@ struct BlockBuilder<'a> {
     d: Data,
     qbuf: Vec<f64>,
     block: DMatrix<f64>,
+    /// entry (row, block column) of the block is at `row·strides.0 + column·strides.1` of its storage
+    strides: (usize, usize),
+    /// samples per block
+    block_samples: usize,
+    /// block column of the right-hand side
+    y_col: usize,
     /// the bodies that have a column to keep or a known, nonzero parameter, in body order
     bodies: Vec<BodyColumns>,
     sw: [f64; 6],
@@ -103,27 +141,46 @@ struct BlockBuilder<'a> {
 /// What the block builder takes from one body's ten regressor columns.
 struct BodyColumns {
     body: usize,
-    /// (column k of the body, block column j) of the unknowns
+    /// (column k of the body, block column) of the unknowns whose linear-momentum rows are written
     kept: Vec<(usize, usize)>,
+    /// the same for the unknowns of which only the angular rows are written: in [`Layout::Rows`], the inertia
+    /// columns, whose linear rows are exactly zero (eq. 10) and stay as the zeroed block has them, since the Gram
+    /// pass only reads its blocks (the QR pass overwrites its blocks, so there every row is written)
+    kept_angular: Vec<(usize, usize)>,
     /// (column k of the body, parameter) of the known, nonzero standard parameters (moved to the right-hand side)
     known: Vec<(usize, f64)>,
 }
 
 impl<'a> BlockBuilder<'a> {
-    fn new(m: &'a Model, p: &'a MomentumProblem<'a>) -> Self {
+    fn new(m: &'a Model, p: &'a MomentumProblem<'a>, layout: Layout) -> Self {
         let n = p.unknown_cols.len();
+        let (slot, block, strides, block_samples) = match layout {
+            Layout::Columns => {
+                let cap = 6 * BLOCK_SAMPLES;
+                ((0..=n).collect(), DMatrix::zeros(cap, n + 1), (1, cap), BLOCK_SAMPLES)
+            }
+            Layout::Rows => {
+                let w = (n + 1).next_multiple_of(GRAM_TILE);
+                (gram_slots(p).0, DMatrix::zeros(w, 6 * ROW_BLOCK_SAMPLES), (w, 1), ROW_BLOCK_SAMPLES)
+            }
+        };
+        let angular_only = |k: usize| layout == Layout::Rows && k >= 4;
         let bodies = (0..m.nbodies())
-            .map(|i| BodyColumns {
-                body: i,
-                kept: (0..10)
-                    .filter_map(|k| p.unknown_cols.iter().position(|&c| c == 10 * i + k).map(|j| (k, j)))
-                    .collect(),
-                known: (0..10)
-                    .map(|k| (k, p.known_params[10 * i + k]))
-                    .filter(|&(k, pk)| pk != 0.0 && !p.unknown_cols.contains(&(10 * i + k)))
-                    .collect(),
+            .map(|i| {
+                let kept =
+                    (0..10).filter_map(|k| p.unknown_cols.iter().position(|&c| c == 10 * i + k).map(|j| (k, slot[j])));
+                let (kept_angular, kept) = kept.partition(|&(k, _)| angular_only(k));
+                BodyColumns {
+                    body: i,
+                    kept,
+                    kept_angular,
+                    known: (0..10)
+                        .map(|k| (k, p.known_params[10 * i + k]))
+                        .filter(|&(k, pk)| pk != 0.0 && !p.unknown_cols.contains(&(10 * i + k)))
+                        .collect(),
+                }
             })
-            .filter(|b| !b.kept.is_empty() || !b.known.is_empty())
+            .filter(|b| !b.kept.is_empty() || !b.kept_angular.is_empty() || !b.known.is_empty())
             .collect();
         let sw = p.weights.map_or([1.0; 6], |w| w.map(f64::sqrt));
         BlockBuilder {
@@ -131,7 +188,10 @@ impl<'a> BlockBuilder<'a> {
             p,
             d: Data::new(m),
             qbuf: Vec::new(),
-            block: DMatrix::zeros(6 * BLOCK_SAMPLES, n + 1),
+            block,
+            strides,
+            block_samples,
+            y_col: slot[n],
             bodies,
             sw,
         }
@@ -146,23 +206,27 @@ impl<'a> BlockBuilder<'a> {
         let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
         // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
         forward_velocities_unchecked(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv]);
-        let n = p.unknown_cols.len();
-        let cap = self.block.nrows();
         let bs = self.block.as_mut_slice();
+        let (rs, cs) = self.strides;
         let (lin0, ang0) = (3 * slot, 3 * cnt + 3 * slot);
         let sw = self.sw;
         let mut y: [f64; 6] = std::array::from_fn(|r| p.h[6 * s + r]);
         // Only the kept columns are written, straight into their block column (no full 6 × 10·nbodies regressor
         // and no copy of it): the columns of the bodies in use, from the one formula (Naveen, Shah, Misra, eq. 10).
+        // (Forming only the needed columns one by one, through a match on the column, measured 1.3x slower:
+        // all ten at once share their products and vectorise.)
         for b in &self.bodies {
             let cols = body_momentum_columns(&self.d, b.body);
             for &(k, j) in &b.kept {
                 let src = &cols[k];
-                let (lin, ang) = bs[j * cap..(j + 1) * cap].split_at_mut(ang0);
-                let (lin, ang) = (&mut lin[lin0..lin0 + 3], &mut ang[..3]);
                 for r in 0..3 {
-                    lin[r] = sw[r] * src[r];
-                    ang[r] = sw[r + 3] * src[r + 3];
+                    bs[(lin0 + r) * rs + j * cs] = sw[r] * src[r];
+                    bs[(ang0 + r) * rs + j * cs] = sw[r + 3] * src[r + 3];
+                }
+            }
+            for &(k, j) in &b.kept_angular {
+                for r in 0..3 {
+                    bs[(ang0 + r) * rs + j * cs] = sw[r + 3] * cols[k][r + 3];
                 }
             }
             for &(k, pk) in &b.known {
@@ -171,9 +235,10 @@ impl<'a> BlockBuilder<'a> {
                 }
             }
         }
+        let j = self.y_col;
         for r in 0..3 {
-            bs[n * cap + lin0 + r] = self.sw[r] * y[r];
-            bs[n * cap + ang0 + r] = self.sw[r + 3] * y[r + 3];
+            bs[(lin0 + r) * rs + j * cs] = sw[r] * y[r];
+            bs[(ang0 + r) * rs + j * cs] = sw[r + 3] * y[r + 3];
         }
         Ok(())
     }
@@ -190,7 +255,7 @@ impl<'a> BlockBuilder<'a> {
             if stop.load(Ordering::Relaxed) {
                 return Err(FfError::interrupted(format!("identification stopped after {s} samples of a pass")));
             }
-            let cnt = BLOCK_SAMPLES.min(range.end - s);
+            let cnt = self.block_samples.min(range.end - s);
             for slot in 0..cnt {
                 self.fill(s + slot, slot, cnt)?;
             }
@@ -201,42 +266,44 @@ impl<'a> BlockBuilder<'a> {
     }
 }
 
-/// The Gram matrix of the blocks, exploiting that the linear-momentum rows of the momentum regressor are
-/// exactly zero in every inertia column (Naveen, Shah, Misra, eq. 10: `I_jk` columns are `[0; r_j ω_k + r_k ω_j]`):
-/// the angular rows go through the full (n+1)² product, the linear rows only through the product of their
-/// mass and first-moment columns and y (17 of 53 for the dual-arm robot), gathered into a small buffer.
-/// About 1.8× fewer multiply-adds than the dense product for the dual-arm robot.
+/// The Gram matrix of [`Layout::Rows`] blocks, exploiting that the linear-momentum rows of the momentum regressor
+/// are exactly zero in every inertia column (Naveen, Shah, Misra, eq. 10: `I_jk` columns are
+/// `[0; r_j ω_k + r_k ω_j]`): the angular rows go through the upper triangle of the full product, the linear rows
+/// only through that of the leading block columns (y, mass and first moments: 17 of 53 columns, padded to 24, for
+/// the dual-arm robot). Accumulated in block-column order, put back in augmented order once at the end.
 struct SplitGram {
-    g: GramLs,
-    /// augmented-column indices with nonzero linear rows (mass, first moments, then y)
-    lin: Vec<usize>,
-    small: DMatrix<f64>,
-    buf: DMatrix<f64>,
+    n: usize,
+    /// the padded row width of the blocks, and of the w × w accumulator
+    w: usize,
+    /// padded width of the leading columns whose linear rows can be nonzero
+    lin_w: usize,
+    slot: Vec<usize>,
+    acc: Vec<f64>,
+    rows: usize,
 }
 
 impl SplitGram {
     fn new(p: &MomentumProblem) -> Self {
         let n = p.unknown_cols.len();
-        let mut lin: Vec<usize> = (0..n).filter(|&j| p.unknown_cols[j] % 10 <= 3).collect();
-        lin.push(n);
-        let k = lin.len();
-        SplitGram { g: GramLs::new(n), small: DMatrix::zeros(k, k), buf: DMatrix::zeros(3 * BLOCK_SAMPLES, k), lin }
+        let w = (n + 1).next_multiple_of(GRAM_TILE);
+        let (slot, lin_w) = gram_slots(p);
+        SplitGram { n, w, lin_w, slot, acc: vec![0.0; w * w], rows: 0 }
     }
 
-    /// Add a block filled by [`BlockBuilder::fill`]: rows 0..rows/2 linear, rows/2..rows angular.
+    /// Add a block filled by [`BlockBuilder::fill`] in [`Layout::Rows`]: rows 0..rows/2 linear, rows/2..rows
+    /// angular.
     fn add(&mut self, block: &DMatrix<f64>, rows: usize) {
-        let half = rows / 2;
-        self.g.add_augmented_range(block, half, half);
-        for (a, &j) in self.lin.iter().enumerate() {
-            self.buf.view_mut((0, a), (half, 1)).copy_from(&block.view((0, j), (half, 1)));
-        }
-        gram_update(&mut self.small, &self.buf, 0, half);
+        let (half, w) = (rows / 2, self.w);
+        let b = block.as_slice();
+        gram_rows_upper(&mut self.acc, &b[..half * w], w, half, self.lin_w);
+        gram_rows_upper(&mut self.acc, &b[half * w..rows * w], w, half, w);
+        self.rows += rows;
     }
 
-    fn finish(mut self) -> GramLs {
-        let half = self.g.rows();
-        self.g.add_scattered(&self.lin, &self.small, half);
-        self.g
+    fn finish(self) -> GramLs {
+        let mut g = GramLs::new(self.n);
+        g.add_permuted_upper(&self.acc, self.w, &self.slot, self.rows);
+        g
     }
 }
 
@@ -252,6 +319,7 @@ fn par_pass<A: Send>(
     m: &Model,
     p: &MomentumProblem,
     t: usize,
+    layout: Layout,
     make: impl Fn() -> A + Sync,
     feed: impl Fn(&mut A, &mut DMatrix<f64>, usize) + Sync,
     hook: &mut Option<Hook>,
@@ -262,7 +330,7 @@ fn par_pass<A: Send>(
     let stop = AtomicBool::new(false);
     let work = |range: std::ops::Range<usize>| -> Result<A> {
         let mut acc = make();
-        BlockBuilder::new(m, p).run(range, &stop, |b, rows| feed(&mut acc, b, rows))?;
+        BlockBuilder::new(m, p, layout).run(range, &stop, |b, rows| feed(&mut acc, b, rows))?;
         Ok(acc)
     };
     if threads == 1 && hook.is_none() {
@@ -309,7 +377,7 @@ pub fn identify_momentum_interruptible(
     let t = p.samples(m)?;
     let n = p.unknown_cols.len();
     if !force_qr {
-        let mut grams = par_pass(m, p, t, || SplitGram::new(p), |g, b, rows| g.add(b, rows), hook)?
+        let mut grams = par_pass(m, p, t, Layout::Rows, || SplitGram::new(p), |g, b, rows| g.add(b, rows), hook)?
             .into_iter()
             .map(SplitGram::finish);
         let mut g = grams.next().expect("one thread");
@@ -325,7 +393,9 @@ pub fn identify_momentum_interruptible(
             return refine(m, p, t, f.r, f.x, hook);
         }
     }
-    let mut qrs = par_pass(m, p, t, || StreamingLs::new(n), |q, b, rows| q.add_augmented(b, rows), hook)?.into_iter();
+    let mut qrs =
+        par_pass(m, p, t, Layout::Columns, || StreamingLs::new(n), |q, b, rows| q.add_augmented(b, rows), hook)?
+            .into_iter();
     let mut qr = qrs.next().expect("one thread");
     qrs.for_each(|o| qr.merge(&o));
     qr.solve()
@@ -357,7 +427,7 @@ fn refine(
         acc.rss += res.norm_squared();
         acc.atr.gemv_tr(1.0, &a, &res, 1.0);
     };
-    let mut parts = par_pass(m, p, t, make, feed, hook)?.into_iter();
+    let mut parts = par_pass(m, p, t, Layout::Columns, make, feed, hook)?.into_iter();
     let mut acc = parts.next().expect("one thread");
     for o in parts {
         acc.atr += o.atr;
@@ -371,12 +441,78 @@ fn refine(
     Ok(finish(&r, x + delta, rss, 6 * t, super::Method::GramRefined))
 }
 
-/// One streaming pass that only builds the weighted blocks `[A_b | y_b]` and discards them: the
-/// regressor-building cost inside [`identify_momentum`] (per pass), for benchmarks. Returns the
-/// sum of the right-hand sides so the work cannot be optimised away.
+/// One streaming pass that only builds the weighted blocks `[A_b | y_b]` (in the layout of the first, Gram pass)
+/// and discards them: the regressor-building cost inside [`identify_momentum`] (per pass), for benchmarks.
+/// Returns the sum of the right-hand sides so the work cannot be optimised away.
 pub fn momentum_regressor_pass(m: &Model, p: &MomentumProblem) -> Result<f64> {
     let t = p.samples(m)?;
-    let n = p.unknown_cols.len();
-    let parts = par_pass(m, p, t, || 0.0, |acc: &mut f64, b, rows| *acc += b.view((0, n), (rows, 1)).sum(), &mut None)?;
+    let (y_col, w) = (gram_slots(p).0[p.unknown_cols.len()], (p.unknown_cols.len() + 1).next_multiple_of(GRAM_TILE));
+    let rhs_sum = |acc: &mut f64, b: &mut DMatrix<f64>, rows: usize| {
+        *acc += b.as_slice().chunks_exact(w).take(rows).map(|row| row[y_col]).sum::<f64>();
+    };
+    let parts = par_pass(m, p, t, Layout::Rows, || 0.0, rhs_sum, &mut None)?;
     Ok(parts.into_iter().sum())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::builtin;
+
+    /// A deterministic, well-mixed number in [-0.5, 0.5).
+    fn mix(i: usize, j: usize) -> f64 {
+        ((i * 37 + j * 101) % 97) as f64 / 97.0 - 0.5
+    }
+
+    #[test]
+    fn the_gram_pass_equals_the_dense_gram_of_the_same_blocks() {
+        // The row-major, permuted, triangle-only Gram pass (with its unwritten zero linear rows) against the general
+        // column-major `GramLs` fed the QR pass's blocks, on a problem with known bodies and weights, a sample count
+        // that leaves a partial block and is split over threads.
+        let m = builtin::load("naveen_dual_arm").unwrap();
+        let t = PARALLEL_MIN_SAMPLES + 13;
+        let (mut q, mut v) = (Vec::new(), Vec::new());
+        for s in 0..t {
+            let mut qs = m.neutral();
+            qs.iter_mut().enumerate().for_each(|(k, x)| *x += 3.0 * mix(s, k));
+            let nrm = qs[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+            qs[3..7].iter_mut().for_each(|x| *x /= nrm);
+            q.extend(qs);
+            v.extend((0..m.nv).map(|k| mix(s + 7, k)));
+        }
+        let h: Vec<f64> = (0..6 * t).map(|k| mix(k, 3)).collect();
+        let known: Vec<f64> =
+            m.parameters().into_iter().flatten().enumerate().map(|(c, x)| if c >= 70 { x } else { 0.0 }).collect();
+        let unknown: Vec<usize> = (0..70).filter(|c| c % 10 != 2 && c % 10 != 6).collect();
+        let p = MomentumProblem {
+            q: &q,
+            v: &v,
+            h: &h,
+            unknown_cols: &unknown,
+            known_params: &known,
+            weights: Some([1.0, 2.0, 3.0, 0.5, 0.25, 4.0]),
+        };
+        let n = unknown.len();
+        let fast: Vec<GramLs> =
+            par_pass(&m, &p, t, Layout::Rows, || SplitGram::new(&p), |g, b, r| g.add(b, r), &mut None)
+                .unwrap()
+                .into_iter()
+                .map(SplitGram::finish)
+                .collect();
+        let dense = par_pass(&m, &p, t, Layout::Columns, || GramLs::new(n), |g, b, r| g.add_augmented(b, r), &mut None)
+            .unwrap();
+        assert!(fast.len() > 1, "the samples were not split over threads");
+        let sum = |parts: &[GramLs]| {
+            let mut g = parts[0].clone();
+            parts[1..].iter().for_each(|o| g.merge(o));
+            g
+        };
+        let (a, b) = (sum(&fast), sum(&dense));
+        assert_eq!(a.rows(), 6 * t);
+        assert_eq!(a.rows(), b.rows());
+        let (ga, gb) = (a.matrix(), b.matrix());
+        let scale = gb.amax();
+        assert!((ga - gb).amax() <= 1e-13 * scale, "Gram matrices differ by {:.2e} of {scale:.2e}", (ga - gb).amax());
+        assert_eq!(ga, &ga.transpose());
+    }
 }
