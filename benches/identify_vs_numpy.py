@@ -310,6 +310,13 @@ def numpy_identify(kin, H6, cols, known, solve=solve_normal):
 
 
 # ------------------------------------------------------------------------------------------------------ timing
+#: pause before each timed job: OpenBLAS's worker threads busy-wait for a while after each BLAS call (about 2^28
+#: cycles, ~0.1 s, by default) and, on a 2-core machine, took a core from whichever job ran next (the freefloat
+#: regressor pass after the peer's solve measured 1.0x CPU-time ratio and slower than freefloat's whole
+#: identification). The pause lets them go to sleep; nothing of it is timed.
+SETTLE_S = 0.3
+
+
 def interleaved(jobs, repeats):
     """({name: [wall seconds of each repeat]}, {name: [CPU seconds of this process, all threads]}); the jobs
     take turns so machine noise hits them alike. CPU time is what survives a loaded machine best on one core;
@@ -319,6 +326,7 @@ def interleaved(jobs, repeats):
     for _ in range(repeats):
         for k, f in jobs.items():
             gc.collect()
+            time.sleep(SETTLE_S)
             c0, t0 = time.process_time(), time.perf_counter()
             f()
             ts[k].append(time.perf_counter() - t0)
