@@ -56,11 +56,19 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-import scipy.linalg as sla
+# OpenBLAS's idle worker threads busy-wait for 2^28 cycles (~0.1 s) after every BLAS call before they sleep. On a
+# 2-core machine they took a core from whichever job ran next: the freefloat pass after the peer's solve measured
+# 1.5-2x its own wall time in process CPU time. The shortest wait OpenBLAS allows (2^4 cycles; read when numpy
+# first loads OpenBLAS) removes that without slowing the peer: its medians stayed within 2 % (4 runs of each
+# setting, 2026-12-04). An idle pause between the jobs instead was tried and dropped: it made the peer's solve
+# 1.7-2.5x slower.
+os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
-import freefloat as ff
-from freefloat import estimation as est
+import numpy as np  # noqa: E402
+import scipy.linalg as sla  # noqa: E402
+
+import freefloat as ff  # noqa: E402
+from freefloat import estimation as est  # noqa: E402
 
 MODEL = "naveen_dual_arm"
 DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]
@@ -310,13 +318,6 @@ def numpy_identify(kin, H6, cols, known, solve=solve_normal):
 
 
 # ------------------------------------------------------------------------------------------------------ timing
-#: pause before each timed job: OpenBLAS's worker threads busy-wait for a while after each BLAS call (about 2^28
-#: cycles, ~0.1 s, by default) and, on a 2-core machine, took a core from whichever job ran next (the freefloat
-#: regressor pass after the peer's solve measured 1.0x CPU-time ratio and slower than freefloat's whole
-#: identification). The pause lets them go to sleep; nothing of it is timed.
-SETTLE_S = 0.3
-
-
 def interleaved(jobs, repeats):
     """({name: [wall seconds of each repeat]}, {name: [CPU seconds of this process, all threads]}); the jobs
     take turns so machine noise hits them alike. CPU time is what survives a loaded machine best on one core;
@@ -326,7 +327,6 @@ def interleaved(jobs, repeats):
     for _ in range(repeats):
         for k, f in jobs.items():
             gc.collect()
-            time.sleep(SETTLE_S)
             c0, t0 = time.process_time(), time.perf_counter()
             f()
             ts[k].append(time.perf_counter() - t0)
@@ -471,6 +471,7 @@ def main():
         "repeats": repeats,
         "cores": cores,
         "openblas_threads": os.environ.get("OPENBLAS_NUM_THREADS", f"default ({cores} cores allowed)"),
+        "openblas_thread_timeout": os.environ.get("OPENBLAS_THREAD_TIMEOUT"),
         "machine": platform.processor() or platform.machine(),
         "numpy": np.__version__,
         "git": git_hash(),
@@ -497,7 +498,8 @@ def main():
         f"agreement: regressor {reg_err:.1e}, estimate {est_err:.1e}, the peer's kinematics {kin_err:.1e}; "
         f"eqs. 38-39 errors: median {med:.3f} %, max {mx:.3f} %.",
         f"Median (min-max) of {repeats} interleaved repeats on {cores} core(s) (both programs use them all: "
-        f"freefloat's threads, OpenBLAS threads {res['openblas_threads']}); git {res['git']}; load average "
+        f"freefloat's threads, OpenBLAS threads {res['openblas_threads']}, idle spin "
+        f"2^{res['openblas_thread_timeout']} cycles); git {res['git']}; load average "
         f"{load_before[0]:.1f} before, {load_after[0]:.1f} after.",
         "",
         "| what | freefloat [s] | numpy peer [s] | ratio | CPU-time ratio | target |",
