@@ -9,11 +9,11 @@
 //!   a QR of `[R; block]`, so accuracy is that of a dense QR of the whole problem (error ∝ κ·ε).
 //! - [`GramLs`]: the Gram matrix `[A y]ᵀ[A y]`, accumulated with cache-blocked matrix products (several times
 //!   faster; the identification's own pass writes its rows in the layout of a triangle-only kernel,
-//!   [`gram_rows_upper`], and folds each small block while it is still in L1). Plain normal equations lose twice the digits (error ∝ κ²·ε), so
-//!   [`identify_momentum`] only keeps this route when the measured, column-equilibrated condition
-//!   number is small, and then adds one refinement pass on the true residual (corrected
-//!   semi-normal equations, Björck), which restores QR-grade accuracy. Otherwise it re-streams the
-//!   data through [`StreamingLs`].
+//!   [`gram_rows_upper`], and folds each small block while it is still in L1). Plain normal equations lose twice
+//!   the digits (error ∝ κ²·ε), so [`identify_momentum`] only keeps this route when the measured,
+//!   column-equilibrated condition number is small, and then adds one refinement pass on the true residual
+//!   (corrected semi-normal equations, Björck), which restores QR-grade accuracy. Otherwise it re-streams the data
+//!   through [`StreamingLs`].
 //!
 //! Statistics: `σ̂² = RSS/(m − n)`, `cov = σ̂² (RᵀR)⁻¹`, `std = √diag(cov)`; the condition number is
 //! exact, from the singular values of the small factor `R` (σ(R) = σ(A)). A rank-deficient problem

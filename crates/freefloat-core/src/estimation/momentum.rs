@@ -12,8 +12,8 @@ use crate::regressors::body_momentum_columns;
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Samples per block: 64 samples = 384 rows × (n+1) columns (≈160 kB for n = 52), big enough for
-/// the blocked Gram product to run at full speed, small enough to stay in L2.
+/// Samples per block of the QR and refinement passes ([`Layout::Columns`]): 64 samples = 384 rows × (n+1) columns
+/// (≈160 kB for n = 52), long columns for their reflectors and products, small enough to stay in L2.
 const BLOCK_SAMPLES: usize = 64;
 /// Samples per block of the Gram pass ([`Layout::Rows`]): 8 samples are 24 linear and 24 angular rows, about
 /// 21 kB for n = 52, so the Gram kernel reads them from L1 right after they are written (64-sample blocks, 172 kB,
@@ -98,9 +98,9 @@ enum Layout {
     /// column-major, 6·BLOCK_SAMPLES rows × (n+1) columns in augmented order (the unknowns, then y): what the
     /// streaming QR and the refinement pass read
     Columns,
-    /// row-major, 6·ROW_BLOCK_SAMPLES rows padded to a multiple of [`GRAM_TILE`] (the padding left zero) and the columns permuted as
-    /// [`gram_slots`] says: what the Gram kernel reads without packing (stored as a (width × rows) column-major
-    /// matrix, which is the same memory)
+    /// row-major, 6·ROW_BLOCK_SAMPLES rows, each padded to a multiple of [`GRAM_TILE`] (the padding left zero),
+    /// the columns permuted as [`gram_slots`] says: what the Gram kernel reads without packing (stored as a
+    /// (width × rows) column-major matrix, which is the same memory)
     Rows,
 }
 
@@ -144,8 +144,11 @@ struct BodyColumns {
     /// (column k of the body, block column) of the unknowns whose linear-momentum rows are written
     kept: Vec<(usize, usize)>,
     /// the same for the unknowns of which only the angular rows are written: in [`Layout::Rows`], the inertia
-    /// columns, whose linear rows are exactly zero (eq. 10) and stay as the zeroed block has them, since the Gram
-    /// pass only reads its blocks (the QR pass overwrites its blocks, so there every row is written)
+    /// columns, whose linear rows are exactly zero (eq. 10) and stay as the zeroed block has them. That holds
+    /// because the Gram pass only reads its blocks (the QR pass overwrites its blocks, so there every row is
+    /// written), and because no row is ever angular before it is linear: the linear rows of a block of `cnt`
+    /// samples are rows 0..3·cnt, a full block's angular rows start at 3·ROW_BLOCK_SAMPLES, and only a builder's
+    /// last block is partial (its angular rows start lower, but every one of their entries is written)
     kept_angular: Vec<(usize, usize)>,
     /// (column k of the body, parameter) of the known, nonzero standard parameters (moved to the right-hand side)
     known: Vec<(usize, f64)>,
