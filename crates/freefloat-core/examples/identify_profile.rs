@@ -2,18 +2,16 @@
 //! instruction counts (`valgrind --tool=callgrind`) and indicative wall times:
 //! - `pass MODEL SAMPLES`: the streaming regressor build (kinematics, the kept columns, the right-hand side) over
 //!   deterministic states, every column of the non-root bodies kept (no solve);
-//! - `identify MODEL SAMPLES`: the same states through the whole identification (`identify_momentum`: the pass
-//!   above with the Gram accumulation, then the solve);
-//! - `gram REPS`: the general Gram accumulation (`GramLs`, column-major blocks) alone, one block of 64 samples (192 angular rows x 53 columns) REPS times.
+//! - `gram REPS`: the Gram accumulation alone, one block of 64 samples (192 angular rows x 53 columns) REPS times,
+//!   twice: by the general `GramLs` (column-major blocks, matrixmultiply) and by the row kernel of the
+//!   identification's Gram pass (`gram_rows_upper`, the same rows row-major), with their checksums.
 //!
 //! Build and run:
 //!
 //!     cargo build --release -p freefloat-core --example identify_profile
 //!     target/release/examples/identify_profile pass naveen_dual_arm 20000
 //!     target/release/examples/identify_profile gram 20000
-use freefloat_core::estimation::{
-    gram_rows_upper, identify_momentum, momentum_regressor_pass, GramLs, MomentumProblem, GRAM_TILE,
-};
+use freefloat_core::estimation::{gram_rows_upper, momentum_regressor_pass, GramLs, MomentumProblem, GRAM_TILE};
 use freefloat_core::model::builtin;
 use nalgebra::DMatrix;
 use std::time::Instant;
@@ -23,7 +21,7 @@ fn mix(i: usize, j: usize) -> f64 {
     ((i * 37 + j * 101) % 97) as f64 / 97.0 - 0.5
 }
 
-fn pass(model: &str, t: usize, solve: bool) {
+fn pass(model: &str, t: usize) {
     let m = builtin::load(model).expect("built-in model");
     let mut q = Vec::with_capacity(t * m.nq);
     let mut v = Vec::with_capacity(t * m.nv);
@@ -42,11 +40,7 @@ fn pass(model: &str, t: usize, solve: bool) {
     let known = vec![0.0; 10 * m.nbodies()];
     let p = MomentumProblem { q: &q, v: &v, h: &h, unknown_cols: &unknown, known_params: &known, weights: None };
     let t0 = Instant::now();
-    let sum = if solve {
-        identify_momentum(&m, &p).expect("identification").x.sum()
-    } else {
-        momentum_regressor_pass(&m, &p).expect("regressor pass")
-    };
+    let sum = momentum_regressor_pass(&m, &p).expect("regressor pass");
     let dt = t0.elapsed().as_secs_f64();
     println!("{:.1} ns per sample ({} columns), checksum {sum:.6e}", dt / t as f64 * 1e9, unknown.len());
 }
@@ -86,13 +80,10 @@ fn gram(reps: usize) {
 fn main() {
     let a: Vec<String> = std::env::args().collect();
     match (a.get(1).map(String::as_str), a.len()) {
-        (Some("pass"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number"), false),
-        (Some("identify"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number"), true),
+        (Some("pass"), 4) => pass(&a[2], a[3].parse().expect("samples: a whole number")),
         (Some("gram"), 3) => gram(a[2].parse().expect("repetitions: a whole number")),
         _ => {
-            eprintln!(
-                "usage: identify_profile pass|identify <builtin model> <samples> | identify_profile gram <repetitions>"
-            );
+            eprintln!("usage: identify_profile pass <builtin model> <samples> | identify_profile gram <repetitions>");
             std::process::exit(2);
         }
     }
