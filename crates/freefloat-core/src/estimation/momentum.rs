@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 /// (≈160 kB for n = 52), long columns for their reflectors and products, small enough to stay in L2.
 const BLOCK_SAMPLES: usize = 64;
 /// Samples per block of the Gram pass ([`Layout::Rows`]): 8 samples are 24 linear and 24 angular rows, about
-/// 21 kB for n = 52, so the Gram kernel reads them from L1 right after they are written (64-sample blocks, 172 kB,
+/// 21 kB for n = 52, so the Gram kernel reads them from L1 right after they are written (64-sample blocks, 163 kB,
 /// went out to L2 in between).
 const ROW_BLOCK_SAMPLES: usize = 8;
 /// Normal equations are kept when the equilibrated κ is at most this: then κ²ε ≈ 2e-6, and one
