@@ -99,25 +99,36 @@ enum Layout {
     /// streaming QR and the refinement pass read
     Columns,
     /// row-major, 6·ROW_BLOCK_SAMPLES rows, each padded to a multiple of [`GRAM_TILE`] (the padding left zero),
-    /// the columns permuted as [`gram_slots`] says: what the Gram kernel reads without packing (stored as a
+    /// the columns permuted as [`RowLayout`] says: what the Gram kernel reads without packing (stored as a
     /// (width × rows) column-major matrix, which is the same memory)
     Rows,
 }
 
-/// Block column of each augmented index (unknown j < n, y at n) in the [`Layout::Rows`] layout, and the padded
-/// width of the leading columns whose linear-momentum rows can be nonzero: y first, then the unknowns with a
-/// linear part (mass and first moments, `unknown_cols[j] % 10 <= 3`), then the inertia columns, whose linear rows
-/// are exactly zero (Naveen, Shah, Misra, eq. 10). The linear rows' Gram product then runs over the leading
-/// columns only (see [`SplitGram`]).
-fn gram_slots(p: &MomentumProblem) -> (Vec<usize>, usize) {
-    let n = p.unknown_cols.len();
-    let mut slot = vec![0; n + 1];
-    let linear: Vec<usize> = (0..n).filter(|&j| p.unknown_cols[j] % 10 <= 3).collect();
-    let rest = (0..n).filter(|&j| p.unknown_cols[j] % 10 > 3);
-    for (k, j) in linear.iter().copied().chain(rest).enumerate() {
-        slot[j] = k + 1;
+/// The columns of a [`Layout::Rows`] block: y first, then the unknowns with a linear part (mass and first moments,
+/// `unknown_cols[j] % 10 <= 3`), then the inertia columns, whose linear rows are exactly zero (Naveen, Shah, Misra,
+/// eq. 10), then zero padding. The linear rows' Gram product then runs over the leading columns only (see
+/// [`SplitGram`]).
+struct RowLayout {
+    /// block column of each augmented index (unknown j < n, y at n)
+    slot: Vec<usize>,
+    /// the padded row width: n + 1 rounded up to a multiple of [`GRAM_TILE`]
+    width: usize,
+    /// the padded width of the leading columns whose linear rows can be nonzero
+    lin_width: usize,
+}
+
+impl RowLayout {
+    fn new(p: &MomentumProblem) -> Self {
+        let n = p.unknown_cols.len();
+        let mut slot = vec![0; n + 1];
+        let linear: Vec<usize> = (0..n).filter(|&j| p.unknown_cols[j] % 10 <= 3).collect();
+        let rest = (0..n).filter(|&j| p.unknown_cols[j] % 10 > 3);
+        for (k, j) in linear.iter().copied().chain(rest).enumerate() {
+            slot[j] = k + 1;
+        }
+        let lin_width = (linear.len() + 1).next_multiple_of(GRAM_TILE);
+        RowLayout { slot, width: (n + 1).next_multiple_of(GRAM_TILE), lin_width }
     }
-    (slot, (linear.len() + 1).next_multiple_of(GRAM_TILE))
 }
 
 /// Per-thread work buffers that turn samples into weighted blocks `[A_b | y_b]`.
@@ -163,8 +174,8 @@ impl<'a> BlockBuilder<'a> {
                 ((0..=n).collect(), DMatrix::zeros(cap, n + 1), (1, cap), BLOCK_SAMPLES)
             }
             Layout::Rows => {
-                let w = (n + 1).next_multiple_of(GRAM_TILE);
-                (gram_slots(p).0, DMatrix::zeros(w, 6 * ROW_BLOCK_SAMPLES), (w, 1), ROW_BLOCK_SAMPLES)
+                let RowLayout { slot, width: w, .. } = RowLayout::new(p);
+                (slot, DMatrix::zeros(w, 6 * ROW_BLOCK_SAMPLES), (w, 1), ROW_BLOCK_SAMPLES)
             }
         };
         let angular_only = |k: usize| layout == Layout::Rows && k >= 4;
@@ -275,37 +286,33 @@ impl<'a> BlockBuilder<'a> {
 /// only through that of the leading block columns (y, mass and first moments: 17 of 53 columns, padded to 24, for
 /// the dual-arm robot). Accumulated in block-column order, put back in augmented order once at the end.
 struct SplitGram {
-    n: usize,
-    /// the padded row width of the blocks, and of the w × w accumulator
-    w: usize,
-    /// padded width of the leading columns whose linear rows can be nonzero
-    lin_w: usize,
-    slot: Vec<usize>,
+    layout: RowLayout,
+    /// width × width, row-major, in block-column order
     acc: Vec<f64>,
     rows: usize,
 }
 
 impl SplitGram {
     fn new(p: &MomentumProblem) -> Self {
-        let n = p.unknown_cols.len();
-        let w = (n + 1).next_multiple_of(GRAM_TILE);
-        let (slot, lin_w) = gram_slots(p);
-        SplitGram { n, w, lin_w, slot, acc: vec![0.0; w * w], rows: 0 }
+        let layout = RowLayout::new(p);
+        let acc = vec![0.0; layout.width * layout.width];
+        SplitGram { layout, acc, rows: 0 }
     }
 
     /// Add a block filled by [`BlockBuilder::fill`] in [`Layout::Rows`]: rows 0..rows/2 linear, rows/2..rows
     /// angular.
     fn add(&mut self, block: &DMatrix<f64>, rows: usize) {
-        let (half, w) = (rows / 2, self.w);
+        let (half, w) = (rows / 2, self.layout.width);
         let b = block.as_slice();
-        gram_rows_upper(&mut self.acc, &b[..half * w], w, half, self.lin_w);
+        gram_rows_upper(&mut self.acc, &b[..half * w], w, half, self.layout.lin_width);
         gram_rows_upper(&mut self.acc, &b[half * w..rows * w], w, half, w);
         self.rows += rows;
     }
 
     fn finish(self) -> GramLs {
-        let mut g = GramLs::new(self.n);
-        g.add_permuted_upper(&self.acc, self.w, &self.slot, self.rows);
+        let l = &self.layout;
+        let mut g = GramLs::new(l.slot.len() - 1);
+        g.add_permuted_upper(&self.acc, l.width, &l.slot, self.rows);
         g
     }
 }
@@ -449,7 +456,8 @@ fn refine(
 /// Returns the sum of the right-hand sides so the work cannot be optimised away.
 pub fn momentum_regressor_pass(m: &Model, p: &MomentumProblem) -> Result<f64> {
     let t = p.samples(m)?;
-    let (y_col, w) = (gram_slots(p).0[p.unknown_cols.len()], (p.unknown_cols.len() + 1).next_multiple_of(GRAM_TILE));
+    let l = RowLayout::new(p);
+    let (y_col, w) = (l.slot[p.unknown_cols.len()], l.width);
     let rhs_sum = |acc: &mut f64, b: &mut DMatrix<f64>, rows: usize| {
         *acc += b.as_slice().chunks_exact(w).take(rows).map(|row| row[y_col]).sum::<f64>();
     };
