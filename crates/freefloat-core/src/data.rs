@@ -31,6 +31,9 @@ pub struct Data {
     pub oc: Vec<Motion>,
     /// ABA: bias forces (then articulated bias forces), inertial frame.
     pub of: Vec<Force>,
+    /// Sine and cosine of each revolute joint's angle at the last kinematic sweep (`[0, 1]` for other joints),
+    /// computed four joints at a time before the sweep (`spatial::trig`).
+    pub joint_sc: Vec<[f64; 2]>,
     /// Motion subspace of each joint in its child frame at the last `forward_kinematics` call: a copy
     /// of `Model::subspaces`, whose universal-joint columns forward kinematics refreshes.
     pub s: Vec<M6>,
@@ -83,6 +86,7 @@ impl Data {
             oa: vec![Motion::ZERO; n],
             oc: vec![Motion::ZERO; n],
             of: vec![Force::ZERO; n],
+            joint_sc: vec![[0.0, 1.0]; n],
             s: m.subspaces.clone(),
             os: vec![M6::zeros(); n],
             aba_momentum: Force::ZERO,
@@ -111,6 +115,7 @@ impl Data {
             + 2 * std::mem::size_of::<Force>()
             + 5 * std::mem::size_of::<M6>()
             + std::mem::size_of::<[f64; 6]>()
+            + std::mem::size_of::<[f64; 2]>()
             + std::mem::size_of::<Inertia>();
         let bytes = n.checked_mul(per_body).ok_or_else(|| too_big(m, usize::MAX))?;
         let mut probe: Vec<u8> = Vec::new();
@@ -160,6 +165,7 @@ impl Data {
             self.oa.len(),
             self.oc.len(),
             self.of.len(),
+            self.joint_sc.len(),
             self.s.len(),
             self.os.len(),
             self.u.len(),

@@ -1,7 +1,7 @@
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
-use crate::kinematics::{joint_placement_at, subspace_column_at};
+use crate::kinematics::{joint_placement_at, joint_sin_cos, subspace_column_at};
 use crate::model::{JointType, Model};
 use crate::spatial::{Motion, Se3, V3};
 
@@ -61,6 +61,8 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     let free_root = n > 0 && m.joint_types[0] == JointType::Free;
     {
         let (o_mi, ic, os, s) = (&mut d.o_mi[..n], &mut d.ic[..n], &mut d.os[..n], &mut d.s[..n]);
+        let sc = &mut d.joint_sc[..n];
+        joint_sin_cos(m, q, sc);
         for i in 0..n {
             if i == 0 && free_root {
                 o_mi[0] = Se3::identity();
@@ -69,7 +71,7 @@ pub(crate) fn crba_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
             }
             // (revolute joints about a principal axis of their frame take the specialised rotation and subspace
             // column inside `joint_placement_at` and `subspace_column_at`, as forward kinematics and ABA do)
-            let li = joint_placement_at(m, &mut s[i], i, q);
+            let li = joint_placement_at(m, &mut s[i], i, q, sc[i]);
             let o = match m.parents[i] {
                 Some(0) if free_root => li,
                 Some(p) => o_mi[p].compose(&li),

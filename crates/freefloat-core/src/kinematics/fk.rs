@@ -2,7 +2,8 @@ use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::error::Result;
 use crate::model::{universal_bias, universal_first_axis, JointType, Model};
-use crate::spatial::{cross_fma, rotate_about_principal_axis, rotation_about_axis, Motion, Se3, M6, V3};
+use crate::spatial::trig::{sin_cos4, LANES};
+use crate::spatial::{cross_fma, rotate_about_principal_axis, rotation_about_axis_sc, Motion, Se3, M6, V3};
 
 /// Placements of every body: `li_mi` (in the parent) and `o_mi` (in the inertial frame).
 /// Also refreshes the configuration-dependent subspace columns (`d.s`) of universal joints.
@@ -29,9 +30,10 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
             && m.axes2.len() == n
             && m.principal_revolute().len() == n
     );
-    let (li_mi, o_mi, s) = (&mut d.li_mi[..n], &mut d.o_mi[..n], &mut d.s[..n]);
+    let (li_mi, o_mi, s, sc) = (&mut d.li_mi[..n], &mut d.o_mi[..n], &mut d.s[..n], &mut d.joint_sc[..n]);
+    joint_sin_cos(m, q, sc);
     for i in 0..n {
-        let li = joint_placement_at(m, &mut s[i], i, q);
+        let li = joint_placement_at(m, &mut s[i], i, q, sc[i]);
         li_mi[i] = li;
         o_mi[i] = match m.parents[i] {
             Some(p) => o_mi[p].compose(&li),
@@ -40,10 +42,33 @@ pub(crate) fn forward_kinematics_unchecked(m: &Model, d: &mut Data, q: &[f64]) {
     }
 }
 
+/// Sine and cosine of every revolute joint's angle (`[0, 1]` for the other bodies), four bodies per
+/// `trig::sin_cos4` call: `sc` must have one entry per body. Run before a kinematic sweep, whose
+/// `joint_placement_at` takes body i's entry.
+#[inline]
+pub(crate) fn joint_sin_cos(m: &Model, q: &[f64], sc: &mut [[f64; 2]]) {
+    let n = m.nbodies();
+    assert!(sc.len() == n && m.joint_types.len() == n && m.idx_q.len() == n);
+    for (b0, chunk) in sc.chunks_mut(LANES).enumerate() {
+        let mut x = [0.0; LANES];
+        for (l, xl) in x.iter_mut().enumerate().take(chunk.len()) {
+            let i = b0 * LANES + l;
+            if m.joint_types[i] == JointType::Revolute {
+                *xl = q[m.idx_q[i]];
+            }
+        }
+        let (s, c) = sin_cos4(x);
+        for (l, out) in chunk.iter_mut().enumerate() {
+            *out = [s[l], c[l]];
+        }
+    }
+}
+
 /// Placement of body i in its parent at `q` (the whole configuration), also refreshing body i's subspace buffer
 /// `s` (`d.s[i]`) for a universal joint: one step of `forward_kinematics` (and of the CRBA's forward sweep).
+/// `sc` is body i's entry of `joint_sin_cos` at this `q` (used by revolute joints).
 #[inline(always)]
-pub(crate) fn joint_placement_at(m: &Model, s: &mut M6, i: usize, q: &[f64]) -> Se3 {
+pub(crate) fn joint_placement_at(m: &Model, s: &mut M6, i: usize, q: &[f64], sc: [f64; 2]) -> Se3 {
     let qi = &q[m.idx_q[i]..m.idx_q[i] + m.nqs[i]];
     let jt = m.joint_types[i];
     if jt == JointType::Universal {
@@ -57,8 +82,8 @@ pub(crate) fn joint_placement_at(m: &Model, s: &mut M6, i: usize, q: &[f64]) -> 
         JointType::Revolute => {
             let p = &m.placements[i];
             match m.principal_revolute()[i] {
-                Some(k) => Se3::new(rotate_about_principal_axis(&p.rot, k, qi[0]), p.trans),
-                None => Se3::new(p.rot * rotation_about_axis(&m.axes[i], qi[0]), p.trans),
+                Some(k) => Se3::new(rotate_about_principal_axis(&p.rot, k, sc[0], sc[1]), p.trans),
+                None => Se3::new(p.rot * rotation_about_axis_sc(&m.axes[i], sc[0], sc[1]), p.trans),
             }
         }
         _ => m.placements[i].compose(&jt.transform(&m.axes[i], &m.axes2[i], qi)),

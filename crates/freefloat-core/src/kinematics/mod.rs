@@ -12,7 +12,7 @@ pub(crate) use com::center_of_mass_from_placements;
 pub use fk::{classical_acceleration, forward_accelerations, forward_kinematics, forward_velocities};
 pub(crate) use fk::{
     forward_accelerations_unchecked, forward_kinematics_unchecked, forward_velocities_unchecked, joint_bias,
-    joint_bias_at, joint_placement_at, joint_velocity, subspace_column_at, world_subspace_column,
+    joint_bias_at, joint_placement_at, joint_sin_cos, joint_velocity, subspace_column_at, world_subspace_column,
 };
 pub(crate) use jacobian::jacobian_from_data;
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};

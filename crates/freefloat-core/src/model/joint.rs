@@ -161,7 +161,7 @@ impl JointType {
             JointType::Cylindrical => Se3::new(rotation_about_axis(axis, q[0]), axis * q[1]),
             JointType::Free => Se3::new(rot_from_quat(&q[3..7]), V3::new(q[0], q[1], q[2])),
             JointType::Planar => {
-                let (s, c) = q[2].sin_cos();
+                let (s, c) = crate::spatial::trig::sin_cos(q[2]);
                 Se3::new(M3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0), V3::new(q[0], q[1], 0.0))
             }
             JointType::Spherical => Se3::new(rot_from_quat(&q[0..4]), V3::zeros()),

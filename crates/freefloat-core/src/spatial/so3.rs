@@ -1,7 +1,7 @@
 //! Rotations: quaternions in the (x, y, z, w) order used by `q`, rotation matrices, the SO(3)
 //! exponential/logarithm and the inverse right Jacobian that the Lie-group integrator needs.
 
-use super::{M3, V3};
+use super::{trig, M3, V3};
 
 /// Hamilton product of two quaternions stored (x, y, z, w).
 #[inline]
@@ -90,10 +90,17 @@ pub fn quat_exp(phi: &V3) -> [f64; 4] {
 
 /// Rotation matrix about a unit axis by `angle` (Rodrigues): `R = c 1 + s [a]× + (1 − c) a aᵀ`, entry by entry
 /// (the same matrix as `1 + s [a]× + (1 − c)[a]ײ` for a unit axis, without the 3×3 products of skew matrices that
-/// made it a tenth of forward kinematics).
+/// made it a tenth of forward kinematics). The sine and cosine are the engine's (`trig::sin_cos`), the same bits as
+/// the batched ones of the kinematic sweeps.
 #[inline]
 pub fn rotation_about_axis(axis: &V3, angle: f64) -> M3 {
-    let (s, c) = angle.sin_cos();
+    let (s, c) = trig::sin_cos(angle);
+    rotation_about_axis_sc(axis, s, c)
+}
+
+/// `rotation_about_axis` from the angle's sine `s` and cosine `c`.
+#[inline]
+pub fn rotation_about_axis_sc(axis: &V3, s: f64, c: f64) -> M3 {
     let t = 1.0 - c;
     let (x, y, z) = (axis.x, axis.y, axis.z);
     let (tx, ty, tz) = (t * x, t * y, t * z);
@@ -122,18 +129,14 @@ pub fn principal_axis(axis: &V3) -> Option<usize> {
     }
 }
 
-/// `r · R(eₖ, angle)`, `R` as `rotation_about_axis`: a placement's rotation times a rotation about its own k-th
-/// axis. Column k of `r` is unchanged and the other two mix by the angle's cosine and sine (R(eₖ) maps
-/// eₐ → c eₐ + s e_b and e_b → −s eₐ + c e_b, with (k, a, b) a cyclic order): 12 products instead of
-/// Rodrigues' formula and a dense 3×3 product.
+/// `r · R(eₖ, θ)` from θ's sine `s` and cosine `c`, `R` as `rotation_about_axis`: a placement's rotation times a
+/// rotation about its own k-th axis. Column k of `r` is unchanged and the other two mix by the angle's cosine and
+/// sine (R(eₖ) maps eₐ → c eₐ + s e_b and e_b → −s eₐ + c e_b, with (k, a, b) a cyclic order): 12 products instead
+/// of Rodrigues' formula and a dense 3×3 product. The kinematic sweeps take s and c from one batched evaluation
+/// of all joints (`trig::sin_cos4`, four joints per call) instead of one C-library `sincos` per joint, which was
+/// 18 % of a CRBA call.
 #[inline(always)]
-pub fn rotate_about_principal_axis(r: &M3, k: usize, angle: f64) -> M3 {
-    // The C library's sine and cosine (glibc: about 120 instructions per call on angles in [-π, π], 14 % of the
-    // CRBA). The `libm` crate's take 105 and a hand-written Cody-Waite + Taylor routine 75, all within one ulp, but
-    // either moved the default excitation design (a non-convex SQP over 256 intervals) to another local optimum:
-    // 55 kept intervals instead of the 63, κ 901.4 and C 1665 that docs/excitation.md documents and its test
-    // checks. Changing the trigonometry means re-deriving those results.
-    let (s, c) = angle.sin_cos();
+pub fn rotate_about_principal_axis(r: &M3, k: usize, s: f64, c: f64) -> M3 {
     // one monomorphised body per axis: the column indices are constants, not run-time arithmetic
     match k {
         0 => mix_columns::<1, 2>(r, s, c),
