@@ -163,7 +163,7 @@ def test_scenarios_lists_postcapture_scenarios_and_shipped_trajectories():
     } <= set(names)
     assert "naveen_exciting_trajectory" in names and len(names) >= 6
     line = next(ln for ln in out if ln.startswith("naveen_exciting_trajectory"))
-    assert "55 intervals" in line and "naveen_dual_arm_offset" in line
+    assert "63 intervals" in line and "naveen_dual_arm_offset" in line
 
 
 def test_identify_minimal_trajectory_by_unknown_name_is_a_clear_error():

@@ -126,6 +126,6 @@ def test_load_trajectory_takes_a_file_or_a_built_in_name():
     with data.path("trajectories", "naveen_exciting_trajectory") as p:
         by_file, joints_f = load_trajectory(p)
     by_name, joints_n = load_trajectory("naveen_exciting_trajectory")
-    assert joints_n == joints_f and by_name.n_intervals == by_file.n_intervals == 55
+    assert joints_n == joints_f and by_name.n_intervals == by_file.n_intervals == 63
     with pytest.raises(ff.InputError, match="neither a file nor a built-in trajectory.*naveen_exciting_trajectory"):
         load_trajectory("no_such_trajectory")

@@ -3,10 +3,11 @@
 
 use crate::data::Data;
 use crate::error::{FfError, Result};
+use crate::estimation::{gram_rows_upper, GRAM_TILE};
 use crate::interrupt::stopped;
 use crate::kinematics::{base_twist_for_momentum, forward_velocities_unchecked};
 use crate::model::{JointType, Model};
-use crate::regressors::momentum_regressor_from_data_unchecked;
+use crate::regressors::body_momentum_columns;
 use crate::sim::{integrate_base_poses, Steps};
 use crate::spatial::{rot_from_quat, Motion, Se3, V3};
 use nalgebra::{DMatrix, Vector6};
@@ -118,25 +119,48 @@ pub fn excitation_rows(
     n_signal: usize,
     threads: usize,
 ) -> Result<ExcitationRows> {
-    let s = sample_blocks(m, q0, path, stride, offset, columns, n_signal, threads, None)?;
-    let total: usize = s.blocks.iter().map(|b| b.nrows()).sum();
+    let s = sample_blocks(m, q0, path, stride, offset, columns, n_signal, threads, Collect::Rows, None)?;
+    let total: usize = s.parts.iter().map(|b| b.rows.nrows()).sum();
     let mut rows = DMatrix::zeros(total, columns.len());
     let mut r0 = 0;
-    for b in &s.blocks {
-        rows.rows_mut(r0, b.nrows()).copy_from(b);
-        r0 += b.nrows();
+    for b in &s.parts {
+        rows.rows_mut(r0, b.rows.nrows()).copy_from(&b.rows);
+        r0 += b.rows.nrows();
     }
     Ok(ExcitationRows { rows, sumsq: s.sumsq, count: s.count, q_end: s.q_end })
 }
 
-/// The rows of `excitation_rows` as consecutive blocks, one per worker thread (the objective forms each
-/// block's Gram matrix where it was built).
+/// What the workers of phase 3 of [`sample_blocks`] keep of the rows they build.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Collect {
+    /// the rows themselves (`excitation_rows`)
+    Rows,
+    /// only their Gram matrix (the objective), accumulated while each 8-point chunk of rows is still in L1
+    Gram,
+}
+
+/// One phase-3 worker's share: its rows (consecutive, in grid order) or their Gram matrix.
+pub(crate) struct Part {
+    /// (6 · its points) × columns.len() with [`Collect::Rows`]; 0 × 0 otherwise
+    pub rows: DMatrix<f64>,
+    /// with [`Collect::Gram`]: `width × width` row-major, the upper triangle of RᵀR valid (see `gram_rows_upper`);
+    /// empty otherwise
+    pub gram: Vec<f64>,
+    /// row length of `gram`: columns.len() padded to a multiple of `GRAM_TILE`
+    pub width: usize,
+}
+
+/// The rows of `excitation_rows`, or their Gram matrix, as one [`Part`] per worker thread.
 pub(crate) struct SampleBlocks {
-    pub blocks: Vec<DMatrix<f64>>,
+    pub parts: Vec<Part>,
     pub sumsq: f64,
     pub count: usize,
     pub q_end: Vec<f64>,
 }
+
+/// Points per chunk of phase 3's row-major row buffer: 48 rows of 56 columns are 21 kB, which stay in L1 between
+/// their writes and the Gram kernel's reads (as in the identification's Gram pass).
+const CHUNK_POINTS: usize = 8;
 
 /// Three phases, so that the expensive ones run in parallel: (1) the zero-momentum twist at every grid
 /// point depends on the joints only (not on the base pose), so the points are split over threads; (2) the
@@ -153,6 +177,7 @@ pub(crate) fn sample_blocks(
     columns: &[usize],
     n_signal: usize,
     threads: usize,
+    collect: Collect,
     stop: Option<&AtomicBool>,
 ) -> Result<SampleBlocks> {
     let halt = || FfError::interrupted("excitation objective stopped");
@@ -218,38 +243,68 @@ pub(crate) fn sample_blocks(
     let poses: Vec<Se3> =
         pose_rows.chunks_exact(7).map(|p| Se3::new(rot_from_quat(&p[3..7]), V3::new(p[0], p[1], p[2]))).collect();
 
-    // (3) regressor rows at the sampled points
+    // (3) regressor rows at the sampled points. Only the bodies with kept columns are formed, each from the one
+    // copy of Naveen, Shah, Misra's eq. 10 (`body_momentum_columns`), straight into a row-major chunk of
+    // CHUNK_POINTS points; the chunk then goes into the worker's rows or its Gram matrix.
+    let ncols = columns.len();
+    let width = ncols.div_ceil(GRAM_TILE) * GRAM_TILE;
+    let bodies: Vec<(usize, Vec<(usize, usize)>)> = (0..m.nbodies())
+        .map(|i| (i, columns.iter().enumerate().filter(|&(_, &c)| c / 10 == i).map(|(j, &c)| (c % 10, j)).collect()))
+        .filter(|(_, kept): &(usize, Vec<(usize, usize)>)| !kept.is_empty())
+        .collect();
+    let bodies = &bodies;
     let picked: Vec<usize> = (0..samples).filter(|i| i % stride == offset).collect();
     let pchunk = picked.len().div_ceil(threads).max(1);
     let (twists, poses) = (&twists, &poses);
-    let parts: Vec<(DMatrix<f64>, f64)> = std::thread::scope(|s| {
+    let parts: Vec<(Part, f64)> = std::thread::scope(|s| {
         let handles: Vec<_> = picked
             .chunks(pchunk)
             .map(|idx| {
-                s.spawn(move || -> Result<(DMatrix<f64>, f64)> {
+                s.spawn(move || -> Result<(Part, f64)> {
                     let mut d = Data::new(m);
                     let (mut q, mut v) = (q0.to_vec(), vec![0.0; m.nv]);
                     q[..7].copy_from_slice(&[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]);
-                    let mut full = DMatrix::zeros(6, ncol);
-                    let mut rows = DMatrix::zeros(6 * idx.len(), columns.len());
+                    let mut part = Part { rows: DMatrix::zeros(0, 0), gram: vec![], width };
+                    match collect {
+                        Collect::Rows => part.rows = DMatrix::zeros(6 * idx.len(), ncols),
+                        Collect::Gram => part.gram = vec![0.0; width * width],
+                    }
+                    // the padding columns stay zero
+                    let mut buf = vec![0.0; 6 * CHUNK_POINTS * width];
                     let mut sumsq = 0.0;
-                    for (r, &i) in idx.iter().enumerate() {
-                        if stopped(stop) {
-                            return Err(halt());
+                    for (c0, chunk) in idx.chunks(CHUNK_POINTS).enumerate() {
+                        for (slot, &i) in chunk.iter().enumerate() {
+                            if stopped(stop) {
+                                return Err(halt());
+                            }
+                            set_joints(i, &mut q, &mut v);
+                            forward_velocities_unchecked(m, &mut d, &q, &v); // identity base, joint-only twists
+                            place_base(m, &mut d, &twists[i], &poses[i]);
+                            for (body, kept) in bodies {
+                                let cols = body_momentum_columns(&d, *body);
+                                for &(k, j) in kept {
+                                    for r in 0..6 {
+                                        buf[(6 * slot + r) * width + j] = cols[k][r];
+                                    }
+                                }
+                            }
+                            sumsq += twists[i].norm_squared()
+                                + (0..n_signal).map(|k| path.qd[i * n + k].powi(2)).sum::<f64>();
                         }
-                        set_joints(i, &mut q, &mut v);
-                        forward_velocities_unchecked(m, &mut d, &q, &v); // identity base, joint-only twists
-                        place_base(m, &mut d, &twists[i], &poses[i]);
-                        momentum_regressor_from_data_unchecked(m, &d, &mut full);
-                        for (c, &col) in columns.iter().enumerate() {
-                            for k in 0..6 {
-                                rows[(6 * r + k, c)] = full[(k, col)];
+                        let rows = 6 * chunk.len();
+                        match collect {
+                            Collect::Gram => gram_rows_upper(&mut part.gram, &buf, width, rows, width),
+                            Collect::Rows => {
+                                let r0 = 6 * CHUNK_POINTS * c0;
+                                for r in 0..rows {
+                                    for j in 0..ncols {
+                                        part.rows[(r0 + r, j)] = buf[r * width + j];
+                                    }
+                                }
                             }
                         }
-                        sumsq +=
-                            twists[i].norm_squared() + (0..n_signal).map(|k| path.qd[i * n + k].powi(2)).sum::<f64>();
                     }
-                    Ok((rows, sumsq))
+                    Ok((part, sumsq))
                 })
             })
             .collect();
@@ -263,7 +318,7 @@ pub(crate) fn sample_blocks(
     q_end[..7].copy_from_slice(&pose_rows[7 * (samples - 1)..]);
     let sumsq = parts.iter().map(|p| p.1).sum();
     Ok(SampleBlocks {
-        blocks: parts.into_iter().map(|p| p.0).collect(),
+        parts: parts.into_iter().map(|p| p.0).collect(),
         sumsq,
         count: (6 + n_signal) * picked.len(),
         q_end,
