@@ -249,8 +249,18 @@ pub(crate) fn sample_blocks(
     let ncols = columns.len();
     let width = ncols.div_ceil(GRAM_TILE) * GRAM_TILE;
     let bodies: Vec<(usize, Vec<(usize, usize)>)> = (0..m.nbodies())
-        .map(|i| (i, columns.iter().enumerate().filter(|&(_, &c)| c / 10 == i).map(|(j, &c)| (c % 10, j)).collect()))
-        .filter(|(_, kept): &(usize, Vec<(usize, usize)>)| !kept.is_empty())
+        .map(|i| {
+            (
+                i,
+                columns
+                    .iter()
+                    .enumerate()
+                    .filter(|&(_, &c)| c / 10 == i)
+                    .map(|(j, &c)| (c % 10, j))
+                    .collect::<Vec<_>>(),
+            )
+        })
+        .filter(|(_, kept)| !kept.is_empty())
         .collect();
     let bodies = &bodies;
     let picked: Vec<usize> = (0..samples).filter(|i| i % stride == offset).collect();
