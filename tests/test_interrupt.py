@@ -375,7 +375,11 @@ def _cl_data(n):
 def test_ctrl_c_stops_ch9_estimate_recorded_and_keeps_the_estimates_so_far():
     from freefloat import _core
 
-    R, F, m0 = _cl_data(120_000)  # ~30 µs a sample for 11 bodies: seconds of work (and 0.8 GB of data)
+    # About 5 µs a sample for 11 bodies (2026-12-04; 30 µs when this test was written): 240 000 samples are about
+    # 1.2 s of work and 1.4 GB of data, so the signal at 0.5 s lands well inside the estimator's loop. With 120 000
+    # samples the whole call took 0.6 s and, on a loaded machine, the loop could end between its last check for
+    # signals and the signal, which then surfaced as a plain KeyboardInterrupt.
+    R, F, m0 = _cl_data(240_000)
     exc, latency = _run_interrupted(lambda: _core.cl_estimate(R, F, 1e-3, m0), delay=0.5)
     assert isinstance(exc, ff.Interrupted), type(exc)
     assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
