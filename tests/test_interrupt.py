@@ -217,15 +217,15 @@ def test_sigint_to_the_cli_stops_it_within_a_second_and_saves_the_partial_run(tm
 
 def test_ctrl_c_stops_an_identification_solve_within_a_second(robot):
     """The momentum least squares streams its samples on worker threads; the calling thread polls for Ctrl-C and
-    stops them before their next block. A 1000-sample record repeated 600 times (600 000 samples, several
-    seconds of work on this machine) is interrupted after 0.3 s."""
+    stops them before their next block. A 1000-sample record repeated 1200 times (1.2 million samples, about a
+    second of work in a release build on 2 cores, 2026-12-04) is interrupted after 0.3 s."""
     from freefloat.identification.estimation import least_squares
 
     rng = np.random.default_rng(0)
     q = np.array([robot.random_configuration(rng) for _ in range(1000)])
     v = rng.normal(size=(1000, robot.nv))
     h = np.asarray(ff.momentum(robot, q, v))
-    Q, V, H = (np.tile(x, (600, 1)) for x in (q, v, h))
+    Q, V, H = (np.tile(x, (1200, 1)) for x in (q, v, h))
     mp = ff.minimal_parameters(robot, "closed-form")
     t0 = time.monotonic()
     exc, latency = _run_interrupted(lambda: least_squares(robot, Q, V, H, mp), delay=0.3)
@@ -248,18 +248,18 @@ def design():
 
 
 def test_ctrl_c_stops_one_excitation_objective_batch_within_a_second(design):
-    """One engine call evaluating 300 candidate trajectories (the whole 256-interval path each, ~50 ms: about
-    15 s of work) is stopped by the calling thread's Ctrl-C check: the workers stop before their next grid
-    point."""
+    """One engine call evaluating 600 candidate trajectories (the whole 256-interval path each, 4-10 ms on one
+    thread in a release build since the objective streams its Gram matrix: 1.5-3 s of work on two workers) is
+    stopped by the calling thread's Ctrl-C check: the workers stop before their next grid point."""
     d = design
     x = d.feasible_start(d.all_directions)
     t = d._grid(len(d.all_directions))
     q, qd, _ = d.cycloid(x, d.all_directions).evaluate(t)
-    Q = np.ascontiguousarray(np.broadcast_to(q, (300, *q.shape)))
-    QD = np.ascontiguousarray(np.broadcast_to(qd, (300, *qd.shape)))
+    Q = np.ascontiguousarray(np.broadcast_to(q, (600, *q.shape)))
+    QD = np.ascontiguousarray(np.broadcast_to(qd, (600, *qd.shape)))
     exc, latency = _run_interrupted(lambda: d._objective(Q, QD), 0.5)
     assert isinstance(exc, ff.Interrupted), type(exc)
-    assert "excitation objective stopped after" in str(exc) and "of 300" in str(exc), str(exc)
+    assert "excitation objective stopped after" in str(exc) and "of 600" in str(exc), str(exc)
     assert latency < STOP_WITHIN, f"stopped {latency:.2f} s after the signal"
     # the same call, small, still completes and agrees with the one-path evaluation
     one = d._objective(q[None], qd[None])
