@@ -134,21 +134,6 @@ fn library_sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
     (s, c)
 }
 
-/// Sines and cosines of `x`, written to `sin` and `cos` (which must be as long as `x`), four lanes at a time.
-pub fn sin_cos_slice(x: &[f64], sin: &mut [f64], cos: &mut [f64]) {
-    assert!(sin.len() == x.len() && cos.len() == x.len());
-    let mut i = 0;
-    while i < x.len() {
-        let mut lane = [0.0; LANES];
-        let len = LANES.min(x.len() - i);
-        lane[..len].copy_from_slice(&x[i..i + len]);
-        let (s, c) = sin_cos4(lane);
-        sin[i..i + len].copy_from_slice(&s[..len]);
-        cos[i..i + len].copy_from_slice(&c[..len]);
-        i += LANES;
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -238,15 +223,5 @@ mod tests {
         assert!(s[1].is_nan() && c[1].is_nan() && s[2].is_nan() && c[2].is_nan());
         assert_eq!((s[0], c[0]), sin_cos(0.3));
         assert_eq!((s[3], c[3]), sin_cos(-2.0));
-    }
-
-    #[test]
-    fn the_slice_form_matches_the_single_calls() {
-        let x: Vec<f64> = (0..11).map(|i| 0.7 * i as f64 - 3.0).collect();
-        let (mut s, mut c) = (vec![0.0; 11], vec![0.0; 11]);
-        sin_cos_slice(&x, &mut s, &mut c);
-        for i in 0..11 {
-            assert_eq!((s[i], c[i]), sin_cos(x[i]));
-        }
     }
 }
