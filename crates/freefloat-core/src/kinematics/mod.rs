@@ -4,6 +4,7 @@ mod base_twist;
 mod com;
 mod fk;
 mod jacobian;
+mod lanes;
 mod momentum;
 
 pub use base_twist::{base_twist_for_momentum, base_velocity_coordinates};
@@ -16,6 +17,7 @@ pub(crate) use fk::{
 };
 pub(crate) use jacobian::jacobian_from_data;
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};
+pub(crate) use lanes::Kin4;
 pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,
     world_composite_inertias, world_motion_subspaces,

@@ -5,9 +5,10 @@
 //! the frame origin). Both are expressed in some frame's axes; `Se3` moves them between frames.
 
 mod inertia;
+pub mod lanes;
 pub mod lie;
 mod se3;
-mod so3;
+pub(crate) mod so3;
 pub mod trig;
 mod vectors;
 

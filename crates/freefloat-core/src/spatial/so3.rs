@@ -1,6 +1,7 @@
 //! Rotations: quaternions in the (x, y, z, w) order used by `q`, rotation matrices, the SO(3)
 //! exponential/logarithm and the inverse right Jacobian that the Lie-group integrator needs.
 
+use super::lanes::Real;
 use super::{trig, M3, V3};
 
 /// Hamilton product of two quaternions stored (x, y, z, w).
@@ -33,20 +34,22 @@ pub fn quat_normalize(q: &mut [f64]) {
 /// If `q` has fewer than 4 entries (callers pass checked slices).
 #[inline]
 pub fn rot_from_quat(q: &[f64]) -> M3 {
-    let (x, y, z, w) = (q[0], q[1], q[2], q[3]);
+    let r = quat_rotation_rows(q[0], q[1], q[2], q[3]);
+    M3::new(r[0][0], r[0][1], r[0][2], r[1][0], r[1][1], r[1][2], r[2][0], r[2][1], r[2][2])
+}
+
+/// The rows of the rotation matrix of the unit quaternion (x, y, z, w), for one sample or four side by side
+/// (the one copy of the formula: `rot_from_quat` and the four-sample kinematics).
+#[inline(always)]
+pub(crate) fn quat_rotation_rows<T: Real>(x: T, y: T, z: T, w: T) -> [[T; 3]; 3] {
     let (xx, yy, zz) = (x * x, y * y, z * z);
     let (xy, xz, yz, wx, wy, wz) = (x * y, x * z, y * z, w * x, w * y, w * z);
-    M3::new(
-        1.0 - 2.0 * (yy + zz),
-        2.0 * (xy - wz),
-        2.0 * (xz + wy),
-        2.0 * (xy + wz),
-        1.0 - 2.0 * (xx + zz),
-        2.0 * (yz - wx),
-        2.0 * (xz - wy),
-        2.0 * (yz + wx),
-        1.0 - 2.0 * (xx + yy),
-    )
+    let (one, two) = (T::splat(1.0), T::splat(2.0));
+    [
+        [one - two * (yy + zz), two * (xy - wz), two * (xz + wy)],
+        [two * (xy + wz), one - two * (xx + zz), two * (yz - wx)],
+        [two * (xz - wy), two * (yz + wx), one - two * (xx + yy)],
+    ]
 }
 
 /// Unit quaternion (x, y, z, w, with w >= 0) of a rotation matrix (Shepperd's method).
