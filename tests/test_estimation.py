@@ -3,6 +3,10 @@ naveen_dual_arm driven by a prescribed multi-sine on the six arm joints and thre
 noise-free momentum, consistent standard deviations under noise, agreement with numpy.linalg.lstsq on the
 explicitly built minimal regressor (eq. 26), rank deficiency reported, and the error figures (eqs. 38-39)."""
 
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -117,3 +121,33 @@ def test_bad_arguments_are_named(case):
         est.least_squares(m, tr.q, tr.v, tr.momentum, mp, weights=[1.0, 1.0, 1.0, 1.0, 1.0, -1.0])
     with pytest.raises(ff.InputError, match="method"):
         est.least_squares(m, tr.q, tr.v, tr.momentum, mp, method="svd")
+
+
+_SAME_BITS_SCRIPT = """
+import os, sys, numpy as np, freefloat as ff
+from freefloat import estimation as est
+os.sched_setaffinity(0, {int(c) for c in sys.argv[1].split(",")})
+m = ff.models.load("naveen_dual_arm")
+mp = ff.minimal_parameters(m, method="closed-form")
+rng = np.random.default_rng(3)
+T = 9000  # above the engine's one-thread limit (4096): several chunks, several threads where allowed
+Q = np.tile(m.neutral(), (T, 1)) + rng.uniform(-1, 1, (T, m.nq))
+Q[:, 3:7] /= np.linalg.norm(Q[:, 3:7], axis=1, keepdims=True)
+V = rng.uniform(-1, 1, (T, m.nv))
+H = rng.uniform(-1, 1, (T, 6))
+r = est.least_squares(m, Q, V, H, mp)
+print(r.estimate.tobytes().hex(), float(r.rss).hex())
+"""
+
+
+@pytest.mark.skipif(not hasattr(os, "sched_setaffinity") or len(os.sched_getaffinity(0)) < 2, reason="needs 2 cores")
+def test_the_estimate_is_the_same_to_the_bit_on_one_core_and_on_two():
+    # The samples are streamed in fixed chunks whose partial sums are merged in chunk order, so the number of
+    # threads (the cores the process may use) changes nothing, not even the last bit.
+    cores = sorted(os.sched_getaffinity(0))[:2]
+    one = subprocess.run([sys.executable, "-c", _SAME_BITS_SCRIPT, str(cores[0])], capture_output=True, text=True)
+    two = subprocess.run(
+        [sys.executable, "-c", _SAME_BITS_SCRIPT, ",".join(map(str, cores))], capture_output=True, text=True
+    )
+    assert one.returncode == 0 and two.returncode == 0, one.stderr + two.stderr
+    assert one.stdout.strip() and one.stdout == two.stdout

@@ -3,15 +3,17 @@
 use super::analysis::{check_rank, finish};
 use super::gram::{gram_rows_upper, GramLs, GRAM_TILE};
 use super::{LsResult, StreamingLs};
+use crate::check::{check_finite, check_len};
 use crate::data::Data;
 use crate::error::{check_vec, FfError, Result};
-use crate::interrupt::{supervise, Hook};
+use crate::interrupt::{Hook, POLL_INTERVAL};
 use crate::kinematics::{forward_velocities_unchecked, Kin4};
 use crate::model::Model;
-use crate::regressors::{body_momentum_columns, momentum_columns};
+use crate::regressors::{body_momentum_columns, momentum_columns_of};
 use crate::spatial::lanes::{Real, F4, LANES};
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Instant;
 
 /// Samples per block of the QR and refinement passes ([`Layout::Columns`]): 64 samples = 384 rows × (n+1) columns
 /// (≈160 kB for n = 52), long columns for their reflectors and products, small enough to stay in L2.
@@ -72,9 +74,11 @@ pub struct MomentumProblem<'a> {
 impl MomentumProblem<'_> {
     fn samples(&self, m: &Model) -> Result<usize> {
         let t = self.h.len() / 6;
-        check_vec("h", self.h, 6 * t)?;
-        check_vec("q", self.q, m.nq * t)?;
-        check_vec("v", self.v, m.nv * t)?;
+        // sizes here; finiteness sample by sample in the passes (`BlockBuilder::fill`, `fill4`: on the worker
+        // threads, naming the sample), where a scan of every entry here held up the start of every pass
+        check_len("h", self.h.len(), 6 * t)?;
+        check_len("q", self.q.len(), m.nq * t)?;
+        check_len("v", self.v.len(), m.nv * t)?;
         check_vec("known_params", self.known_params, 10 * m.nbodies())?;
         let np = 10 * m.nbodies();
         let mut seen = vec![false; np];
@@ -173,6 +177,8 @@ struct BodyColumns {
     kept_angular: Vec<(usize, usize)>,
     /// (column k of the body, parameter) of the known, nonzero standard parameters (moved to the right-hand side)
     known: Vec<(usize, f64)>,
+    /// bit k set: column k is used (kept or known), the columns `fill4` forms
+    need: u16,
 }
 
 impl<'a> BlockBuilder<'a> {
@@ -193,16 +199,14 @@ impl<'a> BlockBuilder<'a> {
             .map(|i| {
                 let kept =
                     (0..10).filter_map(|k| p.unknown_cols.iter().position(|&c| c == 10 * i + k).map(|j| (k, slot[j])));
-                let (kept_angular, kept) = kept.partition(|&(k, _)| angular_only(k));
-                BodyColumns {
-                    body: i,
-                    kept,
-                    kept_angular,
-                    known: (0..10)
-                        .map(|k| (k, p.known_params[10 * i + k]))
-                        .filter(|&(k, pk)| pk != 0.0 && !p.unknown_cols.contains(&(10 * i + k)))
-                        .collect(),
-                }
+                let (kept_angular, kept): (Vec<_>, Vec<_>) = kept.partition(|&(k, _)| angular_only(k));
+                let known: Vec<(usize, f64)> = (0..10)
+                    .map(|k| (k, p.known_params[10 * i + k]))
+                    .filter(|&(k, pk)| pk != 0.0 && !p.unknown_cols.contains(&(10 * i + k)))
+                    .collect();
+                let used = kept.iter().chain(&kept_angular).map(|&(k, _)| k).chain(known.iter().map(|&(k, _)| k));
+                let need = used.fold(0u16, |acc, k| acc | (1 << k));
+                BodyColumns { body: i, kept, kept_angular, known, need }
             })
             .filter(|b| !b.kept.is_empty() || !b.kept_angular.is_empty() || !b.known.is_empty())
             .collect();
@@ -236,8 +240,10 @@ impl<'a> BlockBuilder<'a> {
     fn fill(&mut self, s: usize, slot: usize, cnt: usize) -> Result<()> {
         let (m, p) = (self.m, self.p);
         let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
-        // q checked just above, v and the sizes by `MomentumProblem::check`: the unchecked core
-        forward_velocities_unchecked(m, &mut self.d, q, &p.v[s * m.nv..(s + 1) * m.nv]);
+        let v = &p.v[s * m.nv..(s + 1) * m.nv];
+        check_finite("v", v).and_then(|_| check_finite("h", &p.h[6 * s..6 * s + 6])).map_err(|e| at_sample(e, s))?;
+        // q and v checked just above, the sizes by `MomentumProblem::samples`: the unchecked core
+        forward_velocities_unchecked(m, &mut self.d, q, v);
         let bs = self.block.as_mut_slice();
         let (rs, cs) = self.strides;
         let (lin0, ang0) = (3 * slot, 3 * cnt + 3 * slot);
@@ -284,8 +290,13 @@ impl<'a> BlockBuilder<'a> {
         let Some(kin) = self.kin.as_mut() else { unreachable!("fill4 runs only with the four-sample sweep") };
         let (nq, nv) = (m.nq, m.nv);
         let [b0, b1, b2, b3] = &mut self.qbufs;
-        let check =
-            |l: usize, buf| m.checked_q(&p.q[(s + l) * nq..(s + l + 1) * nq], buf).map_err(|e| at_sample(e, s + l));
+        // each sample's q (size, finite, unit quaternions), v and h (finite), in sample order as `fill` checks them
+        let check = |l: usize, buf| {
+            let (v, h) = (&p.v[(s + l) * nv..(s + l + 1) * nv], &p.h[6 * (s + l)..6 * (s + l) + 6]);
+            let q = m.checked_q(&p.q[(s + l) * nq..(s + l + 1) * nq], buf);
+            q.and_then(|q| check_finite("v", v).and_then(|_| check_finite("h", h)).map(|_| q))
+                .map_err(|e| at_sample(e, s + l))
+        };
         let q = [check(0, b0)?, check(1, b1)?, check(2, b2)?, check(3, b3)?];
         kin.run(m, &mut self.d, q, std::array::from_fn(|l| &p.v[(s + l) * nv..(s + l + 1) * nv]));
         assert!(slot + LANES <= cnt && cnt <= self.block_samples);
@@ -304,7 +315,7 @@ impl<'a> BlockBuilder<'a> {
         let mut y: [F4; 6] = std::array::from_fn(|r| F4::from_fn(|l| p.h[6 * (s + l) + r]));
         for b in &self.bodies {
             let i = b.body;
-            let cols = momentum_columns(&kin.rot[i], &kin.pos[i], &kin.lin[i], &kin.ang[i]);
+            let cols = momentum_columns_of(&kin.rot[i], &kin.pos[i], &kin.lin[i], &kin.ang[i], b.need);
             // weighted four lanes at once (the same product per lane as `fill`), then one store per lane
             for &(k, j) in &b.kept {
                 for r in 0..6 {
@@ -444,12 +455,19 @@ fn par_pass<A: Send>(
     let chunks = t.div_ceil(size).max(1);
     let threads = std::thread::available_parallelism().map_or(1, |x| x.get()).min(8).min(chunks);
     let (stop, next) = (AtomicBool::new(false), AtomicUsize::new(0));
-    // one worker: chunks in increasing order until none is left or one fails (then it stops taking chunks; the
-    // others go on, so every chunk before the failing one is still done and the first bad sample is the one named)
-    let work = || -> Worked<A> {
+    // One worker: chunks in increasing order until none is left or one fails (then it stops taking chunks; the
+    // others go on, so every chunk before the failing one is still done and the first bad sample is the one
+    // named). `poll`, on the calling thread only, runs before every chunk and says whether to go on.
+    let work = |mut poll: Option<&mut dyn FnMut() -> bool>| -> Worked<A> {
         let mut builder = BlockBuilder::new(m, p, layout);
         let mut done = Vec::new();
         loop {
+            if let Some(go_on) = poll.as_mut() {
+                if !go_on() {
+                    // every worker stops before its next block, this one too (`run` reads the flag first)
+                    stop.store(true, Ordering::Relaxed);
+                }
+            }
             let c = next.fetch_add(1, Ordering::Relaxed);
             if c >= chunks {
                 return (done, None);
@@ -461,18 +479,25 @@ fn par_pass<A: Send>(
             }
         }
     };
-    let results = if threads == 1 && hook.is_none() {
-        vec![work()]
-    } else {
-        // The workers stream their samples; the calling thread (which may hold the interrupt hook, e.g. a Ctrl-C
-        // check that needs the Python interpreter) polls the hook every POLL_INTERVAL and raises the stop flag
-        // that the workers read before each block.
-        std::thread::scope(|sc| {
-            let handles: Vec<_> = (0..threads).map(|_| sc.spawn(work)).collect();
-            supervise(hook, &stop, &handles, || next.load(Ordering::Relaxed).min(chunks) as f64 / chunks as f64);
-            handles.into_iter().map(|h| h.join().expect("estimation worker panicked")).collect::<Vec<_>>()
-        })
+    // The calling thread works too, and between its chunks (about a millisecond each) calls the hook every
+    // POLL_INTERVAL: it may hold what the hook needs (the Python interpreter, for a Ctrl-C check). Watching the
+    // workers from a sleeping thread instead left a core idle and, when they finished, woke up to 5 ms late.
+    let mut last = Instant::now();
+    let mut poll = || -> bool {
+        let Some(h) = hook.as_mut() else { return true };
+        if last.elapsed() < POLL_INTERVAL {
+            return true;
+        }
+        last = Instant::now();
+        h(next.load(Ordering::Relaxed).min(chunks) as f64 / chunks as f64)
     };
+    let results = std::thread::scope(|sc| {
+        let handles: Vec<_> = (1..threads).map(|_| sc.spawn(|| work(None))).collect();
+        let mine = work(Some(&mut poll));
+        let mut all = vec![mine];
+        all.extend(handles.into_iter().map(|h| h.join().expect("estimation worker panicked")));
+        all
+    });
     let mut parts = Vec::with_capacity(chunks);
     let mut first_error: Option<(usize, FfError)> = None;
     for (done, err) in results {
@@ -611,6 +636,33 @@ mod tests {
     /// A deterministic, well-mixed number in [-0.5, 0.5).
     fn mix(i: usize, j: usize) -> f64 {
         ((i * 37 + j * 101) % 97) as f64 / 97.0 - 0.5
+    }
+
+    #[test]
+    fn a_bad_sample_is_named_whichever_thread_or_lane_meets_it() {
+        // finiteness of v and h is checked sample by sample in the passes (not up front): the first bad sample is
+        // named, in a four-sample step (lane 2) or in the one-sample remainder of the last block, in any chunk
+        let m = builtin::load("naveen_dual_arm").unwrap();
+        let t = 2 * CHUNK_SAMPLES + 13;
+        let mut q = Vec::new();
+        for _ in 0..t {
+            q.extend(m.neutral());
+        }
+        let (v, h) = (vec![0.1; m.nv * t], vec![0.2; 6 * t]);
+        let unknown: Vec<usize> = (10..70).collect();
+        let known = vec![0.0; 10 * m.nbodies()];
+        for (what, s) in [("v", 2 * CHUNK_SAMPLES + 2), ("h", CHUNK_SAMPLES + 6), ("v", t - 1), ("h", 3)] {
+            let (mut v, mut h) = (v.clone(), h.clone());
+            if what == "v" {
+                v[s * m.nv + 4] = f64::NAN;
+            } else {
+                h[6 * s + 5] = f64::INFINITY;
+            }
+            let p =
+                MomentumProblem { q: &q, v: &v, h: &h, unknown_cols: &unknown, known_params: &known, weights: None };
+            let e = identify_momentum(&m, &p).unwrap_err().to_string();
+            assert!(e.contains(&format!("sample {s}:")) && e.contains(&format!("`{what}`")), "{what} at {s}: {e}");
+        }
     }
 
     #[test]

@@ -79,21 +79,50 @@ pub(crate) fn body_momentum_columns(d: &Data, i: usize) -> [[f64; 6]; 10] {
 /// (nalgebra's, which this replaced: the results did not change by a bit).
 #[inline(always)]
 pub(crate) fn momentum_columns<T: Real>(r: &[Vec3<T>; 3], p: &Vec3<T>, vb: &Vec3<T>, wb: &Vec3<T>) -> [[T; 6]; 10] {
-    let (vo, wo) = (mat_vec(r, vb), mat_vec(r, wb));
+    momentum_columns_of(r, p, vb, wb, ALL_COLUMNS)
+}
+
+/// Every column of [`momentum_columns_of`].
+pub(crate) const ALL_COLUMNS: u16 = (1 << 10) - 1;
+
+/// [`momentum_columns`], only the columns k with bit k of `need` set (the others are left zero): the
+/// identification's stream asks for the columns it keeps or moves to the right-hand side (on the dual-arm robot,
+/// no first moments of the wheels, no mass, h_z, I_yy of the links). With `ALL_COLUMNS` the tests fold away.
+#[inline(always)]
+pub(crate) fn momentum_columns_of<T: Real>(
+    r: &[Vec3<T>; 3],
+    p: &Vec3<T>,
+    vb: &Vec3<T>,
+    wb: &Vec3<T>,
+    need: u16,
+) -> [[T; 6]; 10] {
+    let on = |k: usize| need & (1 << k) != 0;
     let col = |lin: Vec3<T>, ang: Vec3<T>| [lin[0], lin[1], lin[2], ang[0], ang[1], ang[2]];
     let z = [T::splat(0.0); 3];
-    [
-        col(vo, cross(p, &vo)),
-        first_moment_column(&r[0], p, &vo, &wo),
-        first_moment_column(&r[1], p, &vo, &wo),
-        first_moment_column(&r[2], p, &vo, &wo),
-        col(z, scale(&r[0], wb[0])),
-        col(z, add(&scale(&r[0], wb[1]), &scale(&r[1], wb[0]))),
-        col(z, scale(&r[1], wb[1])),
-        col(z, add(&scale(&r[0], wb[2]), &scale(&r[2], wb[0]))),
-        col(z, add(&scale(&r[1], wb[2]), &scale(&r[2], wb[1]))),
-        col(z, scale(&r[2], wb[2])),
-    ]
+    let mut out = [col(z, z); 10];
+    if need & 0b1111 != 0 {
+        let vo = mat_vec(r, vb);
+        if on(0) {
+            out[0] = col(vo, cross(p, &vo));
+        }
+        if need & 0b1110 != 0 {
+            let wo = mat_vec(r, wb);
+            for k in 0..3 {
+                if on(k + 1) {
+                    out[k + 1] = first_moment_column(&r[k], p, &vo, &wo);
+                }
+            }
+        }
+    }
+    // the inertia columns: [0; r_j ω_k + r_k ω_j]
+    let inertia = [(0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)];
+    for (c, &(j, k)) in inertia.iter().enumerate() {
+        if on(4 + c) {
+            out[4 + c] =
+                col(z, if j == k { scale(&r[j], wb[j]) } else { add(&scale(&r[j], wb[k]), &scale(&r[k], wb[j])) });
+        }
+    }
+    out
 }
 
 /// The column of the first moment along `r_k`: `[ω_o × r_k; r_k × v_o + p × (ω_o × r_k)]` (a function, not a
