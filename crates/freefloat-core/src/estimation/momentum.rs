@@ -282,9 +282,10 @@ impl<'a> BlockBuilder<'a> {
     }
 
     /// [`fill`](Self::fill) for the four samples s..s+4 at slots slot..slot+4: their kinematics and regressor
-    /// columns side by side, one sample per lane ([`Kin4`], [`momentum_columns`]), every entry the same to the bit
+    /// columns side by side, one sample per lane ([`Kin4`], [`momentum_columns_of`]), every entry the same to the bit
     /// as `fill` would write it (the same operations in the same order, lane by lane). Four samples per step cost
-    /// about a third of the instructions of four one-sample steps (callgrind, `identify_profile pass`).
+    /// less than half the instructions of four one-sample steps (11 982 → 5 570 per sample in `identify_profile
+    /// pass`, callgrind).
     fn fill4(&mut self, s: usize, slot: usize, cnt: usize) -> Result<()> {
         let (m, p) = (self.m, self.p);
         let Some(kin) = self.kin.as_mut() else { unreachable!("fill4 runs only with the four-sample sweep") };
@@ -305,7 +306,7 @@ impl<'a> BlockBuilder<'a> {
         let sw: [F4; 6] = self.sw.map(F4::splat);
         // SAFETY: every store below is at `row[l][r] + j·cs` with a row below 6·cnt ≤ 6·block_samples (asserted just
         // above) and j a block column (a slot of `bodies` or `y_col`, checked against the block's width in `new`):
-        // inside the block, which `new` sized for exactly that. The bounds checks cost about a tenth of the pass
+        // inside the block, which `new` sized for exactly that. The bounds checks cost about a sixth of the pass
         // (callgrind), one store being a load, an add and the check.
         let mut put = |at: usize, x: f64| unsafe { *bs.get_unchecked_mut(at) = x };
         // where each lane's six rows start: linear rows at 3·slot.., angular rows at 3·cnt + 3·slot.. (see `fill`)
@@ -439,8 +440,7 @@ type Worked<A> = (Vec<(usize, A)>, Option<(usize, FfError)>);
 /// Fixed chunks, not one share per thread: the caller merges the accumulators in chunk order, so the result is
 /// the same to the bit whatever the number of threads or the order they ran in (with one half per thread it
 /// depended on the core count); and a thread slowed by the rest of a shared machine takes fewer chunks instead of
-/// holding up the whole pass (with halves, the pass waited for the slower one: 26.7 ms against 15.7 on a quiet
-/// machine, for 67 000 samples).
+/// holding up the whole pass (with halves, the pass always waited for the slower thread).
 fn par_pass<A: Send>(
     m: &Model,
     p: &MomentumProblem,
@@ -638,6 +638,48 @@ mod tests {
         ((i * 37 + j * 101) % 97) as f64 / 97.0 - 0.5
     }
 
+    /// Deterministic, well-mixed data of `t` samples (unit quaternions) and the problem the tests pose on it: the
+    /// columns below `first_known` unknown except h_y and I_yy, the model's parameters from there on known, weights.
+    struct Case {
+        q: Vec<f64>,
+        v: Vec<f64>,
+        h: Vec<f64>,
+        known: Vec<f64>,
+        unknown: Vec<usize>,
+    }
+
+    impl Case {
+        fn new(m: &Model, t: usize, first_known: usize) -> Case {
+            let (mut q, mut v) = (Vec::new(), Vec::new());
+            for s in 0..t {
+                let mut qs = m.neutral();
+                qs.iter_mut().enumerate().for_each(|(k, x)| *x += 3.0 * mix(s, k));
+                for &(_, o) in m.quaternions() {
+                    let nrm = qs[o..o + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
+                    qs[o..o + 4].iter_mut().for_each(|x| *x /= nrm);
+                }
+                q.extend(qs);
+                v.extend((0..m.nv).map(|k| mix(s + 7, k)));
+            }
+            let h = (0..6 * t).map(|k| mix(k, 3)).collect();
+            let params = m.parameters().into_iter().flatten().enumerate();
+            let known = params.map(|(c, x)| if c >= first_known { x } else { 0.0 }).collect();
+            let unknown = (0..first_known).filter(|c| c % 10 != 2 && c % 10 != 6).collect();
+            Case { q, v, h, known, unknown }
+        }
+
+        fn problem(&self) -> MomentumProblem<'_> {
+            MomentumProblem {
+                q: &self.q,
+                v: &self.v,
+                h: &self.h,
+                unknown_cols: &self.unknown,
+                known_params: &self.known,
+                weights: Some([1.0, 2.0, 3.0, 0.5, 0.25, 4.0]),
+            }
+        }
+    }
+
     #[test]
     fn a_bad_sample_is_named_whichever_thread_or_lane_meets_it() {
         // finiteness of v and h is checked sample by sample in the passes (not up front): the first bad sample is
@@ -672,35 +714,8 @@ mod tests {
         for name in ["naveen_dual_arm", "zhang2020_3d"] {
             let m = builtin::load(name).unwrap();
             let t = 64;
-            let (mut q, mut v) = (Vec::new(), Vec::new());
-            for s in 0..t {
-                let mut qs = m.neutral();
-                qs.iter_mut().enumerate().for_each(|(k, x)| *x += 3.0 * mix(s, k));
-                for &(_, o) in m.quaternions() {
-                    let nrm = qs[o..o + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
-                    qs[o..o + 4].iter_mut().for_each(|x| *x /= nrm);
-                }
-                q.extend(qs);
-                v.extend((0..m.nv).map(|k| mix(s + 7, k)));
-            }
-            let h: Vec<f64> = (0..6 * t).map(|k| mix(k, 3)).collect();
-            let np = 10 * m.nbodies();
-            let known: Vec<f64> = m
-                .parameters()
-                .into_iter()
-                .flatten()
-                .enumerate()
-                .map(|(c, x)| if c >= np - 20 { x } else { 0.0 })
-                .collect();
-            let unknown: Vec<usize> = (0..np - 20).filter(|c| c % 10 != 2 && c % 10 != 6).collect();
-            let p = MomentumProblem {
-                q: &q,
-                v: &v,
-                h: &h,
-                unknown_cols: &unknown,
-                known_params: &known,
-                weights: Some([1.0, 2.0, 3.0, 0.5, 0.25, 4.0]),
-            };
+            let case = Case::new(&m, t, 10 * m.nbodies() - 20);
+            let p = case.problem();
             for layout in [Layout::Rows, Layout::Columns] {
                 let mut bb = BlockBuilder::new(&m, &p, layout);
                 assert!(bb.kin.is_some(), "{name}: no four-sample sweep");
@@ -730,28 +745,9 @@ mod tests {
         // that leaves a partial block and is split over threads.
         let m = builtin::load("naveen_dual_arm").unwrap();
         let t = PARALLEL_MIN_SAMPLES + 13;
-        let (mut q, mut v) = (Vec::new(), Vec::new());
-        for s in 0..t {
-            let mut qs = m.neutral();
-            qs.iter_mut().enumerate().for_each(|(k, x)| *x += 3.0 * mix(s, k));
-            let nrm = qs[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
-            qs[3..7].iter_mut().for_each(|x| *x /= nrm);
-            q.extend(qs);
-            v.extend((0..m.nv).map(|k| mix(s + 7, k)));
-        }
-        let h: Vec<f64> = (0..6 * t).map(|k| mix(k, 3)).collect();
-        let known: Vec<f64> =
-            m.parameters().into_iter().flatten().enumerate().map(|(c, x)| if c >= 70 { x } else { 0.0 }).collect();
-        let unknown: Vec<usize> = (0..70).filter(|c| c % 10 != 2 && c % 10 != 6).collect();
-        let p = MomentumProblem {
-            q: &q,
-            v: &v,
-            h: &h,
-            unknown_cols: &unknown,
-            known_params: &known,
-            weights: Some([1.0, 2.0, 3.0, 0.5, 0.25, 4.0]),
-        };
-        let n = unknown.len();
+        let case = Case::new(&m, t, 70);
+        let p = case.problem();
+        let n = case.unknown.len();
         let fast: Vec<GramLs> =
             par_pass(&m, &p, t, Layout::Rows, || SplitGram::new(&p), |g, b, r| g.add(b, r), &mut None)
                 .unwrap()
