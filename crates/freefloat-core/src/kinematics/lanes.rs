@@ -108,12 +108,9 @@ impl Kin4 {
             let qq = |k: usize| F4::from_fn(|l| q[l][r.iq + k]);
             let rq = quat_rotation_rows(qq(3), qq(4), qq(5), qq(6));
             let pr = r.rot.map(|c| c.map(F4::splat));
-            let mv = |x: &Vec3<F4>, b: Vec3<F4>| -> Vec3<F4> {
-                std::array::from_fn(|a| pr[2][a].mul_add(x[2], pr[1][a].mul_add(x[1], pr[0][a].mul_add(x[0], b[a]))))
-            };
             let col = |c: usize| [rq[0][c], rq[1][c], rq[2][c]];
-            self.rot[0] = [mv(&col(0), [zero; 3]), mv(&col(1), [zero; 3]), mv(&col(2), [zero; 3])];
-            self.pos[0] = mv(&[qq(0), qq(1), qq(2)], r.trans.map(F4::splat));
+            self.rot[0] = [0, 1, 2].map(|c| rotate_add(&pr, &col(c), [zero; 3]));
+            self.pos[0] = rotate_add(&pr, &[qq(0), qq(1), qq(2)], r.trans.map(F4::splat));
             let vv: [F4; 6] = std::array::from_fn(|c| F4::from_fn(|l| v[l][r.iv + c]));
             let mut tw = [zero; 6];
             for c in 0..6 {
@@ -124,17 +121,19 @@ impl Kin4 {
             self.lin[0] = [tw[0], tw[1], tw[2]];
             self.ang[0] = [tw[3], tw[4], tw[5]];
         }
-        // another base joint: the one-sample code, lane by lane (it is one body of many)
-        for l in (0..LANES).filter(|_| self.free_root.is_none()) {
-            let x = joint_placement_at(m, &mut d.s[0], 0, q[l], [0.0, 1.0]);
-            let vj = joint_velocity(m, d, 0, v[l]);
-            for a in 0..3 {
-                for c in 0..3 {
-                    self.rot[0][c][a].0[l] = x.rot[(a, c)];
+        if self.free_root.is_none() {
+            // another base joint: the one-sample code, lane by lane (it is one body of many)
+            for l in 0..LANES {
+                let x = joint_placement_at(m, &mut d.s[0], 0, q[l], [0.0, 1.0]);
+                let vj = joint_velocity(m, d, 0, v[l]);
+                for a in 0..3 {
+                    for c in 0..3 {
+                        self.rot[0][c][a].0[l] = x.rot[(a, c)];
+                    }
+                    self.pos[0][a].0[l] = x.trans[a];
+                    self.lin[0][a].0[l] = vj.lin[a];
+                    self.ang[0][a].0[l] = vj.ang[a];
                 }
-                self.pos[0][a].0[l] = x.trans[a];
-                self.lin[0][a].0[l] = vj.lin[a];
-                self.ang[0][a].0[l] = vj.ang[a];
             }
         }
         for j in &self.joints {
@@ -154,11 +153,8 @@ impl Kin4 {
             }
             // placement in the inertial frame: the parent's composed with the joint's (`Se3::compose`)
             let (rp, tp) = (self.rot[j.parent], self.pos[j.parent]);
-            let mv = |x: &Vec3<F4>, b: Vec3<F4>| -> Vec3<F4> {
-                std::array::from_fn(|a| rp[2][a].mul_add(x[2], rp[1][a].mul_add(x[1], rp[0][a].mul_add(x[0], b[a]))))
-            };
-            self.rot[j.body] = [mv(&lr[0], [zero; 3]), mv(&lr[1], [zero; 3]), mv(&lr[2], [zero; 3])];
-            self.pos[j.body] = mv(&j.trans.map(F4::splat), tp);
+            self.rot[j.body] = [0, 1, 2].map(|c| rotate_add(&rp, &lr[c], [zero; 3]));
+            self.pos[j.body] = rotate_add(&rp, &j.trans.map(F4::splat), tp);
             // body twist: the parent's carried into the joint frame (`Se3::inv_act_motion`), plus the joint's
             // [0; axis q̇] (`joint_velocity`; a fixed joint's is zero, added as 0 · 0 here and as a zero twist there)
             let (vp, wp) = (self.lin[j.parent], self.ang[j.parent]);
@@ -170,6 +166,12 @@ impl Kin4 {
             self.ang[j.body] = std::array::from_fn(|a| ang[a] + F4::splat(j.axis[a]) * qd);
         }
     }
+}
+
+/// `R x + b` for R by its columns, as `Se3::compose` sums it: `r₂ x₂ + (r₁ x₁ + (r₀ x₀ + b))`, fused.
+#[inline(always)]
+fn rotate_add(r: &[Vec3<F4>; 3], x: &Vec3<F4>, b: Vec3<F4>) -> Vec3<F4> {
+    std::array::from_fn(|a| r[2][a].mul_add(x[2], r[1][a].mul_add(x[1], r[0][a].mul_add(x[0], b[a]))))
 }
 
 #[cfg(test)]
