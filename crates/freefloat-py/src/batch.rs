@@ -55,19 +55,34 @@ fn copy_out(src: &[f64]) -> Vec<f64> {
     }
     let mut out: Vec<f64> = Vec::with_capacity(src.len());
     let part = src.len().div_ceil(threads);
+    let mut all_started = true;
     std::thread::scope(|sc| {
-        for (dst, from) in out.spare_capacity_mut().chunks_mut(part).zip(src.chunks(part)) {
-            sc.spawn(move || {
-                for (d, x) in dst.iter_mut().zip(from) {
-                    d.write(*x);
-                }
-            });
+        let mut parts = out.spare_capacity_mut().chunks_mut(part).zip(src.chunks(part));
+        let first = parts.next();
+        for (dst, from) in parts {
+            // a thread that cannot be started (a process at its thread limit): copy the plain way below, no panic
+            if std::thread::Builder::new().spawn_scoped(sc, move || copy_into(dst, from)).is_err() {
+                all_started = false;
+                break;
+            }
+        }
+        if let Some((dst, from)) = first {
+            copy_into(dst, from);
         }
     });
+    if !all_started {
+        return src.to_vec();
+    }
     // SAFETY: the chunks above cover the first src.len() entries of the spare capacity, each written once, and
     // every thread has joined (end of the scope).
     unsafe { out.set_len(src.len()) };
     out
+}
+
+fn copy_into(dst: &mut [std::mem::MaybeUninit<f64>], from: &[f64]) {
+    for (d, x) in dst.iter_mut().zip(from) {
+        d.write(*x);
+    }
 }
 
 /// A validated, contiguous copy of an argument with `rows` samples of `width` numbers each.
