@@ -291,15 +291,16 @@ impl<'a> BlockBuilder<'a> {
         let Some(kin) = self.kin.as_mut() else { unreachable!("fill4 runs only with the four-sample sweep") };
         let (nq, nv) = (m.nq, m.nv);
         let [b0, b1, b2, b3] = &mut self.qbufs;
+        let v: [&[f64]; LANES] = std::array::from_fn(|l| &p.v[(s + l) * nv..(s + l + 1) * nv]);
         // each sample's q (size, finite, unit quaternions), v and h (finite), in sample order as `fill` checks them
         let check = |l: usize, buf| {
-            let (v, h) = (&p.v[(s + l) * nv..(s + l + 1) * nv], &p.h[6 * (s + l)..6 * (s + l) + 6]);
+            let h = &p.h[6 * (s + l)..6 * (s + l) + 6];
             let q = m.checked_q(&p.q[(s + l) * nq..(s + l + 1) * nq], buf);
-            q.and_then(|q| check_finite("v", v).and_then(|_| check_finite("h", h)).map(|_| q))
+            q.and_then(|q| check_finite("v", v[l]).and_then(|_| check_finite("h", h)).map(|_| q))
                 .map_err(|e| at_sample(e, s + l))
         };
         let q = [check(0, b0)?, check(1, b1)?, check(2, b2)?, check(3, b3)?];
-        kin.run(m, &mut self.d, q, std::array::from_fn(|l| &p.v[(s + l) * nv..(s + l + 1) * nv]));
+        kin.run(m, &mut self.d, q, v);
         assert!(slot + LANES <= cnt && cnt <= self.block_samples);
         let bs = self.block.as_mut_slice();
         let (rs, cs) = self.strides;

@@ -8,8 +8,8 @@
 
 use std::ops::{Add, Mul, Neg, Sub};
 
-/// Samples per [`F4`].
-pub const LANES: usize = 4;
+/// Samples per [`F4`]: the lane count of `trig::sin_cos4` (the four-sample kinematics feeds one to the other).
+pub use super::trig::LANES;
 
 /// Four `f64`, one per sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
