@@ -47,6 +47,8 @@ pub mod sensors;
 pub mod sim;
 /// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers.
 pub mod spatial;
+/// How many threads the parallel passes may use (the process's cores, read once).
+pub mod threads;
 
 pub use data::Data;
 pub use error::{FfError, Result};

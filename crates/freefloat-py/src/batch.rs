@@ -49,8 +49,11 @@ const PARALLEL_COPY_MIN: usize = 1 << 18;
 /// here, against about 16 ms for the whole identification pass on two cores. The caller holds the GIL throughout,
 /// so nothing can write to `src` meanwhile.
 fn copy_out(src: &[f64]) -> Vec<f64> {
-    let threads = std::thread::available_parallelism().map_or(1, |x| x.get()).min(4);
-    if src.len() < PARALLEL_COPY_MIN || threads < 2 {
+    if src.len() < PARALLEL_COPY_MIN {
+        return src.to_vec();
+    }
+    let threads = freefloat_core::threads::available_cores().min(4);
+    if threads < 2 {
         return src.to_vec();
     }
     let mut out: Vec<f64> = Vec::with_capacity(src.len());

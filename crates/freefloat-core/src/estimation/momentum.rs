@@ -454,7 +454,7 @@ fn par_pass<A: Send>(
     // whole blocks per chunk (only the last one ends with a partial block)
     let size = if t < PARALLEL_MIN_SAMPLES { t.max(1) } else { CHUNK_SAMPLES };
     let chunks = t.div_ceil(size).max(1);
-    let threads = std::thread::available_parallelism().map_or(1, |x| x.get()).min(8).min(chunks);
+    let threads = crate::threads::available_cores().min(8).min(chunks);
     let (stop, next) = (AtomicBool::new(false), AtomicUsize::new(0));
     // One worker: chunks in increasing order until none is left or one fails (then it stops taking chunks; the
     // others go on, so every chunk before the failing one is still done and the first bad sample is the one

@@ -106,7 +106,7 @@ pub fn simulate_many(
     stop: Option<&AtomicBool>,
 ) -> Result<Vec<Result<Trajectory>>> {
     let b = batch_size(m, spec)?;
-    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let cores = crate::threads::available_cores();
     let threads = if threads == 0 { cores } else { threads }.clamp(1, b);
     let next = AtomicUsize::new(0);
     let slots: Vec<Mutex<Option<Result<Trajectory>>>> = (0..b).map(|_| Mutex::new(None)).collect();
