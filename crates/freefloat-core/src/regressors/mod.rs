@@ -6,7 +6,7 @@ mod dynamics;
 mod momentum;
 
 pub use dynamics::dynamics_regressor;
-pub(crate) use momentum::{body_momentum_columns, momentum_columns_of};
+pub(crate) use momentum::{body_momentum_columns, momentum_columns_into};
 pub use momentum::{momentum_regressor, momentum_regressor_from_data};
 
 use crate::error::Result;
