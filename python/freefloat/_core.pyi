@@ -360,8 +360,9 @@ class RecursiveLS:
 def _time_kernel(model: Model, kernel: ArrayLike, q: ArrayLike, v: ArrayLike, tau: ArrayLike, calls: ArrayLike) -> Any:
     """`calls` calls of `kernel` ("aba", "rnea" or "crba") cycling through the rows of q, v, tau (tau is the
 acceleration for rnea; v and tau are ignored by crba), each through the checked public function as a user calls
-it. Returns (wall seconds of the loop, a checksum of the outputs that keeps the loop from being optimised away).
-The GIL is released: the caller can read the process CPU time around the call.
+it. Returns (wall seconds of the loop, this thread's CPU seconds over the same loop, a checksum of the outputs
+that keeps the loop from being optimised away). Both clocks are read around the loop alone, as the C++ peer
+reads its own: the argument copies before it (page faults of a fresh 7 MB batch) are not the kernel's time.
     """
 
 def aba(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, fext: ArrayLike | None = None) -> np.ndarray:
