@@ -151,3 +151,39 @@ def test_the_estimate_is_the_same_to_the_bit_on_one_core_and_on_two():
     )
     assert one.returncode == 0 and two.returncode == 0, one.stderr + two.stderr
     assert one.stdout.strip() and one.stdout == two.stdout
+
+
+def test_the_time_series_are_read_in_place_whatever_their_memory_layout(case):
+    # Q, V, H are read where numpy keeps them when they are C-contiguous float64 (no copy), converted once
+    # otherwise: every layout gives the same estimate to the bit, a read-only array is accepted, and the arrays
+    # are neither changed nor left borrowed (still writeable afterwards).
+    m, mp, tr, _ = case
+    Q, V, H = (np.ascontiguousarray(x) for x in (tr.q, tr.v, tr.momentum))
+    ref = est.least_squares(m, Q, V, H, mp).estimate
+    before = [x.copy() for x in (Q, V, H)]
+    frozen = H.copy()
+    frozen.flags.writeable = False
+    wide = np.zeros((len(V), 2 * m.nv))
+    wide[:, ::2] = V  # a strided view: every other column
+    layouts = {
+        "Fortran order": (np.asfortranarray(Q), np.asfortranarray(V), np.asfortranarray(H)),
+        "strided view": (Q, wide[:, ::2], H),
+        "read-only": (Q, V, frozen),
+        "lists": (Q.tolist(), V.tolist(), H.tolist()),
+        "big-endian": (Q.astype(">f8"), V, H),
+    }
+    for name, (q, v, h) in layouts.items():
+        got = est.least_squares(m, q, v, h, mp).estimate
+        assert got.tobytes() == ref.tobytes(), name
+    for x, x0 in zip((Q, V, H), before):
+        assert np.array_equal(x, x0) and x.flags.writeable
+        x[0, 0] += 0.0  # writing is allowed again: no borrow outlives the call
+
+
+def test_a_non_finite_sample_is_named_with_its_argument(case):
+    m, mp, tr, _ = case
+    for name, k in (("Q", 0), ("V", 1), ("H", 2)):
+        args = [np.array(tr.q), np.array(tr.v), np.array(tr.momentum)]
+        args[k][123, 2] = np.nan
+        with pytest.raises(ff.InputError, match=rf"argument `{name}`: sample 123: entry 2 is NaN"):
+            est.least_squares(m, *args, mp)
