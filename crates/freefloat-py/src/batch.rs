@@ -43,11 +43,10 @@ pub fn array_arg<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonl
 /// Entries from which [`copy_out`] copies on several threads.
 const PARALLEL_COPY_MIN: usize = 1 << 18;
 
-/// `src.to_vec()`, on up to four threads for a long array. The copy of a long time series is work the calling
-/// thread does alone before the engine's threads start (and its fresh pages fault in one by one): 67 000 samples
-/// of identification data are 20 MB, and numpy's own copy of those three arrays takes 4.7–4.9 ms on one thread
-/// here, against about 16 ms for the whole identification pass on two cores. The caller holds the GIL throughout,
-/// so nothing can write to `src` meanwhile.
+/// `src.to_vec()`, on up to four threads for a long array. The copy of a long batch is work the calling thread does
+/// alone before the engine's threads start (and its fresh pages fault in one by one): numpy's own copy of 20 MB
+/// takes about 5 ms on one thread here. (The identification's time series are not copied at all: see
+/// `estimation::Series`.) The caller holds the GIL throughout, so no Python code can write to `src` meanwhile.
 fn copy_out(src: &[f64]) -> Vec<f64> {
     if src.len() < PARALLEL_COPY_MIN {
         return src.to_vec();

@@ -195,6 +195,7 @@ def run_campaign(
     failed0 = sum(1 for k in s.failed if k in keys)
     try:
         if todo:
+            dataset.warm_up()
             _execute_all(spec, todo, writer, state, workers, scheduler, progress, max_retries, on_row, done0, failed0)
     except KeyboardInterrupt:
         state["interrupted"] = True
