@@ -244,12 +244,10 @@ impl<'a> BlockBuilder<'a> {
     fn fill(&mut self, s: usize, slot: usize, cnt: usize) -> Result<()> {
         let (m, p) = (self.m, self.p);
         let q = m.checked_q(&p.q[s * m.nq..(s + 1) * m.nq], &mut self.qbuf).map_err(|e| at_sample(e, s))?;
-        let v = &p.v[s * m.nv..(s + 1) * m.nv];
         if !self.vh_finite {
-            check_finite("v", v)
-                .and_then(|_| check_finite("h", &p.h[6 * s..6 * s + 6]))
-                .map_err(|e| at_sample(e, s))?;
+            vh_finite_at(p, m.nv, s).map_err(|e| at_sample(e, s))?;
         }
+        let v = &p.v[s * m.nv..(s + 1) * m.nv];
         // q and v checked just above, the sizes by `MomentumProblem::samples`: the unchecked core
         forward_velocities_unchecked(m, &mut self.d, q, v);
         let bs = self.block.as_mut_slice();
@@ -303,15 +301,8 @@ impl<'a> BlockBuilder<'a> {
         let v: [&[f64]; LANES] = std::array::from_fn(|l| &p.v[(s + l) * nv..(s + l + 1) * nv]);
         // each sample's q (size, finite, unit quaternions), v and h (finite), in sample order as `fill` checks them
         let check = |l: usize, buf| {
-            let h = &p.h[6 * (s + l)..6 * (s + l) + 6];
             let q = m.checked_q(&p.q[(s + l) * nq..(s + l + 1) * nq], buf);
-            let vh = |q| {
-                if vh_finite {
-                    Ok(q)
-                } else {
-                    check_finite("v", v[l]).and_then(|_| check_finite("h", h)).map(|_| q)
-                }
-            };
+            let vh = |q| if vh_finite { Ok(q) } else { vh_finite_at(p, nv, s + l).map(|_| q) };
             q.and_then(vh).map_err(|e| at_sample(e, s + l))
         };
         let q = [check(0, b0)?, check(1, b1)?, check(2, b2)?, check(3, b3)?];
@@ -444,6 +435,12 @@ impl SplitGram {
         g.add_permuted_upper(&self.acc, l.width, &l.slot, self.rows);
         g
     }
+}
+
+/// v and h of sample s are finite (the per-sample check of `fill` and `fill4`, for a range whose one scan in `run`
+/// found a non-finite entry).
+fn vh_finite_at(p: &MomentumProblem, nv: usize, s: usize) -> Result<()> {
+    check_finite("v", &p.v[s * nv..(s + 1) * nv]).and_then(|_| check_finite("h", &p.h[6 * s..6 * s + 6]))
 }
 
 fn at_sample(e: FfError, s: usize) -> FfError {

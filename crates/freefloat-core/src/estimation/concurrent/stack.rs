@@ -456,6 +456,7 @@ mod tests {
         };
         (0..n).map(|_| one()).collect()
     }
+
     #[test]
     fn the_early_deciding_trial_test_agrees_with_decomposing_every_block() {
         // `trial_passes` against Remark 17's test on all blocks decomposed first, for every slot of full stacks of
