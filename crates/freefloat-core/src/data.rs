@@ -44,6 +44,9 @@ pub struct Data {
     pub aba_momentum: Force,
     /// ABA's by-product: kinetic energy (J) at the state it was called with.
     pub aba_kinetic_energy: f64,
+    /// ABA's by-product: the power (W) of the external wrenches `fext` it was called with on the bodies' twists
+    /// (zero without them); every call sets it.
+    pub aba_fext_power: f64,
     /// `U = I^A S`, one 6×nv block per joint (unused columns zero).
     pub u: Vec<M6>,
     /// `D⁻¹ = (Sᵀ U)⁻¹`, top-left nv×nv block (for a multi-DoF root: D itself, solved in place).
@@ -91,6 +94,7 @@ impl Data {
             os: vec![M6::zeros(); n],
             aba_momentum: Force::ZERO,
             aba_kinetic_energy: 0.0,
+            aba_fext_power: 0.0,
             u: vec![M6::zeros(); n],
             dinv: vec![M6::zeros(); n],
             uu: vec![[0.0; 6]; n],

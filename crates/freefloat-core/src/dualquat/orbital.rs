@@ -53,17 +53,44 @@ pub fn gravity_gradient_torque(i_com: &M3, r_b: &V3, k: f64) -> V3 {
 /// `g(d) − g(R) = −μ/‖d‖³ [r − R x(3 + 3x + x²)/(1 + (1 + x)^{3/2})]`, since `1 − (1 + x)^{3/2} =
 /// −x(3 + 3x + x²)/(1 + (1 + x)^{3/2})` (Battin 1999, §8.4, the same device as his f(q)).
 pub fn tidal_acceleration(big_r: &V3, r: &V3, mu: f64) -> V3 {
-    let d = big_r + r;
-    tidal_acceleration_from(big_r, r, 1.0 / big_r.norm_squared(), mu / d.norm().powi(3))
+    let inv_r2 = 1.0 / big_r.norm_squared();
+    tidal_acceleration_inv(big_r, r, inv_r2, inv_r2.sqrt(), mu).0
 }
 
-/// [`tidal_acceleration`] with `1/‖R‖²` and `μ/‖R + r‖³` given: the simulator computes the first once per
-/// evaluation for all bodies and shares the second's `1/‖R + r‖` with the body's gravity-gradient torque.
+/// [`tidal_acceleration`] with `1/‖R‖²` and `1/‖R‖` given (the simulator computes them once per evaluation for
+/// all bodies), and `1/‖R + r‖` besides, which the body's gravity-gradient torque and J2 force reuse. In three
+/// steps, which the simulator runs as three loops over the bodies so that the square roots and divisions of all
+/// bodies issue together instead of each stalling its body's chain (they were most of the environment's cost,
+/// perf): [`tidal_x`], [`tidal_roots`], [`tidal_from_roots`].
 #[inline]
-pub fn tidal_acceleration_from(big_r: &V3, r: &V3, inv_r2: f64, mu_d3: f64) -> V3 {
-    let x = (2.0 * big_r.dot(r) + r.norm_squared()) * inv_r2;
-    let s = x * (3.0 + x * (3.0 + x)) / (1.0 + (1.0 + x) * (1.0 + x).sqrt());
-    -(r - big_r * s) * mu_d3
+pub fn tidal_acceleration_inv(big_r: &V3, r: &V3, inv_r2: f64, inv_r: f64, mu: f64) -> (V3, f64) {
+    let x = tidal_x(big_r, r, inv_r2);
+    tidal_from_roots(big_r, r, x, tidal_roots(x), inv_r, mu)
+}
+
+/// The series variable `x = (2R·r + r·r)/‖R‖²` of [`tidal_acceleration`]: `‖R + r‖² = ‖R‖² (1 + x)` exactly.
+#[inline(always)]
+pub fn tidal_x(big_r: &V3, r: &V3, inv_r2: f64) -> f64 {
+    (2.0 * big_r.dot(r) + r.norm_squared()) * inv_r2
+}
+
+/// `(√(1 + x), 1/(√(1 + x) (1 + (1 + x)^{3/2})))`: the one square root and the one division of a body's tidal
+/// acceleration and distance.
+#[inline(always)]
+pub fn tidal_roots(x: f64) -> (f64, f64) {
+    let s1 = (1.0 + x).sqrt();
+    (s1, 1.0 / (s1 * (1.0 + (1.0 + x) * s1)))
+}
+
+/// The tidal acceleration and `1/‖R + r‖` from x and its roots: `1/‖R + r‖ = (1/‖R‖)/√(1 + x)` and the series
+/// factor `x(3 + 3x + x²)/(1 + (1 + x)^{3/2})`, both products of the one reciprocal.
+#[inline(always)]
+pub fn tidal_from_roots(big_r: &V3, r: &V3, x: f64, (s1, inv): (f64, f64), inv_r: f64, mu: f64) -> (V3, f64) {
+    let b = 1.0 + (1.0 + x) * s1;
+    let inv_d = inv_r * b * inv; // 1/(‖R‖ √(1 + x))
+    let s = x * (3.0 + x * (3.0 + x)) * (s1 * inv); // x(3 + 3x + x²)/(1 + (1 + x)^{3/2})
+    let mu_d3 = mu * inv_d * inv_d * inv_d;
+    (-(r - big_r * s) * mu_d3, inv_d)
 }
 
 /// Gravity gradient, the "old" form of [50] (2.68): `3μ/‖r‖⁵ r̂ × (M ⋆ r̂^s)` with `r̂ = r + ε0`.
@@ -74,10 +101,18 @@ pub fn gravity_gradient_old(m: &DualInertia, r_b: &V3, mu: f64) -> DualQuat {
 
 /// J2 acceleration (2.64) in inertial coordinates for the inertial position `r_i`.
 pub fn j2_acceleration(r_i: &V3, mu: f64, j2: f64, re: f64) -> V3 {
-    let r = r_i.norm();
-    let z2 = (r_i.z / r).powi(2);
-    let k = -1.5 * mu * j2 * re * re / r.powi(4);
-    V3::new(k * (1.0 - 5.0 * z2) * r_i.x / r, k * (1.0 - 5.0 * z2) * r_i.y / r, k * (3.0 - 5.0 * z2) * r_i.z / r)
+    j2_acceleration_inv(r_i, 1.0 / r_i.norm(), mu, j2, re)
+}
+
+/// [`j2_acceleration`] with `1/‖r_i‖` given: `k = −(3/2) μ J2 Re²/‖r‖⁵`, `a = k [(1 − 5z²/r²) x, (1 − 5z²/r²) y,
+/// (3 − 5z²/r²) z]`, multiplications only.
+#[inline]
+pub fn j2_acceleration_inv(r_i: &V3, inv_r: f64, mu: f64, j2: f64, re: f64) -> V3 {
+    let z2 = (r_i.z * inv_r).powi(2);
+    let inv_r2 = inv_r * inv_r;
+    let k = -1.5 * mu * j2 * re * re * inv_r2 * inv_r2 * inv_r;
+    let kxy = k * (1.0 - 5.0 * z2);
+    V3::new(kxy * r_i.x, kxy * r_i.y, k * (3.0 - 5.0 * z2) * r_i.z)
 }
 
 /// (2.66): `f_J2 = M ⋆ (a_J2^B + ε0)` with `a_J2^B = q_{B/I}* a_J2^I q_{B/I}` (the rotation the text implies).

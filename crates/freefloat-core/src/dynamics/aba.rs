@@ -105,6 +105,7 @@ fn hybrid_aba_placed<const TOTALS: bool>(
     // Pass 1: subspaces, twists, velocity-product accelerations and bias forces, inertial frame.
     // Each body's momentum oIᵢ vᵢ is formed here anyway, so the totals come for free.
     let (mut h_total, mut ke) = (Force::ZERO, 0.0);
+    let mut fext_power = 0.0;
     // Every per-body buffer as a slice of exactly n entries held in a register: indexing by i < n needs no bounds
     // check (through `d` each access re-reads the vector's length, which any store to a buffer might have changed).
     let (o_mi, s_all) = (&d.o_mi[..n], &d.s[..n]);
@@ -160,10 +161,15 @@ fn hybrid_aba_placed<const TOTALS: bool>(
         }
         let mut f = vi.cross_force(&hi);
         if let Some(fe) = fext {
-            f -= omi.act_force(&Force::from_slice(&fe[6 * i..6 * i + 6]));
+            // the wrench in inertial coordinates, and its power on the body's twist (the simulator's work
+            // integral needs it at every stage; here the frame change is already done)
+            let fw = omi.act_force(&Force::from_slice(&fe[6 * i..6 * i + 6]));
+            f -= fw;
+            fext_power += vi.dot(&fw);
         }
         ofs[i] = f;
     }
+    d.aba_fext_power = fext_power;
     if TOTALS {
         d.aba_momentum = h_total;
         d.aba_kinetic_energy = ke;

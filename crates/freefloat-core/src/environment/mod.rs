@@ -24,6 +24,7 @@ pub use disturbance::{Axes, Disturbance};
 pub use orbit::{CentralBody, Elements, Orbit, Propagator, ReferenceState};
 
 use crate::data::Data;
+use crate::dualquat::orbital::{tidal_roots, tidal_x};
 use crate::error::{check_vec, FfError, Result};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
@@ -109,6 +110,9 @@ impl Environment {
             com: m.inertias.iter().map(|i| i.com()).collect(),
             i_com: m.inertias.iter().map(|i| i.i_com()).collect(),
             mass: m.inertias.iter().map(|i| i.mass).collect(),
+            rel: vec![V3::zeros(); n],
+            xs: vec![0.0; n],
+            roots: vec![(0.0, 0.0); n],
         })
     }
 }
@@ -128,6 +132,11 @@ pub struct EnvWorkspace {
     /// The mass each body's `com` / `i_com` were computed for: a body whose tank drains (variable-mass model
     /// handed to `eval`) gets them recomputed, so its CoM and inertia follow the propellant.
     mass: Vec<f64>,
+    /// Per body, during `eval`: its CoM from the reference point, its tidal series variable and that variable's
+    /// roots (`dualquat::orbital::tidal_x`, `tidal_roots`).
+    rel: Vec<V3>,
+    xs: Vec<f64>,
+    roots: Vec<(f64, f64)>,
 }
 
 impl EnvWorkspace {
@@ -147,17 +156,40 @@ impl EnvWorkspace {
     /// origin by (2.40), `f + ε(τ + c × f)` with `c` the CoM in body axes.
     pub fn eval(&mut self, env: &Environment, m: &Model, d: &Data, t: f64) {
         let refst = self.reference(t);
-        let inv_r2 = refst.as_ref().map_or(0.0, |rs| 1.0 / rs.position.norm_squared());
+        // what every body shares: the origin's distance powers and, with J2, its J2 acceleration
+        let shared = match (&env.orbit, &refst) {
+            (Some(o), Some(rs)) => {
+                let a_j2 = if env.j2 { j2::at_origin(&rs.position, &o.central) } else { V3::zeros() };
+                Some((gravity_gradient::Origin::new(rs.position, o.central.mu), a_j2, o.central))
+            }
+            _ => None,
+        };
         // the reference point P in the frame: c0 + ċ0 t
         let p_ref = self.c0 + self.cdot0 * t;
-        self.fext.fill(0.0);
-        for i in 0..m.nbodies() {
+        let n = m.nbodies();
+        let (rel, xs, roots) = (&mut self.rel[..n], &mut self.xs[..n], &mut self.roots[..n]);
+        for i in 0..n {
             let mass = m.inertias[i].mass;
             if mass != self.mass[i] {
                 self.com[i] = m.inertias[i].com();
                 self.i_com[i] = m.inertias[i].i_com();
                 self.mass[i] = mass;
             }
+        }
+        if let Some((origin, ..)) = &shared {
+            // Three loops (see `tidal_acceleration_inv`): each body's CoM from the reference point P and its series
+            // variable; then every body's square root and division, independent of one another; then the wrenches.
+            for i in 0..n {
+                rel[i] = d.o_mi[i].act_point(&self.com[i]) - p_ref;
+                xs[i] = tidal_x(&origin.big_r, &rel[i], origin.inv_r2);
+            }
+            for (x, r) in xs.iter().zip(roots.iter_mut()) {
+                *r = tidal_roots(*x);
+            }
+        }
+        self.fext.fill(0.0);
+        for i in 0..n {
+            let mass = self.mass[i];
             let x = &d.o_mi[i];
             // the dual force f + ετ about the CoM in body axes, summed over the effects as its two vectors
             let (mut f, mut tau) = (V3::zeros(), V3::zeros());
@@ -166,26 +198,21 @@ impl EnvWorkspace {
                 *tau += w.d.v;
             };
             let mut any = false;
-            if let (Some(o), Some(rs)) = (&env.orbit, &refst) {
+            if let Some((origin, a_j2, central)) = &shared {
                 if mass > 0.0 {
-                    // the body's CoM relative to the reference point P
-                    let r = x.act_point(&self.com[i]) - p_ref;
+                    let r = &rel[i];
+                    let mut inv_d = None;
                     if env.gravity_gradient {
-                        let (fg, tg) = gravity_gradient::wrench(
-                            &x.rot,
-                            &rs.position,
-                            inv_r2,
-                            &r,
-                            mass,
-                            &self.i_com[i],
-                            o.central.mu,
-                        );
+                        let (fg, tg, id) =
+                            gravity_gradient::wrench(&x.rot, origin, r, xs[i], roots[i], mass, &self.i_com[i]);
                         f += fg;
                         tau += tg;
+                        inv_d = Some(id);
                         any = true;
                     }
                     if env.j2 {
-                        add(&mut f, &mut tau, j2::wrench(&x.rot, &rs.position, &r, mass, &o.central));
+                        let inv_d = inv_d.unwrap_or_else(|| 1.0 / (origin.big_r + r).norm());
+                        add(&mut f, &mut tau, j2::wrench(&x.rot, &origin.big_r, r, inv_d, a_j2, mass, central));
                         any = true;
                     }
                 }
@@ -289,6 +316,39 @@ mod tests {
         let lin = (rh * (3.0 * rh.dot(&r)) - r) * (mu / big_r.norm().powi(3));
         let t = tidal_acceleration(&big_r, &r, mu);
         assert!((t - lin).norm() < 1e-5 * lin.norm(), "{t} vs {lin}");
+    }
+
+    /// The per-body shortcuts of the simulator's environment: the distance `1/‖R + r‖` from the tidal series' root,
+    /// and the J2 acceleration from a given `1/‖r‖`, against the direct forms.
+    #[test]
+    fn shared_roots_give_the_distance_and_the_j2_acceleration() {
+        use crate::dualquat::orbital::{j2_acceleration, j2_acceleration_inv, tidal_acceleration_inv};
+        let c = CentralBody::EARTH;
+        for (big_r, r) in [
+            (V3::new(4.0e6, -3.0e6, 5.0e6), V3::new(0.5, -1.0, 2.0)),
+            (V3::new(-6.9e6, 1.0e5, 2.0e3), V3::new(-30.0, 12.0, 4.0)),
+            (V3::new(3.0, -4.0, 12.0), V3::new(0.3, 0.2, -0.1)),
+        ] {
+            let inv_r2 = 1.0 / big_r.norm_squared();
+            let (a, inv_d) = tidal_acceleration_inv(&big_r, &r, inv_r2, inv_r2.sqrt(), c.mu);
+            let d = big_r + r;
+            assert!((inv_d * d.norm() - 1.0).abs() < 4.0 * f64::EPSILON, "{inv_d} vs 1/{}", d.norm());
+            assert_eq!(a, tidal_acceleration(&big_r, &r, c.mu));
+            let (j, k) =
+                (j2_acceleration(&d, c.mu, c.j2, c.radius), j2_acceleration_inv(&d, inv_d, c.mu, c.j2, c.radius));
+            // inv_d to a few ulps, raised to the fifth power
+            assert!((j - k).norm() < 32.0 * f64::EPSILON * j.norm(), "{j} vs {k}");
+            // against the textbook form (2.64), with divisions
+            let rn = d.norm();
+            let z2 = (d.z / rn).powi(2);
+            let kk = -1.5 * c.mu * c.j2 * c.radius * c.radius / rn.powi(4);
+            let book = V3::new(
+                kk * (1.0 - 5.0 * z2) * d.x / rn,
+                kk * (1.0 - 5.0 * z2) * d.y / rn,
+                kk * (3.0 - 5.0 * z2) * d.z / rn,
+            );
+            assert!((j - book).norm() < 8.0 * f64::EPSILON * book.norm(), "{j} vs {book}");
+        }
     }
 
     #[test]

@@ -326,9 +326,12 @@ impl<'m, 'i> Stepper<'m, 'i> {
         tangent_rate(m, &qs, &vs, &mut self.kq[s]);
         self.kv[s].copy_from_slice(&self.d.ddq);
         self.kw[s] = self.d.tau.iter().zip(&vs).map(|(a, b)| a * b).sum();
-        if fext.is_some() {
-            // Power of the external wrenches: each one's inertial-frame image on its body's twist
-            // (ABA leaves the placements and the twists at the inertial origin in `d`).
+        if fext.is_some() && self.formulation == Formulation::Aba {
+            // Power of the external wrenches: ABA summed each one's inertial-frame image on its body's twist.
+            self.kw[s] += self.d.aba_fext_power;
+        } else if fext.is_some() {
+            // The same sum here (the dual-quaternion solve leaves the placements and the twists at the inertial
+            // origin in `d` but not this sum).
             let d = &self.d;
             for (i, fe) in self.fext.chunks_exact(6).enumerate() {
                 // most bodies carry none (a thruster on the base): skip their frame change
