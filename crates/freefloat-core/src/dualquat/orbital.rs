@@ -58,7 +58,7 @@ pub fn tidal_acceleration(big_r: &V3, r: &V3, mu: f64) -> V3 {
 }
 
 /// [`tidal_acceleration`] with `1/‖R‖²` and `1/‖R‖` given (the simulator computes them once per evaluation for
-/// all bodies), and `1/‖R + r‖` besides, which the body's gravity-gradient torque and J2 force reuse. In three
+/// all bodies), and `1/‖R + r‖` besides, which the body's gravity-gradient torque reuses. In three
 /// steps, which the simulator runs as three loops over the bodies so that the square roots and divisions of all
 /// bodies issue together instead of each stalling its body's chain (they were most of the environment's cost,
 /// perf): [`tidal_x`], [`tidal_roots`], [`tidal_from_roots`].

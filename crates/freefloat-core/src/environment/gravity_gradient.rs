@@ -27,19 +27,19 @@ impl Origin {
     }
 }
 
-/// The body's gravity-gradient dual force about its CoM in body axes, `f + ετ` (2.39), as (f, τ), and
-/// `1/‖R + r‖` (for the body's J2 force): `f = C^T m [g(R + r) − g(R)]` (the real part, `M ⋆ (a + ε0)` of (2.65)
-/// with the differential acceleration) and `τ = 3μ d × (Ī d)/‖d‖⁵` with `d = C^T (R + r)` the body's position
-/// from the central body in body axes (the dual part, (2.67)).
+/// The body's gravity-gradient dual force about its CoM in body axes, `f + ετ` (2.39), as (f, τ):
+/// `f = C^T m [g(R + r) − g(R)]` (the real part, `M ⋆ (a + ε0)` of (2.65) with the differential acceleration) and
+/// `τ = 3μ d × (Ī d)/‖d‖⁵` with `d = C^T (R + r)` the body's position from the central body in body axes (the dual
+/// part, (2.67)).
 ///
 /// `rot` rotates body axes to inertial axes, `r` is the body's CoM from the frame origin (inertial axes), `x` and
 /// `roots` its [`tidal_x`](crate::dualquat::orbital::tidal_x) and
 /// [`tidal_roots`](crate::dualquat::orbital::tidal_roots); `mass`, `i_com` are the body's. Both parts' powers of
 /// ‖R + r‖ come from those roots (‖C^T d‖ = ‖d‖).
-pub fn wrench(rot: &M3, o: &Origin, r: &V3, x: f64, roots: (f64, f64), mass: f64, i_com: &M3) -> (V3, V3, f64) {
+pub fn wrench(rot: &M3, o: &Origin, r: &V3, x: f64, roots: (f64, f64), mass: f64, i_com: &M3) -> (V3, V3) {
     let (a, inv_d) = tidal_from_roots(&o.big_r, r, x, roots, o.inv_r, o.mu);
     let f_b = rot.tr_mul(&(a * mass));
     let d_b = rot.tr_mul(&(o.big_r + r));
     let inv_d2 = inv_d * inv_d;
-    (f_b, gravity_gradient_torque(i_com, &d_b, 3.0 * o.mu * inv_d2 * inv_d2 * inv_d), inv_d)
+    (f_b, gravity_gradient_torque(i_com, &d_b, 3.0 * o.mu * inv_d2 * inv_d2 * inv_d))
 }

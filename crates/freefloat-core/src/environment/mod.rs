@@ -113,6 +113,7 @@ impl Environment {
             rel: vec![V3::zeros(); n],
             xs: vec![0.0; n],
             roots: vec![(0.0, 0.0); n],
+            inv_dist: vec![0.0; n],
         })
     }
 }
@@ -133,10 +134,11 @@ pub struct EnvWorkspace {
     /// handed to `eval`) gets them recomputed, so its CoM and inertia follow the propellant.
     mass: Vec<f64>,
     /// Per body, during `eval`: its CoM from the reference point, its tidal series variable and that variable's
-    /// roots (`dualquat::orbital::tidal_x`, `tidal_roots`).
+    /// roots (`dualquat::orbital::tidal_x`, `tidal_roots`), and (with J2) 1/‖R + r‖ computed directly.
     rel: Vec<V3>,
     xs: Vec<f64>,
     roots: Vec<(f64, f64)>,
+    inv_dist: Vec<f64>,
 }
 
 impl EnvWorkspace {
@@ -168,6 +170,7 @@ impl EnvWorkspace {
         let p_ref = self.c0 + self.cdot0 * t;
         let n = m.nbodies();
         let (rel, xs, roots) = (&mut self.rel[..n], &mut self.xs[..n], &mut self.roots[..n]);
+        let inv_dist = &mut self.inv_dist[..n];
         for i in 0..n {
             let mass = m.inertias[i].mass;
             if mass != self.mass[i] {
@@ -186,6 +189,14 @@ impl EnvWorkspace {
             for (x, r) in xs.iter().zip(roots.iter_mut()) {
                 *r = tidal_roots(*x);
             }
+            if env.j2 {
+                // J2's differential is a plain difference that magnifies an error in 1/‖R + r‖ by about ‖R‖/‖r‖:
+                // the distance computed directly, not from the tidal series' root (a few ulps off, which moved the
+                // J2 force by ~1e-8 of itself); here with the other roots, off the per-body chain
+                for (id, r) in inv_dist.iter_mut().zip(rel.iter()) {
+                    *id = 1.0 / (origin.big_r + r).norm();
+                }
+            }
         }
         self.fext.fill(0.0);
         for i in 0..n {
@@ -201,17 +212,15 @@ impl EnvWorkspace {
             if let Some((origin, a_j2, central)) = &shared {
                 if mass > 0.0 {
                     let r = &rel[i];
-                    let mut inv_d = None;
                     if env.gravity_gradient {
-                        let (fg, tg, id) =
+                        let (fg, tg) =
                             gravity_gradient::wrench(&x.rot, origin, r, xs[i], roots[i], mass, &self.i_com[i]);
                         f += fg;
                         tau += tg;
-                        inv_d = Some(id);
                         any = true;
                     }
                     if env.j2 {
-                        let inv_d = inv_d.unwrap_or_else(|| 1.0 / (origin.big_r + r).norm());
+                        let inv_d = inv_dist[i];
                         add(&mut f, &mut tau, j2::wrench(&x.rot, &origin.big_r, r, inv_d, a_j2, mass, central));
                         any = true;
                     }
@@ -384,6 +393,62 @@ mod tests {
         assert!(bad.check().unwrap_err().to_string().contains("mu"));
         let esc = Orbit::new(c, V3::new(7e6, 0.0, 0.0), V3::new(0.0, 2e4, 0.0));
         assert!(esc.unwrap_err().to_string().contains("bound"));
+    }
+
+    /// `eval`'s per-body wrenches (shared roots, three loops, J2 at the origin once) against each body's direct
+    /// forms: `m Cᵀ[g(R + r) − g(R)]` by `tidal_acceleration`, `3μ d × (Ī d)/‖d‖⁵` by `gravity_gradient_of`, and
+    /// `m Cᵀ[a_J2(R + r) − a_J2(R)]` with `j2_acceleration` at both points; for each effect alone and both.
+    #[test]
+    fn eval_matches_the_direct_per_body_forms() {
+        use crate::dualquat::orbital::{gravity_gradient_of, j2_acceleration};
+        let m = crate::model::builtin::load("naveen_dual_arm").unwrap();
+        let el = Elements { a: 6.9e6, e: 0.01, i: 0.9, raan: 0.4, argp: 0.2, nu: 1.1 };
+        let orbit = Some(Orbit::from_elements(CentralBody::EARTH, &el).unwrap());
+        let c = CentralBody::EARTH;
+        let mut d = Data::new(&m);
+        let mut q = m.neutral();
+        q[0..3].copy_from_slice(&[0.4, -1.3, 2.0]);
+        q[3..7].copy_from_slice(&[0.1, -0.2, 0.3, 0.927_361_849_549_570_3]);
+        for (k, x) in q[7..].iter_mut().enumerate() {
+            *x = 0.3 + 0.4 * k as f64;
+        }
+        let mut v0 = vec![0.0; m.nv];
+        v0[6..].iter_mut().enumerate().for_each(|(k, x)| *x = 0.05 * k as f64);
+        for (gg, j2) in [(true, false), (false, true), (true, true)] {
+            let env = Environment { orbit, gravity_gradient: gg, j2, disturbance: None };
+            let mut ws = env.workspace(&m, &mut d, &q, &v0).unwrap();
+            let t = 12.5;
+            forward_kinematics_unchecked(&m, &mut d, &q);
+            ws.eval(&env, &m, &d, t);
+            let big_r = ws.reference(t).unwrap().position;
+            let p_ref = ws.c0 + ws.cdot0 * t;
+            for i in 0..m.nbodies() {
+                let (mass, com, i_com) = (m.inertias[i].mass, m.inertias[i].com(), m.inertias[i].i_com());
+                let x = &d.o_mi[i];
+                let r = x.act_point(&com) - p_ref;
+                let (mut f, mut tau) = (V3::zeros(), V3::zeros());
+                if mass > 0.0 && gg {
+                    f += x.rot.tr_mul(&(tidal_acceleration(&big_r, &r, c.mu) * mass));
+                    tau += gravity_gradient_of(&i_com, &x.rot.tr_mul(&(big_r + r)), c.mu).d.v;
+                }
+                if mass > 0.0 && j2 {
+                    let da = j2_acceleration(&(big_r + r), c.mu, c.j2, c.radius)
+                        - j2_acceleration(&big_r, c.mu, c.j2, c.radius);
+                    f += x.rot.tr_mul(&(da * mass));
+                }
+                let tau = tau + com.cross(&f);
+                let (fe, te) = (
+                    V3::from_column_slice(&ws.fext[6 * i..6 * i + 3]),
+                    V3::from_column_slice(&ws.fext[6 * i + 3..6 * i + 6]),
+                );
+                assert!((fe - f).norm() <= 1e-12 * f.norm().max(1e-300), "body {i} ({gg}, {j2}): force {fe} vs {f}");
+                assert!(
+                    (te - tau).norm() <= 1e-12 * tau.norm().max(1e-300),
+                    "body {i} ({gg}, {j2}): torque {te} vs {tau}"
+                );
+                assert!(mass == 0.0 || f.norm() > 0.0);
+            }
+        }
     }
 
     #[test]
