@@ -180,14 +180,19 @@ impl EnvWorkspace {
             }
         }
         if let Some((origin, ..)) = &shared {
-            // Three loops (see `tidal_acceleration_inv`): each body's CoM from the reference point P and its series
-            // variable; then every body's square root and division, independent of one another; then the wrenches.
+            // Loops of their own (see `tidal_acceleration_inv`): each body's CoM from the reference point P; its
+            // series variable, then every body's square root and division, independent of one another (for the
+            // gravity gradient only: J2 alone needs neither); then, below, the wrenches.
             for i in 0..n {
                 rel[i] = d.o_mi[i].act_point(&self.com[i]) - p_ref;
-                xs[i] = tidal_x(&origin.big_r, &rel[i], origin.inv_r2);
             }
-            for (x, r) in xs.iter().zip(roots.iter_mut()) {
-                *r = tidal_roots(*x);
+            if env.gravity_gradient {
+                for (x, r) in xs.iter_mut().zip(rel.iter()) {
+                    *x = tidal_x(&origin.big_r, r, origin.inv_r2);
+                }
+                for (x, root) in xs.iter().zip(roots.iter_mut()) {
+                    *root = tidal_roots(*x);
+                }
             }
             if env.j2 {
                 // J2's differential is a plain difference that magnifies an error in 1/‖R + r‖ by about ‖R‖/‖r‖:
