@@ -120,6 +120,12 @@ class Model:
         """A new model with parameters P (nbodies, 10), checked for physical consistency."""
         return Model(self._core.with_parameters(as_f64(P, "P")))
 
+    def with_fixed_leaves_merged(self) -> Model:
+        """A copy with every welded leaf (a fixed joint with nothing below it: a grasped target, a tool) merged
+        into its parent body, and a frame of the leaf's name in its place: the same dynamics with fewer bodies
+        (for algorithms that take moving joints only, such as DDP)."""
+        return Model(self._core.with_fixed_leaves_merged())
+
     def with_gravity(self, g) -> Model:
         g = as_f64(g, "g")
         if g.shape != (3,):

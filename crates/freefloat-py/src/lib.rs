@@ -74,6 +74,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(postcapture::postcapture_rows, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_thruster_wrench, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_m_j, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::capture_impact, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::inertia_com_form, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::inertia_standard_form, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::inertia_project_consistent, m)?)?;

@@ -224,6 +224,12 @@ impl PyModel {
         guard(|| self.inner.with_parameters(&flat)).map(PyModel::wrap)
     }
 
+    /// A new Model with every welded (fixed-joint) leaf merged into its parent, a frame of the leaf's name left
+    /// in its place: the same dynamics with fewer bodies.
+    fn with_fixed_leaves_merged(&self) -> PyResult<PyModel> {
+        guard(|| self.inner.with_fixed_leaves_merged()).map(PyModel::wrap)
+    }
+
     fn with_gravity(&self, g: [f64; 3]) -> PyResult<PyModel> {
         guard(|| self.inner.with_gravity(g.into())).map(PyModel::wrap)
     }

@@ -555,3 +555,34 @@ pub fn postcapture_m_j<'py>(py: Python<'py>, mass: f64, com: [f64; 3]) -> Bound<
     let b = freefloat_core::spatial::V3::new(com[0], com[1], com[2]);
     PyArray1::from_vec(py, freefloat_core::postcapture::equations::m_j(mass, &b).to_vec())
 }
+
+/// The grasp of a drifting target as an inelastic impact (`postcapture::capture_impact`): `model` is the combined
+/// model whose leaf body `target` (a fixed joint) is the target, `q` the configuration at contact, `v` the
+/// servicer's velocity just before, `target_twist` the target's twist just before (its own axes, [v; ω]).
+/// Returns a dict: v_post (nv), impulse_local / impulse_world (6, [linear; angular], about the target frame origin),
+/// momentum_before / momentum_after (6, inertial, about the origin), energy_before / energy_after.
+#[pyfunction]
+pub fn capture_impact<'py>(
+    py: Python<'py>,
+    model: &PyModel,
+    target: usize,
+    q: Vec<f64>,
+    v: Vec<f64>,
+    target_twist: Vec<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let tw: [f64; 6] = target_twist
+        .as_slice()
+        .try_into()
+        .map_err(|_| input_err(format!("argument `target_twist`: expected 6 entries, got {}", target_twist.len())))?;
+    let c = model.with_data(|m, d| guard(|| freefloat_core::postcapture::capture_impact(m, d, target, &q, &v, &tw)))?;
+    let six = |f: &freefloat_core::spatial::Force| [f.lin.x, f.lin.y, f.lin.z, f.ang.x, f.ang.y, f.ang.z].to_vec();
+    let out = PyDict::new(py);
+    out.set_item("v_post", PyArray1::from_vec(py, c.v_post))?;
+    out.set_item("impulse_local", PyArray1::from_vec(py, six(&c.impulse_local)))?;
+    out.set_item("impulse_world", PyArray1::from_vec(py, six(&c.impulse_world)))?;
+    out.set_item("momentum_before", PyArray1::from_vec(py, six(&c.momentum_before)))?;
+    out.set_item("momentum_after", PyArray1::from_vec(py, six(&c.momentum_after)))?;
+    out.set_item("energy_before", c.energy_before)?;
+    out.set_item("energy_after", c.energy_after)?;
+    Ok(out)
+}

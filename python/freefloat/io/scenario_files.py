@@ -28,6 +28,7 @@ KINDS = {
     "identify_cl": "freefloat identify cl",
     "control_ddp": "freefloat control ddp",
     "simulate": "freefloat simulate",
+    "mission": "freefloat mission",
 }
 DEFAULT_KIND = "postcapture"
 

@@ -381,6 +381,61 @@ class Simulate(_Scenario):
         return self
 
 
+# -- mission (freefloat mission): capture, identify online, berth with the estimate -------------------------
+class MissionBody(Block):
+    mass: Positive
+    com: numbers(3) = None
+    inertia: Numbers
+
+
+class MissionTarget(MissionBody):
+    velocity: numbers(3) = None
+    rate: numbers(3) = None
+    guess: MissionBody
+
+
+class MissionCapture(Block):
+    joints_deg: Numbers
+    base_velocity: numbers(3) = None
+    base_rate: numbers(3) = None
+
+
+class MissionConvergence(Block):
+    mass: Positive = 0.02
+    com: Positive = 0.01
+    inertia: Positive = 0.05
+
+
+class MissionIdentify(Block):
+    method: literal("momentum", "force") = "momentum"
+    max_duration: Positive = 60.0
+    min_duration: NonNegative = 2.0
+    convergence: MissionConvergence | None = None
+
+
+class MissionBerth(Block):
+    duration: Positive = 20.0
+    dt: Positive = 0.05
+    position: numbers(3)
+    rpy_deg: numbers(3) = None
+    position_tolerance: Positive = 0.01
+    angle_tolerance_deg: Positive = 1.0
+    weights: dict | None = None
+    max_iter: integer(lo=1) = 100
+    controller: literal("policy", "mpc") = "policy"
+    isp: Positive = 220.0
+
+
+class Mission(_Scenario):
+    kind: literal("mission")
+    servicer: Text
+    detumble: Text
+    target: MissionTarget
+    capture: MissionCapture
+    identify: MissionIdentify | None = None
+    berth: MissionBerth
+
+
 # -- campaign specs (freefloat campaign) --------------------------------------------------------------------
 class MonteCarlo(Block):
     runs: integer(lo=1)
@@ -404,6 +459,7 @@ register_kind("control_adaptive", ControlAdaptive)
 register_kind("identify_cl", IdentifyCl)
 register_kind("control_ddp", ControlDdp)
 register_kind("simulate", Simulate)
+register_kind("mission", Mission)
 register_kind("campaign", Campaign)
 
 

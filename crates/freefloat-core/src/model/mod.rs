@@ -4,6 +4,7 @@
 /// Built-in robots, embedded in the engine at build time.
 pub mod builtin;
 mod joint;
+mod merge;
 /// MJCF (MuJoCo) writer.
 pub mod mjcf;
 mod physics;

@@ -12,9 +12,11 @@
 //! `equations`, the estimators `estimation::{Rls, ModifiedRls}`, the orchestration Python
 //! (`freefloat.postcapture`).
 
+pub mod capture;
 mod control;
 pub mod equations;
 mod simulate;
 
+pub use capture::{capture_impact, CaptureImpact};
 pub use control::{saturate, PostcaptureControl};
 pub use simulate::{simulate_postcapture, simulate_postcapture_with, thruster_base_wrench};
