@@ -312,6 +312,10 @@ of static bodies, zero gravity unless `with_gravity`.
     @property
     def total_mass(self) -> float:
         ...
+    def with_fixed_leaves_merged(self) -> Any:
+        """A new Model with every welded (fixed-joint) leaf merged into its parent, a frame of the leaf's name left
+in its place: the same dynamics with fewer bodies.
+        """
     def with_gravity(self, g: ArrayLike) -> Model:
         ...
     def with_parameters(self, params: ArrayLike) -> Model:
@@ -404,6 +408,14 @@ Gravity is not included.
 
 def body_velocities(model: Model, q: ArrayLike, v: ArrayLike) -> np.ndarray:
     """Body twists (nbodies, 6) [linear; angular], each in its own body frame (Pinocchio LOCAL)."""
+
+def capture_impact(model: Model, target: ArrayLike, q: ArrayLike, v: ArrayLike, target_twist: ArrayLike) -> Any:
+    """The grasp of a drifting target as an inelastic impact (`postcapture::capture_impact`): `model` is the combined
+model whose leaf body `target` (a fixed joint) is the target, `q` the configuration at contact, `v` the
+servicer's velocity just before, `target_twist` the target's twist just before (its own axes, [v; ω]).
+Returns a dict: v_post (nv), impulse_local / impulse_world (6, [linear; angular], about the target frame origin),
+momentum_before / momentum_after (6, inertial, about the origin), energy_before / energy_after.
+    """
 
 def center_of_mass(model: Model, q: ArrayLike) -> np.ndarray:
     ...

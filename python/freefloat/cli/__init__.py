@@ -25,6 +25,7 @@ from . import (
     export,
     identify,
     measure,
+    mission,
     models,
     params,
     postcapture,
@@ -75,6 +76,7 @@ main.add_command(simulate.simulate_cmd)
 main.add_command(reactions.reactions_cmd)
 main.add_command(measure.measure_cmd)
 main.add_command(demo.demo_cmd)
+main.add_command(mission.mission_cmd)
 main.add_command(params.params_group)
 main.add_command(identify.identify_group)
 identify.identify_group.add_command(postcapture.identify_postcapture_cmd)

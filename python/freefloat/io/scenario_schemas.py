@@ -404,6 +404,7 @@ class MissionConvergence(Block):
     mass: Positive = 0.02
     com: Positive = 0.01
     inertia: Positive = 0.05
+    window: Positive = 5.0
 
 
 class MissionIdentify(Block):

@@ -2,8 +2,8 @@
 identify the stack online from its telemetry while it is detumbled, and berth the target with the estimate,
 compared on the true plant against the nominal model (target guessed) and the truth.
 
-    import freefloat as ff
-    res = ff.mission.run("zhang2020_3d_capture", progress=print)
+    from freefloat import mission
+    res = mission.run("zhang2020_3d_capture", progress=print)
     print(res["berth"]["identified"]["position_error_final_m"])
 
 The phases and their assumptions are in docs/mission.md; the physics (impact, simulation, rows, RLS, DDP) is the
@@ -40,7 +40,9 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         cap = phases.capture(mission, truth)
         sc = phases.detumble_scenario(mission, cap["q"], cap["v_post"])
         ref_check_q = cap["q"]
-        phases.check_reachable(truth, ref_check_q, phases.berth_reference(truth, ref_check_q, mission.berth), mission.source)
+        phases.check_reachable(
+            truth, ref_check_q, phases.berth_reference(truth, ref_check_q, mission.berth), mission.source
+        )
         out["capture"] = {
             "target_mass_kg": mission.target.mass,
             "impulse_linear_Ns": float(np.linalg.norm(cap["impulse_world"][:3])),
@@ -55,8 +57,8 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         }
         out["phases_done"].append("capture")
         say(
-            f"capture: impulse {out['capture']['impulse_linear_Ns']:.2f} N s / {out['capture']['impulse_angular_Nms']:.2f} "
-            f"N m s, momentum kept to {cap['momentum_error_relative']:.1e}"
+            f"capture: impulse {out['capture']['impulse_linear_Ns']:.2f} N s / "
+            f"{out['capture']['impulse_angular_Nms']:.2f} N m s, momentum kept to {cap['momentum_error_relative']:.1e}"
         )
         # phase 2: detumble and identify online
         ident = phases.identify_online(mission, truth, sc, seed=seed, progress=say)
@@ -98,7 +100,8 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         traces["identify"] = ident
         out["phases_done"].append("identify")
         say(
-            f"identify: {'converged' if ident['converged'] else 'NOT converged'} at t = {ident['handover_time']:.1f} s; "
+            f"identify: {'converged' if ident['converged'] else 'NOT converged'} "
+            f"at t = {ident['handover_time']:.1f} s; "
             f"target mass error {100 * out['identify']['target_mass_error_relative']:.2f} %"
         )
         # phase 3: berth with each model, on the true plant
@@ -147,9 +150,8 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
 
 def write(res: dict, out_dir) -> list:
     """results.json (every printed number), table.txt and the figures of a mission run into `out_dir`."""
-    from pathlib import Path
-
     import json
+    from pathlib import Path
 
     from ..campaign.spec import _jsonable
     from . import plots
@@ -171,8 +173,9 @@ def table(res: dict) -> str:
     if "capture" in res:
         c = res["capture"]
         lines.append(
-            f"capture: impulse {c['impulse_linear_Ns']:.3f} N s, {c['impulse_angular_Nms']:.3f} N m s; momentum kept to "
-            f"{c['momentum_error_relative']:.1e}; kinetic energy {c['energy_before_J']:.3f} -> {c['energy_after_J']:.3f} J"
+            f"capture: impulse {c['impulse_linear_Ns']:.3f} N s, {c['impulse_angular_Nms']:.3f} N m s; "
+            f"momentum kept to {c['momentum_error_relative']:.1e}; "
+            f"kinetic energy {c['energy_before_J']:.3f} -> {c['energy_after_J']:.3f} J"
         )
     if "identify" in res:
         i = res["identify"]
@@ -184,7 +187,9 @@ def table(res: dict) -> str:
         )
     if "berth" in res:
         lines.append(f"berth ({res['berth']['controller']}), on the true plant:")
-        hdr = f"{'model':<11}{'pos err mm':>11}{'ang err deg':>12}{'settle s':>10}{'thrust N s':>11}{'prop kg':>9}{'max rate':>10}{'wheel Nms':>10}"
+        cols = [("model", 11), ("pos err mm", 11), ("ang err deg", 12), ("settle s", 10), ("thrust N s", 11)]
+        cols += [("prop kg", 9), ("max rate", 10), ("wheel Nms", 10)]
+        hdr = "".join(f"{c:<{w}}" if k == 0 else f"{c:>{w}}" for k, (c, w) in enumerate(cols))
         lines.append(hdr)
         for name in ("nominal", "identified", "truth"):
             s = res["berth"].get(name)

@@ -55,7 +55,9 @@ def capture(mission: Mission, truth) -> dict:
     if truth.joint_types[0] != "free":
         raise InputError(f"{mission.source}: key 'servicer': a capture mission needs a free-floating base")
     if len(mission.joints) != nj:
-        raise InputError(f"{mission.source}: key 'capture.joints_deg': {truth.name} has {nj} joints, got {len(mission.joints)}")
+        raise InputError(
+            f"{mission.source}: key 'capture.joints_deg': {truth.name} has {nj} joints, got {len(mission.joints)}"
+        )
     q = np.concatenate([[0, 0, 0, 0, 0, 0, 1], mission.joints])
     v = np.concatenate([mission.base_velocity, mission.base_rate, np.zeros(nj)])  # base frame = inertial at contact
     from .. import algorithms as alg
@@ -76,7 +78,9 @@ def detumble_scenario(mission: Mission, q0, v0) -> Scenario:
     g = mission.guess
     guess = dict(sc.guess)
     guess["target"] = {"mass": g.mass, "com": list(g.com), "inertia": g.inertia.tolist()}
-    return dataclasses.replace(sc, q0=np.asarray(q0, float), v0=np.asarray(v0, float), duration=mission.max_duration, guess=guess)
+    return dataclasses.replace(
+        sc, q0=np.asarray(q0, float), v0=np.asarray(v0, float), duration=mission.max_duration, guess=guess
+    )
 
 
 def covariance_history(rows: eq.StandardRows, x_hist: np.ndarray, p0: float, block: slice) -> np.ndarray:
@@ -140,14 +144,34 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
     diag = [4, 6, 9]
     rel_i = (sig[:, diag] / np.maximum(np.abs(x_t[:, diag]), 1e-12)).max(1)
     tol = mission.tolerance
-    ok = (rel_m <= tol["mass"]) & (com_sd <= tol["com"]) & (rel_i <= tol["inertia"]) & (rows.t >= mission.min_duration)
+    # The RLS covariance alone is optimistic here: the momentum form's rows are cumulative (their errors are
+    # correlated, not white), and at 5 s it claimed 0.2 % on the inertia against a true error of 4.9 % (the
+    # built-in mission). So the test also asks that the estimate has stopped moving: over the trailing
+    # `window` seconds no past estimate differs from the current one by more than the same tolerances.
+    t_rows = np.asarray(rows.t, float)
+    w = float(tol.get("window", 5.0))
+    drift_m, drift_c, drift_i = (np.full(len(t_rows), np.inf) for _ in range(3))
+    est_t = phys[:, half:]
+    for j in range(len(t_rows)):
+        i0 = int(np.searchsorted(t_rows, t_rows[j] - w))
+        if t_rows[j] - t_rows[0] < w:
+            continue
+        seg, cur = est_t[i0 : j + 1], est_t[j]
+        drift_m[j] = np.abs(seg[:, 0] - cur[0]).max() / abs(cur[0])
+        drift_c[j] = np.linalg.norm(seg[:, 1:4] - cur[1:4], axis=1).max()
+        drift_i[j] = (np.abs(seg[:, [4, 7, 9]] - cur[[4, 7, 9]]).max(0) / np.abs(cur[[4, 7, 9]])).max()
+    ok = (rel_m <= tol["mass"]) & (com_sd <= tol["com"]) & (rel_i <= tol["inertia"]) & (t_rows >= mission.min_duration)
+    ok &= (drift_m <= tol["mass"]) & (drift_c <= tol["com"]) & (drift_i <= tol["inertia"])
     converged = bool(ok.any())
     kc = int(np.argmax(ok)) if converged else len(rows.t) - 1
     t_c = float(rows.t[kc])
     # the state at the handover: the sample instant of the recorded run
     i_sim = int(np.argmin(np.abs(np.asarray(sim["t"]) - t_c)))
     truth_phys = np.concatenate(
-        [np.r_[m, b, eq.inertia_sharp(I)[[0, 1, 2, 3, 4, 5]]] for m, b, I in (eq.body_truth(truth, 0), eq.body_truth(truth, target))]
+        [
+            np.r_[m, b, eq.inertia_sharp(I)[[0, 1, 2, 3, 4, 5]]]
+            for m, b, I in (eq.body_truth(truth, 0), eq.body_truth(truth, target))
+        ]
     )
     return {
         "scenario": sc,
@@ -183,8 +207,21 @@ def identified_model(truth, ident: dict):
 
 
 # -- phase 3: berth -------------------------------------------------------------------------------------------
-DEFAULT_BERTH = {"duration": 20.0, "dt": 0.05, "position_tolerance": 0.01, "angle_tolerance_deg": 1.0, "max_iter": 100, "isp": 220.0}
-DEFAULT_WEIGHTS = {"pose": [1.0, 1.0, 1.0, 1.0, 1.0, 1.0], "terminal_pose": 1e4, "velocity": 1.0, "terminal_velocity": 1e3, "control": 1e-6}
+DEFAULT_BERTH = {
+    "duration": 20.0,
+    "dt": 0.05,
+    "position_tolerance": 0.01,
+    "angle_tolerance_deg": 1.0,
+    "max_iter": 100,
+    "isp": 220.0,
+}
+DEFAULT_WEIGHTS = {
+    "pose": [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+    "terminal_pose": 1e4,
+    "velocity": 1.0,
+    "terminal_velocity": 1e3,
+    "control": 1e-6,
+}
 
 
 def berth_reference(truth, q_h, berth: dict) -> np.ndarray:

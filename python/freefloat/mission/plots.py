@@ -24,9 +24,10 @@ def timeline(res: dict, path):
     ax[0].legend(fontsize=8)
     names, est, tru = ident["names"], ident["estimates"], ident["truth_physical"]
     rt = ident["rows_t"]
+    upto = rt <= t_c + 1e-9  # what the estimator had seen by the handover
     h = len(names) // 2
     for j in (h, h + 4, h + 7, h + 9):
-        ax[1].plot(rt, est[:, j] / tru[j], label=names[j])
+        ax[1].plot(rt[upto], est[upto, j] / tru[j], label=names[j])
     ax[1].axvline(t_c, color="k", ls="--", lw=1)
     ax[1].set_ylim(0.5, 1.5)
     ax[1].set_ylabel("target estimate / truth")
@@ -39,7 +40,9 @@ def timeline(res: dict, path):
     for a in ax:
         a.axvspan(0, t_c, color="0.92", zorder=0)
         a.grid(True, which="both", alpha=0.3)
-    ax[0].set_title(f"{res['mission']}: grasp at 0 s, detumble and identify (grey), handover at {t_c:.1f} s, berth")
+    ax[0].set_title(
+        f"{res['mission']}: grasp at 0 s, detumble + identify (grey), handover {t_c:.1f} s, berth", fontsize=10
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -59,12 +59,13 @@ def _inertia(x, where: str) -> np.ndarray:
     raise InputError(f"{where}: expected 3 principal moments or 6 entries [xx, xy, xz, yy, yz, zz], got {a.size}")
 
 
-def _body(d: dict, where: str) -> Body:
-    b = Body(float(d["mass"]), np.asarray(d.get("com", [0, 0, 0]), float), _inertia(d["inertia"], f"{where}.inertia"))
+def _body(d: dict, source: str, key: str) -> Body:
+    where = f"{source}: key '{key}.inertia'"
+    b = Body(float(d["mass"]), np.asarray(d.get("com", [0, 0, 0]), float), _inertia(d["inertia"], where))
     ev = np.linalg.eigvalsh(b.inertia)
     if ev.min() <= 0 or 2 * ev.max() > ev.sum() * (1 + 1e-9):
         raise InputError(
-            f"{where}.inertia: not the inertia of a body (principal moments {np.round(ev, 6).tolist()} must be "
+            f"{where}: not the inertia of a body (principal moments {np.round(ev, 6).tolist()} must be "
             "positive and each at most the sum of the other two)"
         )
     return b
@@ -75,15 +76,15 @@ def load_mission(spec: str | Path) -> Mission:
     d, source = scenario_files.read(spec, kind="mission")
     deg = np.pi / 180
     t, cap, ident, berth = d["target"], d["capture"], d.get("identify") or {}, d["berth"]
-    tol = {"mass": 0.02, "com": 0.01, "inertia": 0.05}
+    tol = {"mass": 0.02, "com": 0.01, "inertia": 0.05, "window": 5.0}
     tol.update(ident.get("convergence") or {})
     return Mission(
         name=d["name"],
         description=str(d.get("description", "")).strip(),
         servicer=d["servicer"],
         detumble=d["detumble"],
-        target=_body(t, f"{source}: key 'target'"),
-        guess=_body(t["guess"], f"{source}: key 'target.guess'"),
+        target=_body(t, source, "target"),
+        guess=_body(t["guess"], source, "target.guess"),
         target_velocity=np.asarray(t.get("velocity", [0, 0, 0]), float),
         target_rate=np.asarray(t.get("rate", [0, 0, 0]), float),
         joints=np.asarray(cap["joints_deg"], float) * deg,

@@ -54,7 +54,19 @@ impl Model {
                 });
             } )* };
         }
-        keep_all!(body_names, joint_names, parents, joint_types, axes, axes2, placements, inertias, limits, tags, allow_nonphysical);
+        keep_all!(
+            body_names,
+            joint_names,
+            parents,
+            joint_types,
+            axes,
+            axes2,
+            placements,
+            inertias,
+            limits,
+            tags,
+            allow_nonphysical
+        );
         for p in m.parents.iter_mut() {
             *p = p.map(|x| new_index[x]);
         }

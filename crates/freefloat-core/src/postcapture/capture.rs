@@ -38,8 +38,9 @@ pub struct CaptureImpact {
     pub momentum_before: Force,
     /// Total momentum of the combined model after.
     pub momentum_after: Force,
-    /// Kinetic energy before (servicer + target) and after (combined), J.
+    /// Kinetic energy before: servicer plus free target (J).
     pub energy_before: f64,
+    /// Kinetic energy after: the combined model (J); below `energy_before`, the impact is plastic.
     pub energy_after: f64,
 }
 
@@ -79,7 +80,8 @@ pub fn capture_impact(
         V3::new(target_twist[3], target_twist[4], target_twist[5]),
     );
     let h_pre = it.mul_motion(&tw_pre);
-    let h_pre6 = DVector::from_column_slice(&[h_pre.lin.x, h_pre.lin.y, h_pre.lin.z, h_pre.ang.x, h_pre.ang.y, h_pre.ang.z]);
+    let h_pre6 =
+        DVector::from_column_slice(&[h_pre.lin.x, h_pre.lin.y, h_pre.lin.z, h_pre.ang.x, h_pre.ang.y, h_pre.ang.z]);
 
     // M_c v⁺ = M_s v⁻ + J_tᵀ I_t V_t⁻
     let vm = DVector::from_column_slice(v_pre);
@@ -131,7 +133,7 @@ fn check_target(model: &Model, target: usize) -> Result<()> {
             format!("body {target} must be welded to the end effector by a fixed joint (the grasp)"),
         ));
     }
-    if model.parents.iter().any(|p| *p == Some(target)) {
+    if model.parents.contains(&Some(target)) {
         return Err(FfError::arg("target", format!("body {target} must be a leaf (nothing is attached to a target)")));
     }
     if model.inertias[target].mass <= 0.0 {
