@@ -24,6 +24,16 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 
 
+def _check_mission(out: Path) -> list[str]:
+    res = json.loads((out / "mission_bench.json").read_text())
+    bad = []
+    if set(res["phase_median_s"]) < {"capture", "detumble_simulation", "identification", "berth_closed_loop"}:
+        bad.append(f"phases missing: {sorted(res['phase_median_s'])}")
+    if not res["mission_time_s"] > res["handover_s"] > 0:
+        bad.append(f"mission time {res['mission_time_s']} / handover {res['handover_s']}")
+    return bad
+
+
 def _check_compare_pinocchio(out: Path) -> list[str]:
     res = json.loads((out / "compare_pinocchio.json").read_text())
     bad = [f"agreement {k} = {v:.3g} > 1e-9" for k, v in res["agreement_max_rel_error"].items() if not v < 1e-9]
@@ -202,6 +212,7 @@ BENCHES = {
     "basilisk_wheels": ("basilisk_wheels.py", [], ("Basilisk",), _check_basilisk_wheels),
     "environment": ("environment_bench.py", [], (), _check_environment),
     "soak": ("soak.py", [], (), _check_soak),
+    "mission": ("mission_bench.py", [], ("scipy",), _check_mission),
 }
 
 

@@ -142,3 +142,23 @@ def test_bad_mission_files_name_the_key(tmp_path):
     f = _mission_file(tmp_path, **{"inertia: [45.0, 38.0, 30.0]": "inertia: [45.0, 3.0, 30.0]"})
     with pytest.raises(ff.InputError, match=r"target\.inertia.*not the inertia of a body"):
         fm.load_mission(f)
+
+
+def test_mission_campaign_kind_and_report(tmp_path):
+    """One Monte Carlo draw of the built-in mission campaign through the campaign machinery, and the HTML report of
+    a mission's --out folder."""
+    from freefloat.campaign import registry
+
+    kind = registry.get("mission")
+    base = kind.load("zhang2020_3d_capture")
+    base["target"]["mass"] = 150.0
+    row = kind.run(kind.normalize(base), 3)
+    assert row["capture.target_mass_kg"] == 150.0
+    assert row["identify.converged"] is True
+    assert row["berth.identified.position_error_final_m"] < row["berth.nominal.position_error_final_m"]
+    res = fm.run("zhang2020_3d_capture_heavy")
+    fm.write(res, tmp_path / "m")
+    from freefloat.report import build_report
+
+    html = build_report(tmp_path / "m")
+    assert "Capture mission: zhang2020_3d_capture_heavy" in html and "Berth (policy)" in html

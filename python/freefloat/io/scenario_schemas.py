@@ -777,7 +777,16 @@ for _name, _block in (
     ("sensors", list[Sensor]),
     ("telemetry", TelemetryBlock),
 ):
-    register_block(_name, _block, kinds=BLOCK_KINDS)
+    # a mission's detumble is a post-capture run: its own sensors replace the detumble scenario's; actuators and
+    # environment belong to that scenario (the mission does not re-declare the spacecraft)
+    register_block(_name, _block, kinds=BLOCK_KINDS + (("mission",) if _name in ("sensors", "telemetry") else ()))
+    if _name in ("actuators", "environment"):
+        refuse_block(
+            _name,
+            "mission",
+            "a mission takes the spacecraft's actuators and environment from its detumble scenario (key 'detumble'); "
+            "put the block there",
+        )
     for _kind, _why in _NOT_APPLIED.items():
         refuse_block(
             _name,

@@ -38,7 +38,7 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         truth = phases.load_truth(mission)
         # phase 1: the grasp
         cap = phases.capture(mission, truth)
-        sc = phases.detumble_scenario(mission, cap["q"], cap["v_post"])
+        sc = phases.detumble_scenario(mission, cap["q"], cap["v_post"], truth)
         ref_check_q = cap["q"]
         phases.check_reachable(
             truth, ref_check_q, phases.berth_reference(truth, ref_check_q, mission.berth), mission.source
@@ -65,7 +65,15 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         tgt = slice(len(ident["names"]) // 2, len(ident["names"]))
         est = ident["estimates"][ident["handover_index"]]
         tru = ident["truth_physical"]
-        rel = np.abs(est - tru) / np.maximum(np.abs(tru), 1e-12)
+        # relative errors; a product of inertia (true value often zero) relative to its body's largest moment
+        h = len(ident["names"]) // 2
+        scale = np.abs(tru).copy()
+        for b0 in (0, h):
+            scale[b0 + 5 : b0 + 10] = np.abs(tru[[b0 + 4, b0 + 7, b0 + 9]]).max()
+            scale[b0 + 1 : b0 + 4] = np.maximum(np.abs(tru[b0 + 1 : b0 + 4]), 1e-3)  # CoM: at least 1 mm
+        scale[[4, 7, 9]] = np.abs(tru[[4, 7, 9]])
+        scale[[h + 4, h + 7, h + 9]] = np.abs(tru[[h + 4, h + 7, h + 9]])
+        rel = np.abs(est - tru) / np.maximum(scale, 1e-300)
         names = ident["names"]
         sim = ident["sim"]
         ts = np.asarray(sim["t"])
@@ -129,7 +137,8 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
             s = r["summary"]
             say(
                 f"berth with the {name} model: final error {1e3 * s['position_error_final_m']:.1f} mm / "
-                f"{s['angle_error_final_deg']:.2f} deg, settled {s['settling_time_s']} s"
+                f"{s['angle_error_final_deg']:.2f} deg, "
+                + ("never settled" if s["settling_time_s"] is None else f"settled at {s['settling_time_s']:.2f} s")
             )
         out["phases_done"].append("berth")
         t_c = ident["handover_time"]
@@ -159,12 +168,42 @@ def write(res: dict, out_dir) -> list:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = {k: v for k, v in res.items() if k != "traces"}
+    if "traces" in res and "berth" in res["traces"]:
+        data["series"] = series(res)
     (out / "results.json").write_text(json.dumps(data, indent=1, default=_jsonable), encoding="utf-8")
     (out / "table.txt").write_text(table(res), encoding="utf-8")
     files = [out / "results.json", out / "table.txt"]
     if "traces" in res and "berth" in res["traces"]:
         files.append(plots.timeline(res, out / "mission_timeline.png"))
     return files
+
+
+def series(res: dict, step_s: float = 0.5) -> dict:
+    """The histories behind the figure, every `step_s` seconds, for the HTML report (`freefloat report DIR`): the
+    target's estimate over truth up to the handover, and each berth run's target position error and base rate."""
+    ident = res["traces"]["identify"]
+    t, est, tru, names = ident["rows_t"], ident["estimates"], ident["truth_physical"], ident["names"]
+    keep = t <= ident["handover_time"] + 1e-9
+    stride = max(1, int(round(step_s / max(float(np.median(np.diff(t))), 1e-9)))) if len(t) > 1 else 1
+    h = len(names) // 2
+    out = {
+        "identify": {
+            "t": t[keep][::stride].tolist(),
+            "estimate_over_truth": {
+                names[j]: (est[keep, j][::stride] / tru[j]).tolist() for j in (h, h + 4, h + 7, h + 9)
+            },
+        },
+        "berth": {},
+    }
+    for name, tr in res["traces"]["berth"].items():
+        bt = np.asarray(tr["t"])
+        st = max(1, int(round(step_s / max(float(np.median(np.diff(bt))), 1e-9)))) if len(bt) > 1 else 1
+        out["berth"][name] = {
+            "t": (ident["handover_time"] + bt[::st]).tolist(),
+            "position_error_m": np.asarray(tr["position_error"])[::st].tolist(),
+            "base_rate_rad_s": np.asarray(tr["base_rate"])[::st].tolist(),
+        }
+    return out
 
 
 def table(res: dict) -> str:

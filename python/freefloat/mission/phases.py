@@ -73,14 +73,22 @@ def capture(mission: Mission, truth) -> dict:
 
 
 # -- phase 2: detumble and identify ---------------------------------------------------------------------------
-def detumble_scenario(mission: Mission, q0, v0) -> Scenario:
+def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
+    """The detumble scenario from the post-impact state, with the mission's guess of the target and, when the
+    mission has its own `sensors:` block, those sensors (checked against the robot like a scenario's)."""
+    from ..postcapture.scenario import _blocks
+
     sc = load_scenario(mission.detumble)
     g = mission.guess
     guess = dict(sc.guess)
     guess["target"] = {"mass": g.mass, "com": list(g.com), "inertia": g.inertia.tolist()}
-    return dataclasses.replace(
+    sc = dataclasses.replace(
         sc, q0=np.asarray(q0, float), v0=np.asarray(v0, float), duration=mission.max_duration, guess=guess
     )
+    if mission.sensors is not None:
+        _, _, sset = _blocks(mission.sensors, mission.source, truth if truth is not None else models.load(sc.model))
+        sc = dataclasses.replace(sc, sensors=sset)
+    return sc
 
 
 def covariance_history(rows: eq.StandardRows, x_hist: np.ndarray, p0: float, block: slice) -> np.ndarray:
@@ -219,6 +227,7 @@ DEFAULT_WEIGHTS = {
     "pose": [1.0, 1.0, 1.0, 1.0, 1.0, 1.0],
     "terminal_pose": 1e4,
     "velocity": 1.0,
+    "base_rate": 100.0,
     "terminal_velocity": 1e3,
     "control": 1e-6,
 }
@@ -269,6 +278,8 @@ def berth_problem(model, x0, ref7, berth: dict, name: str) -> ddp.Problem:
     nv = model.nv
     pose_w = list(np.broadcast_to(np.asarray(w["pose"], float), (6,)))
     vel = np.r_[np.zeros(nv), np.full(nv, float(w["velocity"]))]
+    # the base's rotation rate apart: a servicer does not want its base (antennas, sensors) spun by the berth
+    vel[nv + 3 : nv + 6] = float(w["base_rate"])
     tvel = np.r_[np.zeros(nv), np.full(nv, float(w["terminal_velocity"]))]
     xref = np.asarray(x0, float)[None]
     running = [

@@ -41,6 +41,8 @@ class Mission:
     tolerance: dict
     berth: dict
     source: str = ""
+    #: the mission's own `sensors:` (+ `telemetry:`) blocks, replacing the detumble scenario's, or None
+    sensors: dict | None = None
     extra: dict = field(default_factory=dict)
 
 
@@ -96,4 +98,5 @@ def load_mission(spec: str | Path) -> Mission:
         tolerance=tol,
         berth=dict(berth),
         source=source,
+        sensors={k: d[k] for k in ("sensors", "telemetry") if d.get(k) is not None} or None,
     )

@@ -17,6 +17,8 @@ def what(res: dict) -> str:
     """The kind of folder a results.json describes."""
     if "runs_total" in res:
         return "campaign"
+    if "phases_done" in res and "mission" in res:
+        return "mission"
     if "methods" in res and "scenario" in res:
         return "postcapture"
     if "identification" in res and "momentum_initial" in res:
@@ -241,3 +243,81 @@ def postcapture(page: Page, out: Path, res: dict) -> None:
         page.figure(fig, height=560)
     page.section("Settings")
     page.settings("results.json (without the sweep)", {k: v for k, v in res.items() if k != "velocity_sweep"})
+
+
+def mission(page: Page, out: Path, res: dict) -> None:
+    """A capture mission (`freefloat mission --out`): the phase timeline, the handover, the berth comparison."""
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    page.title = f"Capture mission: {res.get('mission')}"
+    page.subtitle = res.get("description", "")
+    if res.get("interrupted"):
+        page.text(f"Interrupted: {res['interrupted']}. The phases done are shown.")
+    tl = res.get("timeline") or []
+    if tl:
+        page.section("Phase timeline (mission time since the grasp)")
+        page.table(["phase", "start [s]", "end [s]"], [[p["phase"], p["start_s"], p["end_s"]] for p in tl])
+    c = res.get("capture")
+    if c:
+        page.section("Capture: the grasp impact")
+        page.table(
+            ["quantity", "value"],
+            [
+                ["linear impulse [N s]", c["impulse_linear_Ns"]],
+                ["angular impulse [N m s]", c["impulse_angular_Nms"]],
+                ["momentum kept to (relative)", c["momentum_error_relative"]],
+                ["kinetic energy before / after [J]", f"{c['energy_before_J']:.4g} / {c['energy_after_J']:.4g}"],
+            ],
+        )
+    i = res.get("identify")
+    if i:
+        page.section("Detumble and online identification")
+        page.table(
+            ["quantity", "value"],
+            [
+                ["converged", i["converged"]],
+                ["handover time [s]", i["handover_time_s"]],
+                ["target mass estimate [kg]", i["target_mass_estimate_kg"]],
+                ["target mass error", i["target_mass_error_relative"]],
+                ["target CoM error [m]", i["target_com_error_m"]],
+                ["target inertia error (largest diagonal, relative)", i["target_inertia_error_relative"]],
+            ],
+        )
+    se = res.get("series") or {}
+    if "identify" in se:
+        fig = go.Figure()
+        for n, y in se["identify"]["estimate_over_truth"].items():
+            fig.add_trace(go.Scatter(x=se["identify"]["t"], y=y, name=n))
+        fig.update_layout(title="target estimate / truth up to the handover", yaxis_range=[0.5, 1.5])
+        page.figure(fig, height=360)
+    b = res.get("berth")
+    if b:
+        page.section(f"Berth ({b.get('controller')}) with each model, on the true plant")
+        keys = [
+            ("final position error [m]", "position_error_final_m"),
+            ("final angle error [deg]", "angle_error_final_deg"),
+            ("settling time [s]", "settling_time_s"),
+            ("thrust impulse [N s]", "thrust_impulse_Ns"),
+            ("propellant [kg]", "propellant_kg"),
+            ("peak base rate [rad/s]", "base_rate_peak_rad_s"),
+            ("peak wheel momentum [N m s]", "wheel_momentum_peak_Nms"),
+            ("peak joint torque [N m]", "joint_torque_peak_Nm"),
+        ]
+        models = [m for m in ("nominal", "identified", "truth") if m in b]
+        page.table(["quantity"] + models, [[label] + [b[m].get(k) for m in models] for label, k in keys])
+        if "berth" in se:
+            fig = make_subplots(rows=2, cols=1, shared_xaxes=True)
+            for name, tr in se["berth"].items():
+                fig.add_trace(go.Scatter(x=tr["t"], y=tr["position_error_m"], name=f"{name} model"), row=1, col=1)
+                fig.add_trace(
+                    go.Scatter(x=tr["t"], y=tr["base_rate_rad_s"], name=f"{name}: base rate", showlegend=False),
+                    row=2,
+                    col=1,
+                )
+            fig.update_yaxes(type="log", title_text="target position error [m]", row=1, col=1)
+            fig.update_yaxes(title_text="base rate [rad/s]", row=2, col=1)
+            fig.update_layout(title="berth on the true plant")
+            page.figure(fig, height=520)
+    page.section("Settings")
+    page.settings("results.json (without the series)", {k: v for k, v in res.items() if k != "series"})
