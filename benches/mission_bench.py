@@ -107,7 +107,8 @@ def main() -> None:
         "# Capture mission wall time (zhang2020_3d_capture, MPC berth on the identified model)",
         "",
         f"mission time {res['mission_time_s']:.1f} s (handover at {res['handover_s']:.1f} s); wall time median "
-        f"{res['mission_wall_s_median']:.2f} s (min {res['mission_wall_s_min']:.2f}, max {res['mission_wall_s_max']:.2f}, "
+        f"{res['mission_wall_s_median']:.2f} s (min {res['mission_wall_s_min']:.2f}, "
+        f"max {res['mission_wall_s_max']:.2f}, "
         f"{reps} repeats); target < 10 s: {'met' if res['met'] else 'NOT met'}",
         "",
         "| phase | median s | share |",
