@@ -168,12 +168,13 @@ def write(res: dict, out_dir) -> list:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     data = {k: v for k, v in res.items() if k != "traces"}
-    if "traces" in res and "berth" in res["traces"]:
+    complete = "berth" in res.get("phases_done", [])  # an interrupted run keeps its numbers, not half a figure
+    if complete:
         data["series"] = series(res)
     (out / "results.json").write_text(json.dumps(data, indent=1, default=_jsonable), encoding="utf-8")
     (out / "table.txt").write_text(table(res), encoding="utf-8")
     files = [out / "results.json", out / "table.txt"]
-    if "traces" in res and "berth" in res["traces"]:
+    if complete:
         files.append(plots.timeline(res, out / "mission_timeline.png"))
     return files
 

@@ -316,6 +316,8 @@ def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None) -> 
     t0 = time.perf_counter()
     sol = ddp.solve(prob)
     t_solve = time.perf_counter() - t0
+    if sol["stop"] == "interrupted":  # the solver keeps its best iterate on Ctrl-C; the mission stops here
+        raise KeyboardInterrupt(f"in the berth plan on the {name} model")
     mode = berth.get("controller", "policy")
     t0 = time.perf_counter()
     out = closed.run(prob, mode, plant=truth, solution=sol)
