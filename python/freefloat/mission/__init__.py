@@ -133,8 +133,15 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         for name, model in models.items():
             r = phases.berth_run(model, truth, x0, ref7, berth, name)
             out["berth"][name] = r["summary"]
-            traces["berth"][name] = r["trace"]
             s = r["summary"]
+            for joint, ratio in s["planned_torque_over_limit"].items():
+                say(f"warning: the berth planned on the {name} model needs {ratio:.2f} x joint {joint}'s effort limit")
+            if "failed" in s:
+                say(f"berth with the {name} model: {s['failed']}")
+                continue
+            traces["berth"][name] = r["trace"]
+            for joint, ratio in s["joint_torque_over_limit"].items():
+                say(f"warning: the berth with the {name} model needs {ratio:.2f} x the effort limit of joint {joint}")
             say(
                 f"berth with the {name} model: final error {1e3 * s['position_error_final_m']:.1f} mm / "
                 f"{s['angle_error_final_deg']:.2f} deg, "
@@ -234,6 +241,9 @@ def table(res: dict) -> str:
         for name in ("nominal", "identified", "truth"):
             s = res["berth"].get(name)
             if s is None:
+                continue
+            if "failed" in s:
+                lines.append(f"{name:<11}failed: {s['failed']}")
                 continue
             st = "never" if s["settling_time_s"] is None else f"{s['settling_time_s']:.1f}"
             lines.append(

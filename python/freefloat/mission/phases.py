@@ -18,7 +18,7 @@ import time
 import numpy as np
 
 from .. import _core, models
-from .._core import InputError
+from .._core import InputError, NumericalError
 from ..algorithms import quat_to_matrix
 from ..control import ddp
 from ..control import ddp_closed_loop as closed
@@ -319,8 +319,24 @@ def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None) -> 
     if sol["stop"] == "interrupted":  # the solver keeps its best iterate on Ctrl-C; the mission stops here
         raise KeyboardInterrupt(f"in the berth plan on the {name} model")
     mode = berth.get("controller", "policy")
+    planned_over = _over_limit(truth, np.asarray(sol["us"], float))
     t0 = time.perf_counter()
-    out = closed.run(prob, mode, plant=truth, solution=sol)
+    try:
+        out = closed.run(prob, mode, plant=truth, solution=sol)
+    except NumericalError as e:
+        # the plant left the solver's reach (e.g. torques clipped at the joints' effort limits and the stack no
+        # longer held): a result of the mission, reported, not a crash of it
+        failed = {
+            "model": name,
+            "failed": f"the closed loop on the true plant diverged: {e}",
+            "iterations": int(sol["iterations"]),
+            "solve_s": t_solve,
+            "planned_torque_over_limit": planned_over,
+            "position_error_final_m": None,
+            "angle_error_final_deg": None,
+            "settling_time_s": None,
+        }
+        return {"summary": failed, "trace": None}
     t_run = time.perf_counter() - t0
     t, pos, ang, us, xs = out["t"], out["position_error"], out["angle_error_deg"], out["us"], out["xs"]
     inside = (pos <= berth["position_tolerance"]) & (ang <= berth["angle_tolerance_deg"])
@@ -348,6 +364,8 @@ def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None) -> 
         "base_rate_peak_rad_s": float(w_base.max()),
         "wheel_momentum_peak_Nms": float(np.linalg.norm(wheel, axis=1).max()),
         "joint_torque_peak_Nm": float(np.abs(us[:, 6:]).max()),
+        "joint_torque_over_limit": _over_limit(truth, us),
+        "planned_torque_over_limit": planned_over,
         "stopped": bool(out["stopped"]),
     }
     if "mpc" in out:
@@ -355,6 +373,20 @@ def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None) -> 
         s.pop("replan_costs", None)
         res["mpc"] = s
     return {"summary": res, "trace": {"t": t, "position_error": pos, "angle_error_deg": ang, "base_rate": w_base}}
+
+
+def _over_limit(truth, us) -> dict:
+    """Joints whose peak berth torque exceeds the model's effort limit: {joint: peak / limit}. A target too heavy
+    for the arm is run and reported, not refused (the berth does not enforce the limits)."""
+    effort = np.asarray(truth._core.limits["effort"], float)
+    out = {}
+    for i, (name, nv) in enumerate(zip(truth.joint_names, truth.nvs)):
+        if i == 0 or nv != 1 or not np.isfinite(effort[i]) or effort[i] <= 0:
+            continue
+        peak = float(np.abs(us[:, truth.idx_v[i]]).max())
+        if peak > effort[i]:
+            out[name] = peak / float(effort[i])
+    return out
 
 
 def nominal_model(truth, mission: Mission, sc: Scenario):
