@@ -295,7 +295,7 @@ def test_target_must_be_welded_to_the_end_effector():
         text.replace("joint: {name: grasp, type: fixed}", "joint: {name: grasp, type: revolute, axis: [0, 0, 1]}")
     )
     with pytest.raises(ff.InputError, match="welded"):
-        pc._target_index(loose)
+        pc.target_index(loose)
     with pytest.raises(ff.InputError, match="not found"):
         pc.load_scenario("no_such_scenario")
 

@@ -269,7 +269,7 @@ def test_identification_error_grows_with_gyro_noise(tmp_path):
         res = pc.identify(m, meas, s2, methods=("force",))
         from freefloat.postcapture.spacecraft import truth_history
 
-        res.truth_history = truth_history(m, sim, False, pc.estimators._target_index(m))
+        res.truth_history = truth_history(m, sim, False, pc.estimators.target_index(m))
         e = res.rel_error("force", "standard_rls")
         errs.append(float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in cols]))))
     print("gyro noise x1, x10, x50: RMS relative error", errs)

@@ -206,7 +206,7 @@ def load(spec) -> SimulationScenario:
     by the engine, against its robot (joint names, tank masses, sensor joints): every error names the file,
     line and key."""
     from .io import scenario_files
-    from .postcapture.scenario import _blocks
+    from .postcapture.scenario import scenario_blocks
 
     d, source = scenario_files.read(spec, kind="simulate")
     p = Path(spec)
@@ -216,7 +216,7 @@ def load(spec) -> SimulationScenario:
     q0 = _vector(init.get("q"), m.nq, "initial.q", source, m.neutral())
     v0 = _vector(init.get("v"), m.nv, "initial.v", source, np.zeros(m.nv))
     tau, times, hold = _torques(d.get("torques") or {}, m, source, base_dir, float(d["duration"]))
-    acts, env, sset = _blocks(d, source, m)
+    acts, env, sset = scenario_blocks(d, source, m)
     return SimulationScenario(
         name=str(d.get("name", p.stem if p.suffix else spec)),
         description=str(d.get("description", "")).strip(),

@@ -33,7 +33,7 @@ def _load(ref, kind: str) -> dict:
         return _json_roundtrip(d)
     d, source = scenario_files.read(ref, kind=kind)
     src = Path(source)
-    for key in ("model", "robot"):
+    for key in ("model", "robot", "servicer"):
         p = d.get(key)
         if isinstance(p, str) and Path(p).suffix in (".yaml", ".yml", ".urdf", ".xml") and src.is_file():
             if not Path(p).is_absolute():

@@ -122,9 +122,8 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         q_h, v_h = ident["handover_state"]
         x0 = np.r_[q_h, v_h]
         ref7 = phases.berth_reference(truth, q_h, berth)
-        phases.check_reachable(truth, q_h, ref7, mission.source)
         models = {
-            "nominal": phases.nominal_model(truth, mission, sc),
+            "nominal": phases.nominal_model(truth, mission),
             "identified": phases.identified_model(truth, ident),
             "truth": truth,
         }

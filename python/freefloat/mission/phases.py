@@ -24,7 +24,7 @@ from ..control import ddp
 from ..control import ddp_closed_loop as closed
 from ..identification import online
 from ..postcapture import equations as eq
-from ..postcapture.estimators import _guess, _target_index, identify_standard, parameter_names
+from ..postcapture.estimators import identify_standard, initial_guesses, parameter_names, target_index
 from ..postcapture.scenario import Scenario, load_scenario
 from ..postcapture.simulation import measure, simulate
 from .spec import Body, Mission
@@ -50,7 +50,7 @@ def model_with_target(servicer, target: int, b: Body, base=None):
 def capture(mission: Mission, truth) -> dict:
     """The servicer at contact (base at the origin, attitude identity) and the target's twist before the grasp,
     through the impact. Refuses a grasp point the arm cannot be at (wrong joint count) before simulating."""
-    target = _target_index(truth)
+    target = target_index(truth)
     nj = truth.nv - 6
     if truth.joint_types[0] != "free":
         raise InputError(f"{mission.source}: key 'servicer': a capture mission needs a free-floating base")
@@ -76,7 +76,7 @@ def capture(mission: Mission, truth) -> dict:
 def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
     """The detumble scenario from the post-impact state, with the mission's guess of the target and, when the
     mission has its own `sensors:` block, those sensors (checked against the robot like a scenario's)."""
-    from ..postcapture.scenario import _blocks
+    from ..postcapture.scenario import scenario_blocks
 
     sc = load_scenario(mission.detumble)
     g = mission.guess
@@ -86,7 +86,9 @@ def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
         sc, q0=np.asarray(q0, float), v0=np.asarray(v0, float), duration=mission.max_duration, guess=guess
     )
     if mission.sensors is not None:
-        _, _, sset = _blocks(mission.sensors, mission.source, truth if truth is not None else models.load(sc.model))
+        _, _, sset = scenario_blocks(
+            mission.sensors, mission.source, truth if truth is not None else models.load(sc.model)
+        )
         sc = dataclasses.replace(sc, sensors=sset)
     return sc
 
@@ -95,7 +97,7 @@ def covariance_history(rows: eq.StandardRows, x_hist: np.ndarray, p0: float, blo
     """Standard deviations (N, len(block)) of the standard parameters in `block` after each sample: the RLS
     covariance s² (P₀⁻¹ 1 + Σ φφᵀ)⁻¹ with s² the residual variance of the rows so far at the current estimate
     (unbiased: SSE / (rows − parameters), the prior counted as no row)."""
-    phi, y, t = np.asarray(rows.Phi, float), np.asarray(rows.y, float), np.asarray(rows.t, float)
+    phi, y = np.asarray(rows.Phi, float), np.asarray(rows.y, float)
     n, r, p = phi.shape[0], phi.shape[1], phi.shape[2]
     G = np.cumsum(np.einsum("kri,krj->kij", phi, phi), 0)
     b = np.cumsum(np.einsum("kri,kr->ki", phi, y), 0)
@@ -110,7 +112,6 @@ def covariance_history(rows: eq.StandardRows, x_hist: np.ndarray, p0: float, blo
         sse = max(yy[k] - 2 * x @ b[k] + x @ G[k] @ x, 0.0)
         cov = np.linalg.inv(G[k] + eye) * (sse / dof)
         out[k] = np.sqrt(np.maximum(np.diag(cov)[block], 0.0))
-    del t
     return out
 
 
@@ -120,7 +121,7 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
     mass, CoM and inertia standard deviations are within the mission's tolerances (relative for mass and inertia,
     metres for the CoM). Without convergence the handover is at `max_duration`, and said so."""
     planar = False
-    base, target = 0, _target_index(truth)
+    base, target = 0, target_index(truth)
     t0 = time.perf_counter()
     sim = simulate(sc, truth)
     t_sim = time.perf_counter() - t0
@@ -135,7 +136,7 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
         truth, meas, base, target
     )
     L = eq.Layout(planar)
-    x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in _guess(sc, planar)])
+    x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in initial_guesses(sc, planar)])
     est = online.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting)
     x_hist = est.run(rows.t, rows.Phi, rows.y)
     phys = identify_standard(truth, rows, sc, planar)
@@ -204,7 +205,7 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
 def identified_model(truth, ident: dict):
     """The combined model with the base's and target's parameters as identified at the handover, projected onto
     physically consistent parameters (the nearest positive definite pseudo-inertia) so that DDP can run on it."""
-    target = _target_index(truth)
+    target = target_index(truth)
     k = len(ident["std_cols"])
     P = np.array(truth.parameters(), float)
     for body, sl in ((0, slice(0, k)), (target, slice(k, 2 * k))):
@@ -257,7 +258,7 @@ def _fk(model, q):
 def check_reachable(truth, q_h, ref7, source: str) -> None:
     """Refuse a berth position farther from the arm's first joint than the arm reaches (the sum of the joint
     offsets along the chain to the grasp point): no controller can get the target there."""
-    target = _target_index(truth)
+    target = target_index(truth)
     chain, j = [], target
     while j is not None and j != 0:
         chain.append(j)
@@ -391,17 +392,24 @@ def _over_limit(truth, us) -> dict:
     return out
 
 
-def nominal_model(truth, mission: Mission, sc: Scenario):
-    """What is known before identification: the base as the detumble scenario's guess is not used here (the base is
-    the servicer's own, known from ground tests); the target as guessed in the mission."""
-    del sc
-    return model_with_target(truth, _target_index(truth), mission.guess)
+def nominal_model(truth, mission: Mission):
+    """What is known before identification: the servicer as it is (its base and arm are known from ground tests)
+    and the target as the mission guesses it."""
+    return model_with_target(truth, target_index(truth), mission.guess)
 
 
 def load_truth(mission: Mission):
-    servicer = models.load(mission.servicer) if not str(mission.servicer).endswith((".yaml", ".yml")) else None
-    if servicer is None:
-        from ..model import Model
+    """The combined model: the servicer (a built-in robot or a YAML model file) with the true target welded on."""
+    from pathlib import Path
 
-        servicer = Model.from_yaml(mission.servicer)
-    return model_with_target(servicer, _target_index(servicer), mission.target)
+    from ..model import Model
+
+    spec = str(mission.servicer)
+    if Path(spec).suffix in (".yaml", ".yml"):
+        path = Path(spec)
+        if not path.is_absolute() and mission.source and Path(mission.source).is_file():
+            path = Path(mission.source).parent / path  # relative to the mission file, as model files elsewhere
+        servicer = Model.from_yaml(path)
+    else:
+        servicer = models.load(spec)
+    return model_with_target(servicer, target_index(servicer), mission.target)

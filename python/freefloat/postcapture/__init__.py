@@ -16,11 +16,11 @@ from . import equations
 from .estimators import (
     METHODS,
     SOLVERS,
-    _target_index,  # noqa: F401  (used by the tests of the target check)
     equation_residuals,
     identify_modified,
     identify_standard,
     parameter_names,
+    target_index,  # noqa: F401  (used by the tests of the target check)
     truth_vector,
 )
 from .pipeline import identify, noise_study, run, sweep

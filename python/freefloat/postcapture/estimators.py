@@ -63,7 +63,7 @@ def _sharp_to_matrix(s):
     )
 
 
-def _guess(sc: Scenario, planar: bool):
+def initial_guesses(sc: Scenario, planar: bool):
     """Initial guesses (m, b', I'_c) of base and target from the scenario (the paper's §V values)."""
     out = []
     for key in ("base", "target"):
@@ -79,7 +79,7 @@ def _guess(sc: Scenario, planar: bool):
 def identify_modified(model, rows: eq.PaperRows, sc: Scenario, planar: bool) -> np.ndarray:
     """The paper's modified RLS (eqs. 34-38) over the rows; returns (N, P) physical parameters."""
     L = eq.Layout(planar)
-    (m1, b1, I1), (mn, bn, In) = _guess(sc, planar)
+    (m1, b1, I1), (mn, bn, In) = initial_guesses(sc, planar)
     mu0 = np.concatenate([np.concatenate([[m], m * b])[L.mu_cols] for m, b in ((m1, b1), (mn, bn))])
     th0 = np.concatenate([eq.inertia_sharp(I)[L.th_cols] for I in (I1, In)])
     est = online.ModifiedRLS(L.coupling, mu0, np.full(len(mu0), sc.P0), th0, np.full(len(th0), sc.P0))
@@ -104,7 +104,7 @@ def identify_standard(
 ) -> np.ndarray:
     """Ordinary RLS on the standard parameters; returns (N, P) physical parameters."""
     L = eq.Layout(planar)
-    x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in _guess(sc, planar)])
+    x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in initial_guesses(sc, planar)])
     est = online.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting if forgetting is None else forgetting)
     x = est.run(rows.t, rows.Phi, rows.y)
     k = len(L.std_cols)
@@ -132,13 +132,13 @@ def identify_standard(
 
 
 def truth_vector(model, planar: bool) -> np.ndarray:
-    base, target = 0, _target_index(model)
+    base, target = 0, target_index(model)
     (m1, b1, I1), (mn, bn, In) = eq.body_truth(model, base), eq.body_truth(model, target)
     one = lambda x: x[None]  # noqa: E731
     return _physical(planar, np.array([m1]), one(b1), one(I1), np.array([mn]), one(bn), one(In))[0]
 
 
-def _target_index(model) -> int:
+def target_index(model) -> int:
     idx = [i for i, tags in enumerate(model.tags) if "target" in tags]
     if len(idx) != 1:
         raise InputError(f"model '{model.name}' must have exactly one body tagged 'target' (found {len(idx)})")

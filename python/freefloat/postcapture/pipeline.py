@@ -14,11 +14,11 @@ from . import equations as eq
 from .estimators import (
     METHODS,
     SOLVERS,
-    _target_index,
     equation_residuals,
     identify_modified,
     identify_standard,
     parameter_names,
+    target_index,
     truth_vector,
 )
 from .results import PostcaptureResult
@@ -36,7 +36,7 @@ def identify(model, meas: eq.Measurements, sc: Scenario, methods=METHODS, timing
     """Both solvers for each method over the measurements. A Ctrl-C here raises `freefloat.Interrupted` whose
     `partial` is the result with the estimator histories finished before it (`interrupted` set)."""
     planar = model.joint_types[0] == "planar"
-    base, target = 0, _target_index(model)
+    base, target = 0, target_index(model)
     truth = truth_vector(model, planar)
     hist, res, timings = {}, {}, dict(timings or {})
     try:
@@ -76,7 +76,7 @@ def run(sc: Scenario | str, methods=METHODS, seed: int | None = 0, progress=None
     if not isinstance(sc, Scenario):
         sc = load_scenario(sc)
     m = models.load(sc.model)
-    _target_index(m)
+    target_index(m)
     t0 = time.perf_counter()
     stopped = None
     try:
@@ -140,7 +140,7 @@ def _spacecraft_extras(m, sim: dict, sc: Scenario, res: PostcaptureResult) -> No
     from . import spacecraft
 
     planar = m.joint_types[0] == "planar"
-    res.truth_history = spacecraft.truth_history(m, sim, planar, _target_index(m))
+    res.truth_history = spacecraft.truth_history(m, sim, planar, target_index(m))
     if sc.actuators:
         res.extra["actuators"] = sc.actuators
         res.extra.update(spacecraft.balances(m, sim, sc))

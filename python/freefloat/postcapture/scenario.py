@@ -104,7 +104,7 @@ def _parse(d: dict, source: str) -> Scenario:
         "phase": [float(x) * deg for x in ex.get("phase_deg", [0] * nj)],
     }
     ident = d["identification"]
-    acts, env, sset = _blocks(d, source, m)
+    acts, env, sset = scenario_blocks(d, source, m)
     return Scenario(
         name=d["name"],
         description=str(d.get("description", "")).strip(),
@@ -133,7 +133,7 @@ def _parse(d: dict, source: str) -> Scenario:
     )
 
 
-def _blocks(d: dict, source: str, m):
+def scenario_blocks(d: dict, source: str, m):
     """The `actuators:`, `environment:` and `sensors:`/`telemetry:` blocks as the Python API objects that run
     them (the same readers as `freefloat simulate --actuators/--environment` and `freefloat measure --sensors`),
     checked against the robot by the engine now, so that a tank heavier than its body or an unknown joint is

@@ -160,7 +160,7 @@ def noise_forgetting_study(
     import dataclasses
 
     from .. import models
-    from .estimators import _target_index
+    from .estimators import target_index
     from .pipeline import identify
     from .simulation import measure, simulate
 
@@ -170,7 +170,7 @@ def noise_forgetting_study(
         raise ValueError("the scenario needs a gyro in its sensors: block")
     m = models.load(sc.model)
     sim = simulate(sc, m)
-    th = truth_history(m, sim, m.joint_types[0] == "planar", _target_index(m))
+    th = truth_history(m, sim, m.joint_types[0] == "planar", target_index(m))
     rows = []
     for n in gyro_noise:
         sens = dataclasses.replace(
