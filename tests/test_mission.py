@@ -87,6 +87,9 @@ def test_mission_phases_and_comparison(mission_run):
     assert res["phases_done"] == ["capture", "identify", "berth"]
     assert res["capture"]["momentum_error_relative"] < 1e-12
     assert res["capture"]["impulse_linear_Ns"] > 0.1
+    # before the grasp: two bodies (servicer, free target) whose summed momentum is the grasp's "before"
+    a = res["approach"]
+    assert a["momentum_drift_relative"] < 1e-12 and a["gap_at_start_m"] > 0.3 and a["gap_at_contact_m"] < 1e-9
     i = res["identify"]
     assert i["converged"] and 5.0 <= i["handover_time_s"] < 60.0
     # at the handover the estimate is as good as the test said (tolerances 1 % mass, 5 mm CoM, 2 % inertia)

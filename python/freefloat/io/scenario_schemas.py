@@ -395,6 +395,7 @@ class MissionTarget(MissionBody):
 
 
 class MissionCapture(Block):
+    approach_s: NonNegative = 10.0
     joints_deg: Numbers
     base_velocity: numbers(3) = None
     base_rate: numbers(3) = None

@@ -55,6 +55,15 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
             "energy_after_J": float(cap["energy_after"]),
             "v_post": cap["v_post"].tolist(),
         }
+        if mission.approach_s > 0:
+            ap = phases.approach(mission, truth, cap, mission.approach_s)
+            traces["approach"] = ap
+            out["approach"] = {
+                "duration_s": mission.approach_s,
+                "gap_at_start_m": float(ap["gap"][0]),
+                "gap_at_contact_m": float(ap["gap"][-1]),
+                "momentum_drift_relative": ap["momentum_drift_relative"],
+            }
         out["phases_done"].append("capture")
         say(
             f"capture: impulse {out['capture']['impulse_linear_Ns']:.2f} N s / "
@@ -149,6 +158,7 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         out["phases_done"].append("berth")
         t_c = ident["handover_time"]
         out["timeline"] = [
+            {"phase": "approach (servicer and free target)", "start_s": -mission.approach_s, "end_s": 0.0},
             {"phase": "capture", "start_s": 0.0, "end_s": 0.0},
             {"phase": "detumble + identify", "start_s": 0.0, "end_s": t_c},
             {"phase": "berth", "start_s": t_c, "end_s": t_c + float(berth["duration"])},
@@ -216,6 +226,13 @@ def series(res: dict, step_s: float = 0.5) -> dict:
 def table(res: dict) -> str:
     """The comparison on the true plant, one row per model."""
     lines = [f"mission {res['mission']}"]
+    if "approach" in res:
+        a = res["approach"]
+        lines.append(
+            f"approach: {a['duration_s']:g} s, the target from {a['gap_at_start_m']:.3f} m to "
+            f"{a['gap_at_contact_m']:.1e} m of the gripper; "
+            f"momentum of the two kept to {a['momentum_drift_relative']:.1e}"
+        )
     if "capture" in res:
         c = res["capture"]
         lines.append(

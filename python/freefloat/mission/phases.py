@@ -72,6 +72,48 @@ def capture(mission: Mission, truth) -> dict:
     return r
 
 
+def free_target_model(b: Body):
+    """The target before the grasp: a free rigid body of its own (one-body model, its frame at the grasp point)."""
+    from ..model import Model
+
+    I, c = np.asarray(b.inertia, float).tolist(), np.asarray(b.com, float).tolist()
+    text = (
+        "name: free_target\nbase: free\ngravity: [0, 0, 0]\nbodies:\n  - name: target\n    inertial: "
+        f"{{mass: {float(b.mass)!r}, com: {c!r}, inertia: {{xx: {I[0][0]!r}, yy: {I[1][1]!r}, zz: {I[2][2]!r}, "
+        f"xy: {I[0][1]!r}, xz: {I[0][2]!r}, yz: {I[1][2]!r}}}}}\n"
+    )
+    return Model.from_yaml_string(text)
+
+
+def approach(mission: Mission, truth, cap: dict, duration: float, dt: float = 0.01) -> dict:
+    """The last `duration` seconds before the grasp: the servicer (without the target) and the free target drift,
+    each on its own, until the target's grasp frame meets the gripper. Both are torque-free and conservative, so
+    their motion before the contact is their motion after it with the velocities reversed (time reversal of
+    Lagrangian mechanics): each is simulated from the contact with negated velocities and read backwards. Returns
+    the times (-duration .. 0), the distance from the gripper to the target's grasp point, and the total momentum
+    of the two bodies along the way (a conservation check across the change of topology)."""
+    from .. import algorithms as alg
+    from ..simulation import simulate as sim_free
+
+    target = target_index(truth)
+    P = np.array(truth.parameters(), float)
+    P[target] = 0.0
+    servicer = truth.with_parameters(P)
+    free = free_target_model(mission.target)
+    ts = sim_free(servicer, cap["q"], -np.asarray(cap["v_pre"], float), duration, dt)
+    qt0 = np.asarray(cap["grasp_pose"], float)
+    tt = sim_free(free, qt0, -np.asarray(cap["target_twist_local"], float), duration, dt)
+    qs, vs = np.asarray(ts.q)[::-1], -np.asarray(ts.v)[::-1]
+    qt, vt = np.asarray(tt.q)[::-1], -np.asarray(tt.v)[::-1]
+    t = -np.asarray(ts.t)[::-1]
+    grip = np.asarray(alg.forward_kinematics(servicer, qs))[:, target, :3]
+    gap = np.linalg.norm(grip - qt[:, :3], axis=1)
+    h = np.asarray(alg.momentum(servicer, qs, vs)) + np.asarray(alg.momentum(free, qt, vt))
+    ref = np.asarray(cap["momentum_before"], float)
+    drift = float(np.abs(h - ref).max() / max(np.abs(ref).max(), 1e-300))
+    return {"t": t, "gap": gap, "momentum_drift_relative": drift}
+
+
 # -- phase 2: detumble and identify ---------------------------------------------------------------------------
 def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
     """The detumble scenario from the post-impact state, with the mission's guess of the target and, when the

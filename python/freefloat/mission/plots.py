@@ -32,10 +32,14 @@ def timeline(res: dict, path):
     ax[1].set_ylim(0.5, 1.5)
     ax[1].set_ylabel("target estimate / truth")
     ax[1].legend(fontsize=8, ncol=4)
+    ap = res["traces"].get("approach")
+    if ap is not None:
+        ax[2].semilogy(ap["t"], np.maximum(ap["gap"], 1e-6), color="k", label="approach: target to gripper")
+        ax[0].plot(ap["t"], np.zeros_like(ap["t"]), color="k", lw=0.8)
     for name, tr in res["traces"]["berth"].items():
-        ax[2].semilogy(t_c + tr["t"], np.maximum(tr["position_error"], 1e-6), label=f"{name} model")
-    ax[2].set_ylabel("target position error (m)")
-    ax[2].set_xlabel("mission time since the grasp (s)")
+        ax[2].semilogy(t_c + tr["t"], np.maximum(tr["position_error"], 1e-6), label=f"berth, {name} model")
+    ax[2].set_ylabel("distance (m)")
+    ax[2].set_xlabel("mission time (s; the grasp at 0)")
     ax[2].legend(fontsize=8)
     for a in ax:
         a.axvspan(0, t_c, color="0.92", zorder=0)

@@ -35,6 +35,7 @@ class Mission:
     joints: np.ndarray  # servicer joint angles at contact (rad)
     base_velocity: np.ndarray
     base_rate: np.ndarray
+    approach_s: float
     method: str
     max_duration: float
     min_duration: float
@@ -92,6 +93,7 @@ def load_mission(spec: str | Path) -> Mission:
         joints=np.asarray(cap["joints_deg"], float) * deg,
         base_velocity=np.asarray(cap.get("base_velocity", [0, 0, 0]), float),
         base_rate=np.asarray(cap.get("base_rate", [0, 0, 0]), float),
+        approach_s=float(cap.get("approach_s", 10.0)),
         method=ident.get("method", "momentum"),
         max_duration=float(ident.get("max_duration", 60.0)),
         min_duration=float(ident.get("min_duration", 2.0)),

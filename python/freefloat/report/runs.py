@@ -258,6 +258,17 @@ def mission(page: Page, out: Path, res: dict) -> None:
     if tl:
         page.section("Phase timeline (mission time since the grasp)")
         page.table(["phase", "start [s]", "end [s]"], [[p["phase"], p["start_s"], p["end_s"]] for p in tl])
+    a = res.get("approach")
+    if a:
+        page.section("Approach: the servicer and the free target before the grasp")
+        page.table(
+            ["quantity", "value"],
+            [
+                ["duration [s]", a["duration_s"]],
+                ["target to gripper at the start [m]", a["gap_at_start_m"]],
+                ["momentum of the two kept to (relative)", a["momentum_drift_relative"]],
+            ],
+        )
     c = res.get("capture")
     if c:
         page.section("Capture: the grasp impact")
