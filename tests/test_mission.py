@@ -210,3 +210,28 @@ def test_a_target_too_heavy_for_the_arm_is_run_and_reported(tmp_path):
         # clipped at 50 N m the stack is not held: the run is reported as failed, or it ran and says by how much
         assert "failed" in s or s["joint_torque_over_limit"], (name, s)
     assert "berth" in fm.table(res)
+
+
+def test_grasp_on_a_servicer_without_a_target():
+    """Naveen's dual-arm robot carries no target: the mission welds one at arm A's end effector (`grasp:`) and runs
+    the post-capture laws from its inline `detumble:` blocks."""
+    res = fm.run("naveen_dual_arm_capture")
+    assert res["capture"]["momentum_error_relative"] < 1e-12
+    assert res["approach"]["momentum_drift_relative"] < 1e-12
+    i = res["identify"]
+    assert i["converged"] and i["target_mass_error_relative"] < 0.01 and i["target_inertia_error_relative"] < 0.02
+    b = res["berth"]
+    assert b["identified"]["position_error_final_m"] < 0.1 * b["nominal"]["position_error_final_m"]
+
+
+def test_grasp_errors_name_the_key(tmp_path):
+    text = ff.io.data.read_text("scenarios", "naveen_dual_arm_capture").replace("body: L3", "body: L9")
+    (tmp_path / "a.yaml").write_text(text)
+    with pytest.raises(ff.InputError, match=r"grasp'\.body.*no body 'L9'"):
+        fm.run(str(tmp_path / "a.yaml"))
+    text = ff.io.data.read_text("scenarios", "zhang2020_3d_capture").replace(
+        "detumble: zhang2020_3d ", "grasp: {body: link6}\ndetumble: zhang2020_3d "
+    )
+    (tmp_path / "b.yaml").write_text(text)
+    with pytest.raises(ff.InputError, match=r"already carries a target"):
+        fm.run(str(tmp_path / "b.yaml"))

@@ -428,10 +428,26 @@ class MissionBerth(Block):
     isp: Positive = 220.0
 
 
+class MissionGrasp(Block):
+    body: Text
+    xyz: numbers(3) = None
+    rpy_deg: numbers(3) = None
+
+
+class MissionDetumble(Block):
+    # the post-capture blocks of a scenario, for a servicer that has no post-capture scenario of its own
+    dt: Positive = 1e-3
+    sample_period: Positive = 0.1
+    control: PcControl
+    excitation: PcExcitation
+    identification: PcIdentification
+
+
 class Mission(_Scenario):
     kind: literal("mission")
     servicer: Text
-    detumble: Text
+    grasp: MissionGrasp | None = None
+    detumble: Text | MissionDetumble
     target: MissionTarget
     capture: MissionCapture
     identify: MissionIdentify | None = None

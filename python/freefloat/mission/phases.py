@@ -120,7 +120,28 @@ def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
     mission has its own `sensors:` block, those sensors (checked against the robot like a scenario's)."""
     from ..postcapture.scenario import scenario_blocks
 
-    sc = load_scenario(mission.detumble)
+    if isinstance(mission.detumble, dict):  # the post-capture blocks given inline, for this servicer
+        from ..postcapture.scenario import _parse
+
+        b = mission.detumble
+        nj = len(mission.joints)
+        d = {
+            "name": f"{mission.name} detumble",
+            "model": mission.servicer,
+            "duration": mission.max_duration,
+            "dt": b.get("dt", 1e-3),
+            "sample_period": b.get("sample_period", 0.1),
+            "initial": {"joints_deg": [0.0] * nj, "base_velocity": [0.0] * 3, "base_rate": [0.0] * 3},
+            "control": b["control"],
+            "excitation": b["excitation"],
+            "identification": b["identification"],
+        }
+        try:
+            sc = _parse(d, f"{mission.source}: key 'detumble'", model=truth)
+        except KeyError as e:
+            raise InputError(f"{mission.source}: key 'detumble': missing key {e}") from None
+    else:
+        sc = load_scenario(mission.detumble)
     g = mission.guess
     guess = dict(sc.guess)
     guess["target"] = {"mass": g.mass, "com": list(g.com), "inertia": g.inertia.tolist()}
@@ -451,7 +472,41 @@ def load_truth(mission: Mission):
         path = Path(spec)
         if not path.is_absolute() and mission.source and Path(mission.source).is_file():
             path = Path(mission.source).parent / path  # relative to the mission file, as model files elsewhere
-        servicer = Model.from_yaml(path)
+        text = path.read_text(encoding="utf-8")
     else:
-        servicer = models.load(spec)
+        text = models.source(spec)
+    if mission.grasp is not None:
+        text = _with_grasped_body(text, mission)
+    servicer = Model.from_yaml_string(text)
     return model_with_target(servicer, target_index(servicer), mission.target)
+
+
+def _with_grasped_body(text: str, mission: Mission) -> str:
+    """The servicer's model file with a body `target` welded at `grasp` (its inertia is set from the mission
+    afterwards): how a servicer that carries no target becomes the post-capture stack."""
+    import yaml
+
+    d = yaml.safe_load(text)
+    where = f"{mission.source}: key 'grasp'"
+    bodies = d.get("bodies") or []
+    names = [b.get("name") for b in bodies]
+    if any("target" in (b.get("tags") or []) for b in bodies):
+        raise InputError(f"{where}: the servicer '{mission.servicer}' already carries a target; remove 'grasp'")
+    g = mission.grasp
+    if g["body"] not in names:
+        raise InputError(f"{where}.body: the servicer has no body '{g['body']}' (bodies: {', '.join(map(str, names))})")
+    rpy = np.asarray(g.get("rpy_deg") or [0, 0, 0], float)
+    if d.get("angles", "rad") != "deg":
+        rpy = np.radians(rpy)
+    bodies.append(
+        {
+            "name": "target",
+            "parent": g["body"],
+            "joint": {"name": "grasp", "type": "fixed"},
+            "origin": {"xyz": [float(x) for x in (g.get("xyz") or [0, 0, 0])], "rpy": rpy.tolist()},
+            "inertial": {"mass": 1.0, "com": [0.0, 0.0, 0.0], "inertia": [1.0, 1.0, 1.0]},
+            "tags": ["target"],
+        }
+    )
+    d["bodies"] = bodies
+    return yaml.safe_dump(d, sort_keys=False)

@@ -27,7 +27,8 @@ class Mission:
     name: str
     description: str
     servicer: str
-    detumble: str
+    detumble: str | dict  # a post-capture scenario (name or file), or its blocks inline
+    grasp: dict | None  # where to weld the target on a servicer that has none: {body, xyz, rpy_deg}
     target: Body
     guess: Body
     target_velocity: np.ndarray  # of the grasp point before the grasp, inertial (m/s)
@@ -86,6 +87,7 @@ def load_mission(spec: str | Path) -> Mission:
         description=str(d.get("description", "")).strip(),
         servicer=d["servicer"],
         detumble=d["detumble"],
+        grasp=d.get("grasp"),
         target=_body(t, source, "target"),
         guess=_body(t["guess"], source, "target.guess"),
         target_velocity=np.asarray(t.get("velocity", [0, 0, 0]), float),

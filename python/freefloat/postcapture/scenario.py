@@ -77,8 +77,10 @@ def load_scenario(spec: str | Path) -> Scenario:
         raise InputError(f"{source}: missing key {e}") from None
 
 
-def _parse(d: dict, source: str) -> Scenario:
-    m = models.load(d["model"])
+def _parse(d: dict, source: str, model=None) -> Scenario:
+    """A checked scenario mapping as a Scenario; `model` (a freefloat.Model) instead of the built-in robot that
+    `d["model"]` names (a mission's servicer with its target attached)."""
+    m = model if model is not None else models.load(d["model"])
     planar = m.joint_types[0] == "planar"
     ini = d["initial"]
     deg = np.pi / 180
