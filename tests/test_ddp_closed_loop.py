@@ -94,6 +94,59 @@ def test_mpc_cold_start_converges_too(solved):
     assert s["ee_position_error_final_hold_max_m"] < 0.02, s
 
 
+def test_mpc_set_parameters_plans_on_the_new_model(solved):
+    """A controller built on the wrong mass and given the plant's parameters plans what a controller built on the
+    plant plans (same first window, same control), and no longer what it planned before."""
+    prob, _ = solved
+    plant = cl.perturbed_model(prob.model, 0.5, "link3")
+    x0 = np.asarray(prob.x0, float)
+
+    def mpc(model):
+        return _core.DdpMpc(
+            model._core, prob.dt, prob.horizon, prob.running, prob.terminal, 40, 5, options={"max_iter": 3}
+        )
+
+    wrong, right, updated = mpc(prob.model), mpc(plant), mpc(prob.model)
+    updated.set_parameters(np.asarray(plant.parameters(), float))
+    u_right, u_upd, u_wrong = right.control(0, x0), updated.control(0, x0), wrong.control(0, x0)
+    np.testing.assert_allclose(u_upd, u_right, rtol=1e-12, atol=1e-12)
+    assert np.abs(u_wrong - u_right).max() > 1e-3 * np.abs(u_right).max()
+    assert updated.stats()["model_updates"] == 1 and wrong.stats()["model_updates"] == 0
+    with pytest.raises(InputError, match=r"expected shape \(\d+, 10\)"):
+        updated.set_parameters(np.zeros((2, 10)))
+    bad = np.asarray(plant.parameters(), float)
+    bad[1, 0] = np.nan
+    with pytest.raises(InputError, match="not finite"):
+        updated.set_parameters(bad)
+
+
+def test_observed_mpc_is_the_same_run_in_segments(solved):
+    """The observer's segments are the same RK4 steps under the same held controls: an observer that keeps the
+    model gives the run of one piece (to round-off), and sees every step of it exactly once."""
+    prob, sol = solved
+    plant = cl.perturbed_model(prob.model, 0.1, "link3")
+    kw = {"solution": sol, "mpc_horizon": 40, "replan": 5, "mpc_options": {"max_iter": 3}}
+    one = cl.run(prob, "mpc", plant, **kw)
+    seen = []
+
+    def observer(k, seg):
+        seen.append((k, seg["t"][0], seg["t"][-1], len(seg["u"]), len(seg["t"])))
+        # the held control at each step is what the controller applied at that step's node (the one-piece run's,
+        # to round-off: the segments restart from the recorded state)
+        kk = np.floor(seg["t"][:-1] / prob.dt + 1e-9).astype(int)
+        np.testing.assert_allclose(seg["u"], one["us"][kk], rtol=0, atol=1e-9)
+        return None
+
+    seg = cl.run(prob, "mpc", plant, observer=observer, observe_every=20, **kw)
+    np.testing.assert_allclose(seg["xs"], one["xs"], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(seg["t"], one["t"], rtol=0, atol=1e-12)
+    assert [s[0] for s in seen] == list(range(20, prob.horizon + 1, 20))
+    assert all(s[3] == 20 * 5 and s[4] == 20 * 5 + 1 for s in seen)
+    assert abs(seen[-1][2] - prob.horizon * prob.dt) < 1e-9
+    with pytest.raises(InputError, match="observer"):
+        cl.run(prob, "policy", plant, solution=sol, observer=observer, observe_every=20)
+
+
 def test_closed_loop_bad_input(solved):
     prob, sol = solved
     with pytest.raises(InputError, match="mode"):

@@ -102,6 +102,60 @@ def test_mission_phases_and_comparison(mission_run):
     assert b["identified"]["position_error_final_m"] < 1e-3
     assert abs(b["identified"]["propellant_kg"] - b["truth"]["propellant_kg"]) < 0.01 * b["truth"]["propellant_kg"]
     assert b["identified"]["settling_time_s"] is not None
+    # the adaptive berth (MPC re-planning on the estimate its own telemetry refines): the controller took new
+    # estimates, and the berth's motion made the target's inertia better than at the handover
+    ad = b["adaptive"]
+    on = ad["online"]
+    assert on["model_updates"] >= 1 and ad["mpc"]["model_updates"] == on["model_updates"]
+    assert on["rows"] > 0 and on["segments"] == round(20.0 / on["update_every_s"])
+    assert on["target_error_at_handover"]["inertia_relative"] == pytest.approx(i["target_inertia_error_relative"])
+    assert on["target_error_at_end"]["inertia_relative"] < 0.5 * on["target_error_at_handover"]["inertia_relative"]
+    assert ad["settling_time_s"] is not None and ad["position_error_final_m"] < 5e-3
+
+
+def test_adaptive_berth_rows_hold_at_the_true_parameters():
+    """The berth's momentum rows from true states: the true standard parameters of base and target satisfy them to
+    the trapezoid's error (the base wrench held over each step, the attitude moving under it), and a 1 % heavier
+    target does not."""
+    import dataclasses
+
+    from freefloat.identification import online
+    from freefloat.mission import adaptive_berth
+    from freefloat.postcapture import equations as eq
+
+    mission = fm.load_mission("zhang2020_3d_capture")
+    truth = phases.load_truth(mission)
+    q, v = _state(truth)
+    sc = dataclasses.replace(phases.detumble_scenario(mission, q, v, truth), sensors=None)
+    L = eq.Layout(False)
+    target = phases.target_index(truth)
+    theta = np.concatenate([eq.standard_vector(*eq.body_truth(truth, b))[L.std_cols] for b in (0, target)])
+    ident = {
+        "scenario": sc,
+        "rls": online.RecursiveLS(theta, np.full(len(theta), 1.0)),
+        "std_cols": L.std_cols,
+        "truth_physical": adaptive_berth.physical(theta, L.std_cols),
+        "handover_time": 0.0,
+    }
+    est = adaptive_berth.BerthEstimator(truth, ident, {})
+    rng = np.random.default_rng(3)
+    held = rng.normal(0.0, [20, 20, 20, 5, 5, 5] + [10] * 6, (20, truth.nv))  # 20 control steps of 0.05 s
+    us = []
+
+    def law(t, q_, v_):
+        return held[min(int(round(t / 0.05)), 19)]
+
+    tr = ff.simulate(truth, q, v, 1.0, 0.01, method="rk4", record_every=1, controller=law, controller_period=0.05)
+    t = np.asarray(tr.t)
+    us = held[np.minimum(np.floor(t[:-1] / 0.05 + 1e-9).astype(int), 19)]
+    rows = est.segment_rows({"t": t, "q": np.asarray(tr.q), "v": np.asarray(tr.v), "u": us})
+    phi, y = np.asarray(rows.Phi), np.asarray(rows.y)
+    assert len(rows.t) == 10 and np.abs(y).max() > 1.0  # the wrench moved the stack
+    res = np.einsum("kri,i->kr", phi, theta) - y
+    assert np.abs(res).max() < 1e-5 * np.abs(y).max(), np.abs(res).max()
+    wrong = theta.copy()
+    wrong[len(L.std_cols) :] *= 1.01
+    assert np.abs(np.einsum("kri,i->kr", phi, wrong) - y).max() > 1e-3 * np.abs(y).max()
 
 
 def test_mission_cli_writes_results(tmp_path):

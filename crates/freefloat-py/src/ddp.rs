@@ -571,6 +571,19 @@ impl PyDdpMpc {
         Ok(PyArray1::from_slice(py, out))
     }
 
+    /// Replace the model's inertial parameters P (nbodies, 10), as `Model.parameters()` of the model the
+    /// controller was built on: the next re-plan optimises on them (until then the current window's policy
+    /// runs). For a controller that follows an online estimate of the plant.
+    fn set_parameters(&mut self, params: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+        let nb = self.mpc.model().nbodies();
+        if params.shape() != [nb, 10] {
+            return Err(input_err(format!("argument `P`: expected shape ({nb}, 10), got {:?}", params.shape())));
+        }
+        let flat: Vec<f64> = params.as_array().iter().copied().collect();
+        let mpc = &mut self.mpc;
+        guard(|| mpc.set_parameters(&flat))
+    }
+
     /// What the controller did so far (dict).
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = &self.mpc.stats;
@@ -582,6 +595,7 @@ impl PyDdpMpc {
         d.set_item("troubled_replans", s.troubled)?;
         d.set_item("last_stop", s.last_stop.clone())?;
         d.set_item("replan_costs", s.costs.clone())?;
+        d.set_item("model_updates", s.model_updates)?;
         d.set_item("horizon", self.mpc.options().horizon)?;
         d.set_item("replan", self.mpc.options().replan)?;
         Ok(d)

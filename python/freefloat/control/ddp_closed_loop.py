@@ -50,6 +50,8 @@ def run(
     mpc_options: dict | None = None,
     first_max_iter: int = 50,
     progress=None,
+    observer=None,
+    observe_every: int | None = None,
 ) -> dict:
     """Simulate `plant` (default: the problem's own model) for the problem's N·dt seconds from its x0 under a
     controller sampled every dt (zero-order hold), RK4 at dt/substeps:
@@ -62,14 +64,24 @@ def run(
       (default: feasibility-driven, backtracking line search, 5 iterations), `first_max_iter` for the first.
 
     `progress(k, n)` is called at each control sample and may return False to stop (Ctrl-C stops too); a stopped
-    run returns the samples so far with `stopped=True`. Returns a dict: mode, t (T,), xs (T, nx), us (T-1, nu),
-    the end-effector pose errors and their summary, and for MPC the controller's statistics."""
+    run returns the samples so far with `stopped=True`.
+
+    `observer` (MPC only) follows the plant as an estimator does: the run is simulated in segments of
+    `observe_every` nodes (the same RK4 steps and zero-order hold as in one piece), and after each one
+    `observer(k, seg)` gets the node reached and the segment's record at every RK4 step (`t`, `q`, `v`, and `u`,
+    the control held over each step). If it returns parameters P (nbodies, 10) of the problem's model, the
+    controller re-plans on them from its next re-plan on (`DdpMpc.set_parameters`); None keeps the model.
+
+    Returns a dict: mode, t (T,), xs (T, nx), us (T-1, nu), the end-effector pose errors and their summary, and
+    for MPC the controller's statistics."""
     if mode not in MODES:
         raise InputError(f"argument `mode`: expected one of {', '.join(MODES)}, got {mode!r}")
     if mode in ("open_loop", "policy") and solution is None:
         raise InputError(f"argument `solution`: mode {mode!r} needs a DDP solution (from `ddp.solve`)")
     if not isinstance(substeps, int) or substeps < 1:
         raise InputError(f"argument `substeps`: must be an integer >= 1, got {substeps!r}")
+    if observer is not None and (mode != "mpc" or not isinstance(observe_every, int) or observe_every < 1):
+        raise InputError("argument `observer`: needs mode 'mpc' and `observe_every` an integer >= 1 (nodes)")
     from ..simulation import simulate
 
     m = problem.model
@@ -127,21 +139,24 @@ def run(
 
     x0 = np.asarray(problem.x0, float)
     t0 = time.perf_counter()
-    tr = simulate(
-        plant,
-        x0[:nq],
-        x0[nq:],
-        n * dt,
-        dt / substeps,
-        method="rk4",
-        record_every=substeps,
-        controller=controller,
-        controller_period=dt,
-    )
+    if observer is None:
+        tr = simulate(
+            plant,
+            x0[:nq],
+            x0[nq:],
+            n * dt,
+            dt / substeps,
+            method="rk4",
+            record_every=substeps,
+            controller=controller,
+            controller_period=dt,
+        )
+        tq, tv, t = np.asarray(tr.q), np.asarray(tr.v), np.asarray(tr.t)
+    else:
+        tq, tv, t = _observed(plant, x0, n, dt, substeps, controller, applied, stopped, observer, observe_every, ctrl)
     wall = time.perf_counter() - t0
-    xs = np.c_[tr.q, tr.v]
-    t = np.asarray(tr.t)
-    g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(tr.q), problem.frame)
+    xs = np.c_[tq, tv]
+    g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(tq), problem.frame)
     kk = np.clip(np.rint(t / dt).astype(int), 0, n)
     err = pose_errors(g, problem.reference_dq[kk])
     out = {
@@ -158,6 +173,48 @@ def run(
     if mode == "mpc":
         out["mpc"] = dict(ctrl.stats())
     return out
+
+
+def _observed(plant, x0, n, dt, substeps, controller, applied, stopped, observer, every, ctrl):
+    """The closed loop in segments of `every` nodes, each recorded at every RK4 step and shown to `observer`
+    (see `run`); returns the records at the control samples (t, q, v), as one simulation would."""
+    from ..simulation import simulate
+
+    nq = plant.nq
+    q, v = x0[:nq].copy(), x0[nq:].copy()
+    ts, qs, vs = [np.zeros(1)], [q[None]], [v[None]]
+    k0 = 0
+    while k0 < n and not stopped[0]:
+        k1 = min(k0 + every, n)
+        t_start = k0 * dt
+
+        def seg_law(t, q_, v_, _t0=t_start):
+            return controller(t + _t0, q_, v_)
+
+        tr = simulate(
+            plant,
+            q,
+            v,
+            (k1 - k0) * dt,
+            dt / substeps,
+            method="rk4",
+            record_every=1,
+            controller=seg_law,
+            controller_period=dt,
+        )
+        sq, sv, st = np.asarray(tr.q), np.asarray(tr.v), np.asarray(tr.t) + t_start
+        # the control held over each RK4 step (the last record ends the segment)
+        step_node = np.minimum(np.floor((st[:-1] - t_start) / dt + 1e-9).astype(int) + k0, n - 1)
+        seg = {"t": st, "q": sq, "v": sv, "u": applied[step_node]}
+        ts.append(st[substeps::substeps])
+        qs.append(sq[substeps::substeps])
+        vs.append(sv[substeps::substeps])
+        q, v = sq[-1].copy(), sv[-1].copy()
+        k0 = k1
+        P = observer(k1, seg)
+        if P is not None:
+            ctrl.set_parameters(np.asarray(P, float))
+    return np.vstack(qs), np.vstack(vs), np.concatenate(ts)
 
 
 def summary(run_out: dict, final_hold_s: float = 5.0) -> dict:

@@ -426,6 +426,10 @@ class MissionBerth(Block):
     max_iter: integer(lo=1) = 100
     controller: literal("policy", "mpc") = "policy"
     isp: Positive = 220.0
+    # the adaptive berth: MPC re-planning on the estimate the berth's own telemetry keeps refining
+    adaptive: Bool = True
+    update_every_s: Positive = 1.0
+    update_tolerance: Positive = 1e-3
 
 
 class MissionGrasp(Block):

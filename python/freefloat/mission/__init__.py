@@ -17,7 +17,7 @@ import time
 import numpy as np
 
 from .._core import Interrupted
-from . import phases
+from . import adaptive_berth, phases
 from .spec import Mission, list_missions, load_mission
 
 __all__ = ["Mission", "list_missions", "load_mission", "run", "write"]
@@ -72,14 +72,7 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         tgt = slice(len(ident["names"]) // 2, len(ident["names"]))
         est = ident["estimates"][ident["handover_index"]]
         tru = ident["truth_physical"]
-        # relative errors; a product of inertia (true value often zero) relative to its body's largest moment, a
-        # CoM coordinate relative to at least 1 mm
-        h = len(ident["names"]) // 2
-        scale = np.abs(tru).copy()
-        for b0 in (0, h):
-            scale[[b0 + 5, b0 + 6, b0 + 8]] = np.abs(tru[[b0 + 4, b0 + 7, b0 + 9]]).max()
-            scale[b0 + 1 : b0 + 4] = np.maximum(scale[b0 + 1 : b0 + 4], 1e-3)
-        rel = np.abs(est - tru) / np.maximum(scale, 1e-300)
+        rel = np.abs(est - tru) / phases.relative_scale(tru)
         names = ident["names"]
         sim = ident["sim"]
         ts = np.asarray(sim["t"])
@@ -137,8 +130,21 @@ def run(mission: Mission | str, seed: int = 0, controller: str | None = None, pr
         }
         out["berth"] = {"controller": berth["controller"], "reference": ref7.tolist()}
         traces["berth"] = {}
-        for name, model in models.items():
-            r = phases.berth_run(model, truth, x0, ref7, berth, name)
+        runs = [(name, model, berth, None) for name, model in models.items()]
+        if berth.get("adaptive", True):
+            # the adaptive row: MPC from the identified model, re-planning on the estimate the berth refines
+            ab = {**adaptive_berth.DEFAULTS, **berth, "controller": "mpc"}
+            observer = adaptive_berth.BerthEstimator(truth, ident, ab, seed=seed)
+            observer.check_sensors(float(ab["dt"]) / phases.BERTH_SUBSTEPS)
+            runs.append(("adaptive", models["identified"], ab, observer))
+        for name, model, b, observer in runs:
+            r = phases.berth_run(model, truth, x0, ref7, b, name, observer=observer)
+            if observer is not None:
+                r["summary"]["online"] = adaptive_berth.summary(observer, ident)
+                traces["adaptive_estimate"] = {
+                    "t": np.array([ident["handover_time"] + t for t, _ in observer.history]),
+                    "estimates": np.array([e for _, e in observer.history]),
+                }
             out["berth"][name] = r["summary"]
             s = r["summary"]
             for joint, ratio in s["planned_torque_over_limit"].items():
@@ -256,10 +262,20 @@ def table(res: dict) -> str:
         cols += [("prop kg", 9), ("max rate", 10), ("wheel Nms", 10)]
         hdr = "".join(f"{c:<{w}}" if k == 0 else f"{c:>{w}}" for k, (c, w) in enumerate(cols))
         lines.append(hdr)
-        for name in ("nominal", "identified", "truth"):
+        for name in ("nominal", "identified", "truth", "adaptive"):
             s = res["berth"].get(name)
             if s is None:
                 continue
+            if name == "adaptive":
+                on = s.get("online") or {}
+                lines.append(
+                    "adaptive: MPC from the identified model, re-planning on the estimate the berth's telemetry "
+                    f"refines ({on.get('model_updates', 0)} model updates; target inertia error "
+                    f"{100 * on['target_error_at_handover']['inertia_relative']:.2f} % -> "
+                    f"{100 * on['target_error_at_end']['inertia_relative']:.2f} %)"
+                    if on
+                    else "adaptive: MPC re-planning on the online estimate"
+                )
             if "failed" in s:
                 lines.append(f"{name:<11}failed: {s['failed']}")
                 continue

@@ -200,8 +200,7 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
     )
     L = eq.Layout(planar)
     x0 = np.concatenate([eq.standard_vector(*g)[L.std_cols] for g in initial_guesses(sc, planar)])
-    est = online.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting)
-    x_hist = est.run(rows.t, rows.Phi, rows.y)
+    x_hist = _rls(x0, sc).run(rows.t, rows.Phi, rows.y)
     phys = identify_standard(truth, rows, sc, planar)
     k = len(L.std_cols)
     sig = covariance_history(rows, x_hist, sc.P0, slice(k, 2 * k))
@@ -245,9 +244,13 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
             for m, b, I in (eq.body_truth(truth, 0), eq.body_truth(truth, target))
         ]
     )
+    # the estimator as it stands at the handover, for the berth to go on with (the adaptive berth)
+    rls = _rls(x0, sc)
+    rls.run(rows.t[: kc + 1], rows.Phi[: kc + 1], rows.y[: kc + 1])
     return {
         "scenario": sc,
         "sim": sim,
+        "rls": rls,
         "rows_t": np.asarray(rows.t, float),
         "estimates": phys,
         "names": names,
@@ -265,20 +268,44 @@ def identify_online(mission: Mission, truth, sc: Scenario, seed: int = 0, progre
     }
 
 
+def _rls(x0, sc: Scenario) -> online.RecursiveLS:
+    return online.RecursiveLS(x0, np.full(len(x0), sc.P0), sc.forgetting)
+
+
 def identified_model(truth, ident: dict):
     """The combined model with the base's and target's parameters as identified at the handover, projected onto
     physically consistent parameters (the nearest positive definite pseudo-inertia) so that DDP can run on it."""
+    return model_from_estimate(truth, ident["standard_estimate"], ident["std_cols"])
+
+
+def model_from_estimate(truth, x_std: np.ndarray, std_cols) -> object:
+    """`truth` with its base's and target's parameters from the standard-parameter estimate `x_std` (base block,
+    then target block), each projected onto the nearest physically consistent parameters."""
     target = target_index(truth)
-    k = len(ident["std_cols"])
+    k = len(std_cols)
     P = np.array(truth.parameters(), float)
     for body, sl in ((0, slice(0, k)), (target, slice(k, 2 * k))):
         full = np.zeros(10)
-        full[ident["std_cols"]] = ident["standard_estimate"][sl]
+        full[std_cols] = np.asarray(x_std, float)[sl]
         P[body] = eq.project_consistent(full[None])[0]
     return truth.with_parameters(P)
 
 
+def relative_scale(tru: np.ndarray) -> np.ndarray:
+    """What an error in each physical parameter [m, c (3), I (6: xx, xy, xz, yy, yz, zz)] of base and target is
+    relative to: its own size; a product of inertia (true value often zero) its body's largest moment; a CoM
+    coordinate at least 1 mm."""
+    h = len(tru) // 2
+    scale = np.abs(np.asarray(tru, float)).copy()
+    for b0 in (0, h):
+        scale[[b0 + 5, b0 + 6, b0 + 8]] = np.abs(scale[[b0 + 4, b0 + 7, b0 + 9]]).max()
+        scale[b0 + 1 : b0 + 4] = np.maximum(scale[b0 + 1 : b0 + 4], 1e-3)
+    return np.maximum(scale, 1e-300)
+
+
 # -- phase 3: berth -------------------------------------------------------------------------------------------
+#: RK4 steps of the true plant per control step in the berth
+BERTH_SUBSTEPS = 5
 DEFAULT_BERTH = {
     "duration": 20.0,
     "dt": 0.05,
@@ -373,8 +400,10 @@ def berth_problem(model, x0, ref7, berth: dict, name: str) -> ddp.Problem:
     )
 
 
-def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None) -> dict:
-    """Optimise the berth on `model`, then drive the true plant with the policy (or MPC) from the same state."""
+def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None, observer=None) -> dict:
+    """Optimise the berth on `model`, then drive the true plant with the policy (or MPC) from the same state.
+    `observer` (MPC only; see `adaptive_berth.BerthEstimator`) follows the plant every `update_every_s` and may
+    hand the controller new parameters."""
     # DDP's robot model takes moving joints only: the welded target is merged into the end effector (same dynamics)
     prob = berth_problem(model.with_fixed_leaves_merged(), x0, ref7, berth, name)
     mode = berth.get("controller", "policy")
@@ -388,7 +417,10 @@ def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None) -> 
     planned_over = {} if sol is None else _over_limit(truth, np.asarray(sol["us"], float))
     t0 = time.perf_counter()
     try:
-        out = closed.run(prob, mode, plant=truth, solution=sol)
+        kw = {}
+        if observer is not None:
+            kw = {"observer": observer, "observe_every": max(1, int(round(berth["update_every_s"] / berth["dt"])))}
+        out = closed.run(prob, mode, plant=truth, solution=sol, substeps=BERTH_SUBSTEPS, **kw)
     except NumericalError as e:
         # the plant left the solver's reach (e.g. torques clipped at the joints' effort limits and the stack no
         # longer held): a result of the mission, reported, not a crash of it

@@ -315,7 +315,7 @@ def mission(page: Page, out: Path, res: dict) -> None:
             ("peak wheel momentum [N m s]", "wheel_momentum_peak_Nms"),
             ("peak joint torque [N m]", "joint_torque_peak_Nm"),
         ]
-        models = [m for m in ("nominal", "identified", "truth") if m in b]
+        models = [m for m in ("nominal", "identified", "truth", "adaptive") if m in b]
         page.table(["quantity"] + models, [[label] + [b[m].get(k) for m in models] for label, k in keys])
         if "berth" in se:
             fig = make_subplots(rows=2, cols=1, shared_xaxes=True)

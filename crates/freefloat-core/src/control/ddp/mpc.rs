@@ -172,6 +172,8 @@ pub struct MpcStats {
     pub last_stop: String,
     /// Cost of each re-plan's solution.
     pub costs: Vec<f64>,
+    /// Times the model's inertial parameters were replaced (`Mpc::set_parameters`).
+    pub model_updates: usize,
 }
 
 /// A receding-horizon DDP controller over a task (a `FloatingRobot` problem of N nodes): at node k it solves
@@ -224,9 +226,24 @@ impl Mpc {
         })
     }
 
+    /// The model the windows are optimised on.
+    pub fn model(&self) -> &crate::model::Model {
+        self.window.model()
+    }
+
     /// The options.
     pub fn options(&self) -> &MpcOptions {
         &self.opts
+    }
+
+    /// Replace the model's inertial parameters (one row of 10 standard parameters per body of the window's
+    /// model): the next re-plan optimises on them; until then the current window's policy runs (its gains
+    /// belong to the parameters it was planned on). The warm start is kept: the previous plan is still the best
+    /// guess of the new optimum when the estimate moves a little.
+    pub fn set_parameters(&mut self, params: &[f64]) -> Result<()> {
+        self.window.set_parameters(params)?;
+        self.stats.model_updates += 1;
+        Ok(())
     }
 
     /// Control at task node `k` for the measured state `x` (re-planning first when K nodes have passed since

@@ -178,6 +178,14 @@ impl FloatingRobot {
         self.offset = offset;
     }
 
+    /// Replace the robot's inertial parameters (one row of 10 standard parameters per body, as
+    /// `Model::parameters`), keeping its layout, costs and scratch: how a controller takes an updated estimate
+    /// of the plant (e.g. an online identification) without being rebuilt.
+    pub fn set_parameters(&mut self, params: &[f64]) -> Result<()> {
+        self.model = self.model.with_parameters(params)?;
+        Ok(())
+    }
+
     /// The robot.
     pub fn model(&self) -> &Model {
         &self.model
