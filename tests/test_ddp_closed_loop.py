@@ -120,6 +120,24 @@ def test_mpc_set_parameters_plans_on_the_new_model(solved):
         updated.set_parameters(bad)
 
 
+def test_shrinking_horizon_keeps_the_task_end_a_deadline(solved):
+    """Windows that shrink at the task's end: the first window is the same (same control at node 0), both hold
+    the pose, and the last nodes' controls differ (fixed windows plan 40 nodes past the task's end). What the
+    deadline buys is measured on the mission (tests/test_mission.py, the dual-arm berth)."""
+    prob, sol = solved
+    plant = cl.perturbed_model(prob.model, 0.1, "link3")
+    kw = {"solution": sol, "mpc_horizon": 40, "replan": 5, "mpc_options": {"max_iter": 3}}
+    fixed = cl.run(prob, "mpc", plant, **kw)
+    shrunk = cl.run(prob, "mpc", plant, shrink=True, **kw)
+    np.testing.assert_allclose(shrunk["us"][0], fixed["us"][0], rtol=1e-12, atol=1e-12)
+    a, b = cl.summary(fixed, final_hold_s=1.0), cl.summary(shrunk, final_hold_s=1.0)
+    assert b["ee_position_error_final_hold_max_m"] < 0.02, b
+    assert shrunk["mpc"]["replans"] == fixed["mpc"]["replans"]
+    # past the end the fixed windows plan 40 nodes beyond the task: the controls of the last nodes differ
+    assert np.abs(shrunk["us"][-1] - fixed["us"][-1]).max() > 0
+    assert a["ee_position_error_final_hold_max_m"] < 0.02, a
+
+
 def test_observed_mpc_is_the_same_run_in_segments(solved):
     """The observer's segments are the same RK4 steps under the same held controls: an observer that keeps the
     model gives the run of one piece (to round-off), and sees every step of it exactly once."""

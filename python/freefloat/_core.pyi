@@ -94,13 +94,19 @@ class DdpMpc:
 every `replan` nodes (warm-started by the previous window shifted in time; the first window by
 `guess_xs`/`guess_us` over the whole task if given, else zero controls), and in between applies that
 window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
-`first_max_iter` bounds the first solve. `stats()`: re-plans, iterations, solve time, slowest re-plan,
+`first_max_iter` bounds the first solve. `shrink`: no window reaches past the task's last node (the
+terminal cost lands on the task's end, a deadline); off, every window has `mpc_horizon` nodes. `stats()`: re-plans, iterations, solve time, slowest re-plan,
 troubled re-plans, last stop reason, the cost of each re-plan.
     """
-    def __init__(self, model: Model, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, mpc_horizon: ArrayLike, replan: ArrayLike, keep_out: ArrayLike | None = None, options: ArrayLike | None = None, first_max_iter: ArrayLike = 50, guess_xs: ArrayLike | None = None, guess_us: ArrayLike | None = None) -> None: ...
+    def __init__(self, model: Model, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, mpc_horizon: ArrayLike, replan: ArrayLike, keep_out: ArrayLike | None = None, options: ArrayLike | None = None, first_max_iter: ArrayLike = 50, guess_xs: ArrayLike | None = None, guess_us: ArrayLike | None = None, shrink: ArrayLike = False) -> None: ...
     def control(self, k: ArrayLike, x: Any) -> Any:
         """Control (nv,) at task node k for the measured state x = [q; v] (re-plans when due; Ctrl-C is checked
 between re-plans by the caller's loop).
+        """
+    def set_parameters(self, params: ArrayLike) -> Any:
+        """Replace the model's inertial parameters P (nbodies, 10), as `Model.parameters()` of the model the
+controller was built on: the next re-plan optimises on them (until then the current window's policy
+runs). For a controller that follows an online estimate of the plant.
         """
     def stats(self) -> Any:
         """What the controller did so far (dict)."""

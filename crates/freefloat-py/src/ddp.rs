@@ -523,7 +523,8 @@ impl PyDdpPolicy {
 /// every `replan` nodes (warm-started by the previous window shifted in time; the first window by
 /// `guess_xs`/`guess_us` over the whole task if given, else zero controls), and in between applies that
 /// window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
-/// `first_max_iter` bounds the first solve. `stats()`: re-plans, iterations, solve time, slowest re-plan,
+/// `first_max_iter` bounds the first solve. `shrink`: no window reaches past the task's last node (the
+/// terminal cost lands on the task's end, a deadline); off, every window has `mpc_horizon` nodes. `stats()`: re-plans, iterations, solve time, slowest re-plan,
 /// troubled re-plans, last stop reason, the cost of each re-plan.
 #[pyclass(name = "DdpMpc", module = "freefloat._core")]
 pub struct PyDdpMpc {
@@ -534,7 +535,7 @@ pub struct PyDdpMpc {
 #[pymethods]
 impl PyDdpMpc {
     #[new]
-    #[pyo3(signature = (model, dt, horizon, running, terminal, mpc_horizon, replan, keep_out = None, options = None, first_max_iter = 50, guess_xs = None, guess_us = None))]
+    #[pyo3(signature = (model, dt, horizon, running, terminal, mpc_horizon, replan, keep_out = None, options = None, first_max_iter = 50, guess_xs = None, guess_us = None, shrink = false))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &Bound<'_, PyAny>,
@@ -549,6 +550,7 @@ impl PyDdpMpc {
         first_max_iter: usize,
         guess_xs: Option<PyReadonlyArray2<'_, f64>>,
         guess_us: Option<PyReadonlyArray2<'_, f64>>,
+        shrink: bool,
     ) -> PyResult<Self> {
         let robot = build_robot(model, dt, horizon, running, terminal, keep_out)?;
         let (nx, nu) = (robot.nx(), robot.nu());
@@ -558,7 +560,7 @@ impl PyDdpMpc {
             (None, None) => None,
             _ => return Err(input_err("give both `guess_xs` and `guess_us`, or neither")),
         };
-        let opts = MpcOptions { horizon: mpc_horizon, replan, solver, first_max_iter };
+        let opts = MpcOptions { horizon: mpc_horizon, replan, solver, first_max_iter, shrink };
         let mpc = guard(|| Mpc::new(&robot, opts, guess))?;
         Ok(PyDdpMpc { mpc, out: vec![0.0; nu] })
     }

@@ -49,6 +49,7 @@ def run(
     replan: int = 5,
     mpc_options: dict | None = None,
     first_max_iter: int = 50,
+    shrink: bool = False,
     progress=None,
     observer=None,
     observe_every: int | None = None,
@@ -61,7 +62,8 @@ def run(
       to the returned iterate);
     - `mpc`: `DdpMpc` re-solving a window of `mpc_horizon` nodes every `replan` nodes (warm start: the previous
       window shifted; the first window from `solution` if given, else zero controls), `mpc_options` per re-plan
-      (default: feasibility-driven, backtracking line search, 5 iterations), `first_max_iter` for the first.
+      (default: feasibility-driven, backtracking line search, 5 iterations), `first_max_iter` for the first;
+      `shrink`: no window reaches past the task's end (its terminal cost is the task's deadline).
 
     `progress(k, n)` is called at each control sample and may return False to stop (Ctrl-C stops too); a stopped
     run returns the samples so far with `stopped=True`.
@@ -106,6 +108,7 @@ def run(
             keep_out=problem.keep_out,
             options=opts,
             first_max_iter=int(first_max_iter),
+            shrink=bool(shrink),
             **guess,
         )
 

@@ -134,6 +134,10 @@ pub struct MpcOptions {
     pub solver: DdpOptions,
     /// Iterations of the first (cold, or guess-started) solve.
     pub first_max_iter: usize,
+    /// Shrinking horizon: a window never reaches past the task's last node (its terminal cost lands on the
+    /// task's end, a deadline, instead of H nodes ahead of every re-plan). Off: every window has H nodes, and
+    /// past the end the last reference holds (a tracking task that goes on).
+    pub shrink: bool,
 }
 
 impl MpcOptions {
@@ -182,6 +186,11 @@ pub struct MpcStats {
 pub struct Mpc {
     window: FloatingRobot,
     solver: Solver,
+    /// Nodes of the task (the deadline of a shrinking horizon).
+    task_n: usize,
+    /// The shorter window of a shrinking horizon near the task's end, and its solver (rebuilt when its
+    /// length changes).
+    tail: Option<(FloatingRobot, Solver)>,
     opts: MpcOptions,
     guess: Option<Guess>,
     plan: Option<(usize, Policy)>,
@@ -215,6 +224,8 @@ impl Mpc {
         let solver = Solver::new(&window, opts.solver.clone())?;
         let h = opts.horizon;
         Ok(Mpc {
+            task_n: task.horizon(),
+            tail: None,
             window,
             solver,
             guess,
@@ -242,6 +253,9 @@ impl Mpc {
     /// guess of the new optimum when the estimate moves a little.
     pub fn set_parameters(&mut self, params: &[f64]) -> Result<()> {
         self.window.set_parameters(params)?;
+        if let Some((w, _)) = &mut self.tail {
+            w.set_parameters(params)?;
+        }
         self.stats.model_updates += 1;
         Ok(())
     }
@@ -266,54 +280,70 @@ impl Mpc {
 
     /// Solve the window starting at task node `k` from state `x`.
     fn replan(&mut self, k: usize, x: &[f64]) -> Result<()> {
-        let (h, nx, nu) = (self.opts.horizon, self.window.nx(), self.window.nu());
+        let (nx, nu) = (self.window.nx(), self.window.nu());
+        let h = if self.opts.shrink {
+            self.opts.horizon.min(self.task_n.saturating_sub(k).max(1))
+        } else {
+            self.opts.horizon
+        };
         let first = self.plan.is_none();
+        let (warm_us, warm_xs) = (&mut self.warm_us[..h * nu], &mut self.warm_xs[..(h + 1) * nx]);
         match (&self.plan, &self.guess) {
             (Some((start, p)), _) if k >= *start => {
-                // Shift the previous window by the nodes elapsed; the last node repeats.
+                // Shift the previous window by the nodes elapsed; its last node repeats.
                 let d = k - start;
                 for i in 0..h {
-                    let j = (i + d).min(h - 1);
-                    self.warm_us[i * nu..(i + 1) * nu].copy_from_slice(&p.us[j]);
+                    let j = (i + d).min(p.us.len() - 1);
+                    warm_us[i * nu..(i + 1) * nu].copy_from_slice(&p.us[j]);
                 }
                 for i in 0..=h {
                     let j = (i + d).min(p.xs.len() - 1);
-                    self.warm_xs[i * nx..(i + 1) * nx].copy_from_slice(&p.xs[j]);
+                    warm_xs[i * nx..(i + 1) * nx].copy_from_slice(&p.xs[j]);
                 }
             }
             (_, Some((gx, gu))) => {
                 for i in 0..h {
                     let j = (k + i).min(gu.len() - 1);
-                    self.warm_us[i * nu..(i + 1) * nu].copy_from_slice(&gu[j]);
+                    warm_us[i * nu..(i + 1) * nu].copy_from_slice(&gu[j]);
                 }
                 for i in 0..=h {
                     let j = (k + i).min(gx.len() - 1);
-                    self.warm_xs[i * nx..(i + 1) * nx].copy_from_slice(&gx[j]);
+                    warm_xs[i * nx..(i + 1) * nx].copy_from_slice(&gx[j]);
                 }
             }
             _ => {
-                self.warm_us.fill(0.0);
+                warm_us.fill(0.0);
                 for i in 0..=h {
-                    self.warm_xs[i * nx..(i + 1) * nx].copy_from_slice(x);
+                    warm_xs[i * nx..(i + 1) * nx].copy_from_slice(x);
                 }
             }
         }
         let cold = first && self.guess.is_none();
         // The window starts at the measured state; the rest of the shifted guess keeps its gaps, which the
         // feasibility-driven line search closes (a cold start is a plain rollout of zero controls).
-        self.warm_xs[..nx].copy_from_slice(x);
+        warm_xs[..nx].copy_from_slice(x);
         let mut o = self.opts.solver.clone();
         if first {
             o.max_iter = self.opts.first_max_iter;
         }
-        self.solver.set_options(o)?;
-        self.window.set_offset(k);
+        // A shrunk window near the task's end (made once per length: the tail's re-plans are few)
+        if h != self.opts.horizon && self.tail.as_ref().is_none_or(|(w, _)| w.horizon() != h) {
+            let w = self.window.window(h)?;
+            let s = Solver::new(&w, o.clone())?;
+            self.tail = Some((w, s));
+        }
+        let (window, solver) = match &mut self.tail {
+            Some((w, s)) if h != self.opts.horizon => (w, s),
+            _ => (&mut self.window, &mut self.solver),
+        };
+        solver.set_options(o)?;
+        window.set_offset(k);
         let t0 = Instant::now();
-        let xs0 = if cold { None } else { Some(&self.warm_xs[..]) };
-        let sol = self.solver.solve(&mut self.window, x, &self.warm_us, xs0, &mut |_| true)?;
+        let xs0 = if cold { None } else { Some(&warm_xs[..]) };
+        let sol = solver.solve(window, x, warm_us, xs0, &mut |_| true)?;
         let lambda = sol.history.last().map(|i| i.lambda).filter(|l| l.is_finite()).unwrap_or(0.0);
-        let mut policy = Policy::from_solution(&sol, &self.window)?;
-        if let Some(g) = self.solver.refresh_gains(&mut self.window, lambda)? {
+        let mut policy = Policy::from_solution(&sol, window)?;
+        if let Some(g) = solver.refresh_gains(window, lambda)? {
             policy.set_gains(g)?;
         }
         let dt = t0.elapsed().as_secs_f64();
