@@ -21,7 +21,7 @@ reps = int(sys.argv[2]) if len(sys.argv) > 2 else 5
 sc = pc.load_scenario(name)
 m = ff.models.load(sc.model)
 meas = pc.measure(m, pc.simulate(sc, m), sc)
-base, target = 0, pc._target_index(m)
+base, target = 0, pc.target_index(m)
 
 
 def best(f):

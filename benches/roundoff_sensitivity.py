@@ -52,7 +52,7 @@ try:
 
     from freefloat.postcapture import equations as eq
 
-    base, target = 0, pc._target_index(m)
+    base, target = 0, pc.target_index(m)
     for form in ("momentum", "force"):
         for kind in ("paper", "standard"):
             new = getattr(eq, f"{kind}_{form}_rows")(m, meas, base, target)

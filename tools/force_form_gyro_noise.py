@@ -28,7 +28,7 @@ import numpy as np
 import freefloat.postcapture as pc
 from freefloat import models
 from freefloat.io import data
-from freefloat.postcapture.estimators import _target_index
+from freefloat.postcapture.estimators import target_index
 from freefloat.postcapture.spacecraft import truth_history
 
 COLS = ["m1", "mn", "Inxx", "Inyy", "Inzz"]
@@ -96,7 +96,7 @@ def error(m, sim, sc, level: float, method: str, measurement: dict, seed: int) -
     s2 = _with(sc, level, measurement, seed)
     meas = pc.measure(m, sim, s2)
     res = pc.identify(m, meas, s2, methods=(method,))
-    res.truth_history = truth_history(m, sim, False, _target_index(m))
+    res.truth_history = truth_history(m, sim, False, target_index(m))
     e = res.rel_error(method, "standard_rls")
     return float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in COLS])))
 
@@ -120,7 +120,7 @@ def study(name: str, duration: float, seeds: int, variants) -> list:
         # the momentum form's floor: the true states at the samples (no sensors)
         s0 = dataclasses.replace(sc, sensors=None, measurement={"accelerations": "exact"})
         res = pc.identify(m, pc.measure(m, sim, s0), s0, methods=("momentum",))
-        res.truth_history = truth_history(m, sim, False, _target_index(m))
+        res.truth_history = truth_history(m, sim, False, target_index(m))
         e = res.rel_error("momentum", "standard_rls")
         floor = float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in COLS])))
         rows.append(("momentum, true states (no sensors; reference)", [(floor, floor, floor)] * len(LEVELS), None))
