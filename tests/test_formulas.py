@@ -193,8 +193,12 @@ def measured(request):
     sc = pc.load_scenario(request.param)
     sc.duration = 6.0
     m = ff.models.load(sc.model)
-    meas = pc.measure(m, pc.simulate(sc, m), sc)
-    return m, meas
+    sim = pc.simulate(sc, m)
+    sc.measurement["momentum_point"] = "base"  # the default (these paper scenarios pin the origin)
+    meas = pc.measure(m, sim, sc)
+    sc.measurement["momentum_point"] = "origin"  # the paper's eqs. (9)-(10), what the numpy oracle implements
+    origin = pc.measure(m, sim, sc)
+    return m, meas, origin, sim
 
 
 def _close(new, old, what):
@@ -208,8 +212,10 @@ def _close(new, old, what):
 @pytest.mark.parametrize("form", ["momentum", "force"])
 def test_engine_rows_match_the_old_numpy_equations(measured, form):
     """Oracle: the numpy equations the package held (tests/postcapture_numpy_oracle.py, verbatim), on a
-    simulated record: every row block equal to round-off (relative to each sample's largest entry)."""
-    m, meas = measured
+    simulated record: every row block equal to round-off (relative to each sample's largest entry). The oracle
+    balances angular momentum about the inertial origin, as the paper does (measurement.momentum_point: origin)."""
+    m, _, meas, _ = measured
+    assert meas.transport is None
     names = m.body_names
     base, target = 0, len(names) - 1
     new_p = getattr(eq, f"paper_{form}_rows")(m, meas, base, target)
@@ -226,8 +232,9 @@ def test_engine_rows_match_the_old_numpy_equations(measured, form):
 
 def test_rows_hold_at_the_true_parameters(measured):
     """Closed check: at the model's own parameters the rows' residuals vanish (the engine simulated the
-    motion and the engine's regressors and closed forms describe it)."""
-    m, meas = measured
+    motion and the engine's regressors and closed forms describe it), about the base point (the transport term
+    integrated by Simpson's rule on the simulator's steps) and about the inertial origin."""
+    m, meas_b, meas_o, _ = measured
     base, target = 0, len(m.body_names) - 1
     L = eq.Layout(m.joint_types[0] == "planar")
     (m1, b1, I1), (mn, bn, In) = eq.body_truth(m, base), eq.body_truth(m, target)
@@ -238,13 +245,52 @@ def test_rows_hold_at_the_true_parameters(measured):
         D[3], D[7] = m1 * (b1 @ b1), mn * (bn @ bn)
     P = np.array(m.parameters())
     x = np.concatenate([P[base][L.std_cols], P[target][L.std_cols]])
-    for form in ("momentum", "force"):
+    for form, meas in (("momentum", meas_b), ("momentum", meas_o), ("force", meas_b)):
         pr = getattr(eq, f"paper_{form}_rows")(m, meas, base, target)
         sr = getattr(eq, f"standard_{form}_rows")(m, meas, base, target)
         lin = np.abs(eq.mv(pr.A, mu) - pr.b).max() / np.abs(pr.b).max()
         ang = np.abs(eq.mv(pr.Phi, th) - pr.y - eq.mv(pr.Psi, D)).max() / np.abs(pr.y).max()
         std = np.abs(eq.mv(sr.Phi, x) - sr.y).max() / np.abs(sr.y).max()
         assert max(lin, ang, std) < 1e-6, (form, lin, ang, std)
+
+
+def test_transport_term_is_the_integral_of_v_B_cross_P(measured):
+    """The base point's transport term times the model's parameters is ∫ v_B × P dτ, computed here without the
+    regressor: P from the engine's total momentum, v_B the base frame origin's inertial velocity from the base
+    attitude (this file's quaternion formula), Simpson's rule in numpy on the simulator's steps."""
+    m, meas, _, sim = measured
+    t, q, v = sim["t"], sim["q"], sim["v"]
+    P = np.asarray(ff.momentum(m, q, v))[:, :3]
+    if m.joint_types[0] == "planar":
+        c, s_ = np.cos(q[:, 2]), np.sin(q[:, 2])
+        vB = np.stack([c * v[:, 0] - s_ * v[:, 1], s_ * v[:, 0] + c * v[:, 1], 0 * c], -1)
+    else:
+        vB = oracle.mv(oracle.quat_to_matrix(q[:, 3:7]), v[:, 0:3])
+    f = np.cross(vB, P)
+    h = t[1] - t[0]
+    pair = h / 3 * (f[:-2:2] + 4 * f[1:-1:2] + f[2::2])
+    cum = np.concatenate([np.zeros((1, 3)), np.cumsum(pair, 0)])
+    i = np.searchsorted(t, meas.t - 1e-9 * h)
+    assert (i % 2 == 0).all()
+    want = cum[i // 2]
+    got = meas.transport @ np.asarray(m.parameters(), float).ravel()
+    scale = np.abs(want).max() + 1e-300
+    assert np.abs(got - want).max() < 1e-10 * scale, np.abs(got - want).max() / scale
+    # the balance it closes: ∫ M_B = L_B(t) − L_B(t₀) + ∫ v_B × P, L_B = L_O − r_B × P (a conservation law)
+    hq = np.asarray(ff.momentum(m, meas.q, meas.v))
+    rB = np.asarray(ff.algorithms.forward_kinematics(m, meas.q))[:, 0, :3]
+    LB = hq[:, 3:] - np.cross(rB, hq[:, :3])
+    lhs = LB - LB[:1] + got - got[:1]
+    rhs = meas.impulse_M - meas.impulse_M[:1]
+    rows = [2] if m.joint_types[0] == "planar" else [0, 1, 2]
+    assert np.abs(lhs - rhs)[:, rows].max() < 1e-8 * np.abs(LB[:, rows]).max()
+    # bad input names the argument
+    with pytest.raises(ff.InputError, match="at"):
+        eq.momentum_transport(m, t[:5], q[:5], v[:5], [0, 7])
+    with pytest.raises(ff.InputError, match="transport"):
+        from dataclasses import replace
+
+        eq.standard_momentum_rows(m, replace(meas, transport=meas.transport[:, :, :-1]), 0, len(m.body_names) - 1)
 
 
 def test_parameter_conversions_match_the_old_numpy():
@@ -277,7 +323,7 @@ def test_parameter_conversions_match_the_old_numpy():
 
 
 def test_rows_bad_input(measured):
-    m, meas = measured
+    m, meas, _, _ = measured
     from dataclasses import replace
 
     with pytest.raises(ff.InputError, match="ddq"):

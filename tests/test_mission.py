@@ -115,8 +115,10 @@ def test_mission_phases_and_comparison(mission_run):
 
 def test_adaptive_berth_rows_hold_at_the_true_parameters():
     """The berth's momentum rows from true states: the true standard parameters of base and target satisfy them to
-    the trapezoid's error (the base wrench held over each step, the attitude moving under it), and a 1 % heavier
-    target does not."""
+    the quadrature's error, and a 1 % heavier target does not. The impulses are trapezoids (the base wrench held
+    over each step, the attitude moving under it); the base point's transport term ∫ v_B × P is Simpson's rule on
+    the 10 ms record, whose pairs of steps straddle the command's switches every 5 steps (kinks in the integrand):
+    4.0e-5 relative, against 3.1e-6 with a 0.04 s command period (switches on pair boundaries)."""
     import dataclasses
 
     from freefloat.identification import online
@@ -152,7 +154,7 @@ def test_adaptive_berth_rows_hold_at_the_true_parameters():
     phi, y = np.asarray(rows.Phi), np.asarray(rows.y)
     assert len(rows.t) == 10 and np.abs(y).max() > 1.0  # the wrench moved the stack
     res = np.einsum("kri,i->kr", phi, theta) - y
-    assert np.abs(res).max() < 1e-5 * np.abs(y).max(), np.abs(res).max()
+    assert np.abs(res).max() < 1e-4 * np.abs(y).max(), np.abs(res).max()
     wrong = theta.copy()
     wrong[len(L.std_cols) :] *= 1.01
     assert np.abs(np.einsum("kri,i->kr", phi, wrong) - y).max() > 1e-3 * np.abs(y).max()

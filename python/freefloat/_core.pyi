@@ -690,12 +690,21 @@ sides. Same arguments as `identify_momentum`.
 def postcapture_m_j(mass: ArrayLike, com: ArrayLike) -> Any:
     """`m J(b')` (10) = [m, m b', m mono(b')] (Zhang 2020, eq. (23))."""
 
-def postcapture_rows(model: Model, form: ArrayLike, solver: ArrayLike, t: ArrayLike, q: ArrayLike, v: ArrayLike, ddq: ArrayLike, base_wrench: ArrayLike, impulse_f: ArrayLike, impulse_m: ArrayLike, base: str, target: ArrayLike) -> Any:
+def postcapture_momentum_transport(model: Model, t: ArrayLike, q: ArrayLike, v: ArrayLike, at: ArrayLike, point: ArrayLike = 0) -> Any:
+    """The transport term `∫ [v_B]× K_lin dτ` of the base-point momentum balance (`postcapture::momentum_point`)
+from the dense record `t` (N), `q` (N, nq), `v` (N, nv) at the frame indices `at` (T): an array
+(T, 3, 10·nbodies), integrated from `t[at[0]]` (Simpson's rule on an even grid, else trapezoid). B is the
+frame origin of body `point`.
+    """
+
+def postcapture_rows(model: Model, form: ArrayLike, solver: ArrayLike, t: ArrayLike, q: ArrayLike, v: ArrayLike, ddq: ArrayLike, base_wrench: ArrayLike, impulse_f: ArrayLike, impulse_m: ArrayLike, base: str, target: ArrayLike, transport: ArrayLike | None = None) -> Any:
     """Regression rows of Zhang, Yue, Yuan 2020 over a whole measurement record, computed by the
 engine (`postcapture::equations`). `form`: "momentum" (eqs. 11-19; cumulative differences from the first
 sample, so one block fewer) or "force" (eqs. 26-33, about the base sensor). `solver`: "paper" (dict with
 t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict with t, Phi, y, standard
-parameters about the reference points). Arrays have a leading sample axis.
+parameters about the reference points). Arrays have a leading sample axis. `transport` (T, 3, 10·nbodies,
+from `postcapture_momentum_transport`): the momentum rows' angular balance about the moving base point,
+`impulse_m` then being ∫ M_B dτ about it.
     """
 
 def postcapture_simulate(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt: float, f_max: ArrayLike, k_f: ArrayLike, m_max: ArrayLike, k_m: ArrayLike, k_d: ArrayLike, k_p: ArrayLike, jet: ArrayLike, damping: ArrayLike, amp: ArrayLike, freq: ArrayLike, phase: ArrayLike, record_every: int = 1, max_memory: ArrayLike | None = None, actuators: ArrayLike | None = None, environment: ArrayLike | None = None) -> Any:

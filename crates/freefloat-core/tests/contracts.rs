@@ -411,6 +411,7 @@ fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
         com_form, paper_force_rows, paper_momentum_rows, project_consistent, standard_force_rows,
         standard_momentum_rows, Measurements,
     };
+    use freefloat_core::postcapture::momentum_transport;
     use freefloat_core::sim::{integrate_base_poses, integrate_planar_base_poses, Steps};
     let m = builtin::load(MODEL).expect("built-in");
     let g = good(&m);
@@ -491,8 +492,16 @@ fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
             let pick = |name: &str, good: &[f64]| if name == which { x.clone() } else { good.to_vec() };
             let (qq, vv, aa, ww, ff) =
                 (pick("q", &q), pick("v", &v), pick("ddq", &ddq), pick("base_wrench", &bw), pick("impulse_f", &imp));
-            let meas =
-                Measurements { t: &t, q: &qq, v: &vv, ddq: &aa, base_wrench: &ww, impulse_f: &ff, impulse_m: &imp };
+            let meas = Measurements {
+                t: &t,
+                q: &qq,
+                v: &vv,
+                ddq: &aa,
+                base_wrench: &ww,
+                impulse_f: &ff,
+                impulse_m: &imp,
+                transport: None,
+            };
             let tag = format!("{which} {label}");
             must_err(&format!("paper_momentum_rows ({tag})"), &mut failures, || {
                 paper_momentum_rows(&mp, &meas, 0, target)
@@ -506,7 +515,43 @@ fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
             });
         }
     }
-    let meas = Measurements { t: &t, q: &q, v: &v, ddq: &ddq, base_wrench: &bw, impulse_f: &imp, impulse_m: &imp };
+    let meas = Measurements {
+        t: &t,
+        q: &q,
+        v: &v,
+        ddq: &ddq,
+        base_wrench: &bw,
+        impulse_f: &imp,
+        impulse_m: &imp,
+        transport: None,
+    };
+    // a transport term of the wrong length or with a NaN (the base-point momentum rows)
+    let w = 30 * mp.nbodies();
+    let mut nan_tr = vec![0.0; n * w];
+    nan_tr[w + 7] = f64::NAN;
+    for (label, tr) in [("short", vec![0.0; n * w - 1]), ("NaN", nan_tr)] {
+        let m2 = Measurements { transport: Some(&tr), ..meas };
+        must_err(&format!("standard_momentum_rows transport {label}"), &mut failures, || {
+            standard_momentum_rows(&mp, &m2, 0, target)
+        });
+        must_err(&format!("paper_momentum_rows transport {label}"), &mut failures, || {
+            paper_momentum_rows(&mp, &m2, 0, target)
+        });
+    }
+    // the transport integral's own inputs: frames, times, output indices, the point's body
+    let (tq, tv) = (mp.neutral().repeat(n), vec![0.0; n * nv]);
+    let bad_t = [0.0, 0.01, 0.01];
+    for (label, tt, at, point) in [
+        ("times not increasing", &bad_t[..], vec![0usize, 2], 0usize),
+        ("index past the frames", &t[..], vec![0, 3], 0),
+        ("indices decreasing", &t[..], vec![2, 1], 0),
+        ("point body out of range", &t[..], vec![0, 2], mp.nbodies()),
+    ] {
+        must_err(&format!("momentum_transport ({label})"), &mut failures, || {
+            momentum_transport(&mp, tt, &tq, &tv, &at, point)
+        });
+    }
+    must_err("momentum_transport (q short)", &mut failures, || momentum_transport(&mp, &t, &tq[1..], &tv, &[0], 0));
     for (b, tg) in [(0, 0), (0, mp.nbodies()), (mp.nbodies(), 1)] {
         must_err(&format!("paper_momentum_rows bodies {b}, {tg}"), &mut failures, || {
             paper_momentum_rows(&mp, &meas, b, tg)

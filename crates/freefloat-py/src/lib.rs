@@ -72,6 +72,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(excitation::excitation_rows_py, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_simulate, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_rows, m)?)?;
+    m.add_function(wrap_pyfunction!(postcapture::postcapture_momentum_transport, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_thruster_wrench, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::postcapture_m_j, m)?)?;
     m.add_function(wrap_pyfunction!(postcapture::capture_impact, m)?)?;

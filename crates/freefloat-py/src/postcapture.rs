@@ -363,9 +363,11 @@ fn array3<'py>(py: Python<'py>, data: Vec<f64>, shape: &[usize]) -> PyResult<Bou
 /// engine (`postcapture::equations`). `form`: "momentum" (eqs. 11-19; cumulative differences from the first
 /// sample, so one block fewer) or "force" (eqs. 26-33, about the base sensor). `solver`: "paper" (dict with
 /// t, A, b, Phi, y, Psi: `A μ = b`, `Φ θ = y + Ψ D(μ)`) or "standard" (dict with t, Phi, y, standard
-/// parameters about the reference points). Arrays have a leading sample axis.
+/// parameters about the reference points). Arrays have a leading sample axis. `transport` (T, 3, 10·nbodies,
+/// from `postcapture_momentum_transport`): the momentum rows' angular balance about the moving base point,
+/// `impulse_m` then being ∫ M_B dτ about it.
 #[pyfunction]
-#[pyo3(signature = (model, form, solver, t, q, v, ddq, base_wrench, impulse_f, impulse_m, base, target))]
+#[pyo3(signature = (model, form, solver, t, q, v, ddq, base_wrench, impulse_f, impulse_m, base, target, transport=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn postcapture_rows<'py>(
     py: Python<'py>,
@@ -381,6 +383,7 @@ pub fn postcapture_rows<'py>(
     impulse_m: &Bound<'py, PyAny>,
     base: usize,
     target: usize,
+    transport: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     use freefloat_core::postcapture::equations as eq;
     let mb = crate::batch::model_arg(model)?;
@@ -390,6 +393,21 @@ pub fn postcapture_rows<'py>(
     let (q, v, ddq) = (flat("q", q, nq)?, flat("v", v, nv)?, flat("ddq", ddq, nv)?);
     let wrench = flat("base_wrench", base_wrench, nb)?;
     let (imp_f, imp_m) = (flat("impulse_F", impulse_f, 3)?, flat("impulse_M", impulse_m, 3)?);
+    let transport = match transport {
+        None => None,
+        Some(x) if x.is_none() => None,
+        Some(x) => {
+            let a = crate::batch::array_arg(x, "transport")?;
+            let want = [t.len(), 3, 10 * m.nbodies()];
+            if a.shape() != want {
+                return Err(input_err(format!(
+                    "argument `transport`: expected shape {want:?} (samples, 3, 10 · bodies), got {:?}",
+                    a.shape()
+                )));
+            }
+            Some(a.as_array().iter().copied().collect::<Vec<f64>>())
+        }
+    };
     let paper = match solver {
         "paper" => true,
         "standard" => false,
@@ -414,6 +432,7 @@ pub fn postcapture_rows<'py>(
                 base_wrench: &wrench,
                 impulse_f: &imp_f,
                 impulse_m: &imp_m,
+                transport: transport.as_deref(),
             };
             Ok(match (paper, momentum) {
                 (true, true) => Rows::Paper(eq::paper_momentum_rows(&m, &meas, base, target)?),
@@ -444,6 +463,30 @@ pub fn postcapture_rows<'py>(
         }
     }
     Ok(d)
+}
+
+/// The transport term `∫ [v_B]× K_lin dτ` of the base-point momentum balance (`postcapture::momentum_point`)
+/// from the dense record `t` (N), `q` (N, nq), `v` (N, nv) at the frame indices `at` (T): an array
+/// (T, 3, 10·nbodies), integrated from `t[at[0]]` (Simpson's rule on an even grid, else trapezoid). B is the
+/// frame origin of body `point`.
+#[pyfunction]
+#[pyo3(signature = (model, t, q, v, at, point=0))]
+pub fn postcapture_momentum_transport<'py>(
+    py: Python<'py>,
+    model: &Bound<'py, PyAny>,
+    t: &Bound<'py, PyAny>,
+    q: &Bound<'py, PyAny>,
+    v: &Bound<'py, PyAny>,
+    at: Vec<usize>,
+    point: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mb = crate::batch::model_arg(model)?;
+    let m = mb.get().inner.clone();
+    let t = flat("t", t, 1)?;
+    let (q, v) = (flat("q", q, m.nq)?, flat("v", v, m.nv)?);
+    let w = 10 * m.nbodies();
+    let out = py.detach(|| guard(|| freefloat_core::postcapture::momentum_transport(&m, &t, &q, &v, &at, point)))?;
+    array3(py, out, &[at.len(), 3, w])
 }
 
 /// `(m, b', I'_c)` from standard parameters (…, 10) about a reference point: masses (…), centres of mass

@@ -92,6 +92,7 @@ _PC_OPTIONAL = [
     "measurement",
     "measurement.accelerations",
     "measurement.impulses",
+    "measurement.momentum_point",
     "measurement.savgol_window",
     "measurement.savgol_polyorder",
     "identification.project",

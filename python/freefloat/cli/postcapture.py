@@ -54,7 +54,15 @@ from .._core import Interrupted
     type=click.Choice(["simpson", "trapezoid"]),
     help="Thrust impulses for the momentum form: Simpson on the 1 kHz thrust (default) or trapezoid on the samples.",
 )
-def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses):
+@click.option(
+    "--momentum-point",
+    type=click.Choice(["base", "origin"]),
+    help="Point the momentum form balances angular momentum about: the moving base point (default; robust when the "
+    "system drifts and the attitude is integrated from a gyro) or the inertial origin (the paper's eqs. 9-10).",
+)
+def identify_postcapture_cmd(
+    scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses, momentum_point
+):
     """Zhang, Yue, Yuan 2020: identify base and captured target online, in one step (momentum- and force-based).
 
     SCENARIO is a built-in name (`freefloat scenarios`) or a YAML file. Simulates the post-capture motion
@@ -83,6 +91,8 @@ def identify_postcapture_cmd(scenario, out, noise, seed, sweep, forgetting, proj
         sc.measurement["accelerations"] = accelerations
     if impulses:
         sc.measurement["impulses"] = impulses
+    if momentum_point:
+        sc.measurement["momentum_point"] = momentum_point
     t0 = _time.perf_counter()
     try:
         with tqdm(total=2, desc=f"{sc.name}", unit="stage", leave=False) as bar:

@@ -99,6 +99,9 @@ class PcIdentification(Block):
 class PcMeasurement(Block):
     accelerations: literal("exact", "central_difference", "savgol") = "exact"
     impulses: literal("simpson", "trapezoid") = "simpson"
+    # the point the momentum form balances angular momentum about: the moving base point (robust to a drifting
+    # system measured with an integrated attitude) or the inertial origin (the paper's eqs. 9-10)
+    momentum_point: literal("base", "origin") = "base"
     # Savitzky-Golay derivative (accelerations: savgol): window in samples of the differentiated rates (the
     # telemetry's with sensors, else one every sample_period), odd; polynomial degree below it
     savgol_window: integer(lo=3) = None

@@ -4,7 +4,9 @@ estimate has moved, the controller's model takes it (`DdpMpc.set_parameters`) fr
 
 Rows. The berth's base wrench is the controller's own command u[0:6] ([f; τ] in the base frame about its origin,
 held over each control step), so the momentum form needs no accelerations: over a segment of the berth,
-h(t) − h(t₀) = ∫ [F; M + x × F] dt (Zhang 2020, eqs. (9)-(10), the rows `standard_momentum_rows` forms), the
+p(t) − p(t₀) = ∫ F dt and, about the moving base point as in the detumble (`postcapture::momentum_point`),
+L_B(t) − L_B(t₀) + ∫ v_B × P dt = ∫ M_B dt (Zhang 2020, eqs. (9)-(10) moved to the base point; the rows
+`standard_momentum_rows` forms, the transport term on the segment's telemetry frames), the
 impulses integrated from the held command with the plant's attitude at every RK4 step (trapezoid; the attitude
 between telemetry frames is the flight computer's business, as in the detumble's `measure`). Each segment of
 `update_every_s` is measured on its own (its own sensor noise stream; a gyro-integrated attitude restarts from
@@ -43,18 +45,17 @@ def physical(x_std: np.ndarray, std_cols) -> np.ndarray:
 
 
 def segment_impulses(truth, t, q, u) -> tuple[np.ndarray, np.ndarray]:
-    """∫F dt and ∫(M + x_F × F) dt (inertial, about the origin) from t[0] to each t[i] of the base wrench u[i, :6]
-    held over [t[i], t[i+1]] (base frame, about the base origin), the attitude and position at the steps' ends:
+    """∫F dt and ∫M_B dt (inertial; the moment about the moving base origin B) from t[0] to each t[i] of the base
+    wrench u[i, :6] held over [t[i], t[i+1]] (base frame, about the base origin), the attitude at the steps' ends:
     trapezoid on each step with its own held value at both ends (no jump is smeared across a step)."""
     fk = np.asarray(alg.forward_kinematics(truth, np.asarray(q, float)))[:, 0]
-    A, rb = quat_to_matrix(fk[:, 3:]), fk[:, :3]
+    A = quat_to_matrix(fk[:, 3:])
     f, tau = np.asarray(u, float)[:, :3], np.asarray(u, float)[:, 3:6]
     dt = np.diff(t)
 
     def world(i0):  # the held wrench of each step, at the step's start (i0 = 0) or end (i0 = 1)
-        Ai, ri = A[i0 : len(A) - 1 + i0], rb[i0 : len(rb) - 1 + i0]
-        F = eq.mv(Ai, f)
-        return F, eq.mv(Ai, tau) + np.cross(ri, F)
+        Ai = A[i0 : len(A) - 1 + i0]
+        return eq.mv(Ai, f), eq.mv(Ai, tau)
 
     (F0, M0), (F1, M1) = world(0), world(1)
     z = np.zeros((1, 3))
@@ -96,8 +97,8 @@ class BerthEstimator:
         sn.measure(self.truth, run, self.sc.sensors, seed=0).require_telemetry()
 
     def _samples(self, seg: dict):
-        """(t, q, v) at the sample instants of the segment (one every `sample_period` on the telemetry's grid):
-        measured by the sensors, or the true states without them."""
+        """The segment's record (t, q, v) -- the telemetry frames measured by the sensors, or the true states
+        without them -- and the indices of its sample instants (one every `sample_period` on its grid)."""
         t, q, v = seg["t"], seg["q"], seg["v"]
         period = float(self.sc.sample_period)
         if self.sc.sensors is not None:
@@ -112,12 +113,13 @@ class BerthEstimator:
         ok = j < len(tt)
         j = j[ok]
         j = j[np.abs(tt[j] - want[ok]) <= 1e-6]
-        return tt[j], tq[j], tv[j]
+        return (tt, tq, tv), j
 
     def segment_rows(self, seg: dict):
         """The momentum rows of one segment (differences from its first sample), None if it holds fewer than two
         samples."""
-        ts, qs, vs = self._samples(seg)
+        (tt, tq, tv), j = self._samples(seg)
+        ts, qs, vs = tt[j], tq[j], tv[j]
         self.segments += 1
         t_seg = seg["t"]
         if len(ts) < 2:
@@ -125,7 +127,8 @@ class BerthEstimator:
         IF, IM = segment_impulses(self.truth, t_seg, seg["q"], seg["u"])
         i = np.clip(np.searchsorted(t_seg, ts - 1e-9), 0, len(t_seg) - 1)
         held = np.vstack([seg["u"], seg["u"][-1:]])[i, :6]
-        meas = eq.Measurements(ts, qs, vs, np.zeros_like(vs), held, IF[i], IM[i])
+        transport = eq.momentum_transport(self.truth, tt, tq, tv, j)
+        meas = eq.Measurements(ts, qs, vs, np.zeros_like(vs), held, IF[i], IM[i], transport)
         return eq.standard_momentum_rows(self.truth, meas, 0, self.target)
 
     def __call__(self, k: int, seg: dict):

@@ -117,7 +117,10 @@ def approach(mission: Mission, truth, cap: dict, duration: float, dt: float = 0.
 # -- phase 2: detumble and identify ---------------------------------------------------------------------------
 def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
     """The detumble scenario from the post-impact state, with the mission's guess of the target and, when the
-    mission has its own `sensors:` block, those sensors (checked against the robot like a scenario's)."""
+    mission has its own `sensors:` block, those sensors (checked against the robot like a scenario's). The
+    momentum rows balance angular momentum about the moving base point whatever the named scenario says (the
+    paper-reproduction scenarios keep the paper's inertial origin; a mission measures a drifting stack with
+    sensors, where only the base point holds up: docs/postcapture.md), as the adaptive berth's rows do."""
     from ..postcapture.scenario import scenario_blocks
 
     if isinstance(mission.detumble, dict):  # the post-capture blocks given inline, for this servicer
@@ -146,7 +149,12 @@ def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
     guess = dict(sc.guess)
     guess["target"] = {"mass": g.mass, "com": list(g.com), "inertia": g.inertia.tolist()}
     sc = dataclasses.replace(
-        sc, q0=np.asarray(q0, float), v0=np.asarray(v0, float), duration=mission.max_duration, guess=guess
+        sc,
+        q0=np.asarray(q0, float),
+        v0=np.asarray(v0, float),
+        duration=mission.max_duration,
+        guess=guess,
+        measurement={**sc.measurement, "momentum_point": "base"},
     )
     if mission.sensors is not None:
         _, _, sset = scenario_blocks(

@@ -86,7 +86,11 @@ class Measurements:
     ddq: np.ndarray
     base_wrench: np.ndarray  # (T, nb) thruster generalized force [f; τ] in the base frame at the sensor
     impulse_F: np.ndarray  # (T, 3) ∫ F dτ, inertial
-    impulse_M: np.ndarray  # (T, 3) ∫ (M + x_F × F) dτ about the inertial origin
+    impulse_M: np.ndarray  # (T, 3) ∫ (M + x_F × F) dτ about the inertial origin, or ∫ M_B dτ (with transport)
+    # (T, 3, 10·nbodies) ∫ [v_B]× K_lin dτ (`momentum_transport`): when given, the momentum rows balance the
+    # angular momentum about the moving base point B instead of the inertial origin, and impulse_M is ∫ M_B dτ
+    # about B (the engine's `postcapture::momentum_point`; docs/postcapture.md, "Momentum about the base point")
+    transport: np.ndarray | None = None
 
 
 @dataclass
@@ -122,6 +126,16 @@ def _rows(model, meas: Measurements, form: str, solver: str, base: int, target: 
         meas.impulse_M,
         int(base),
         int(target),
+        transport=meas.transport,
+    )
+
+
+def momentum_transport(model, t, q, v, at, point: int = 0) -> np.ndarray:
+    """∫_{t[at[0]]}^{t[at[s]]} [v_B]× K_lin dτ (T, 3, 10·nbodies) on the dense record (t, q, v) at its frame
+    indices `at`, B the frame origin of body `point` (the engine's `postcapture::momentum_point`; Simpson's rule
+    on an evenly spaced record). The term that moves the momentum form's angular balance to the base point."""
+    return _core.postcapture_momentum_transport(
+        model, np.asarray(t, float), np.asarray(q, float), np.asarray(v, float), [int(k) for k in at], int(point)
     )
 
 

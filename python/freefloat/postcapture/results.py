@@ -113,7 +113,13 @@ class PostcaptureResult:
             "timings_s": self.timings,
             "equation_residuals_at_truth": self.residuals,
             "noise": self.scenario.noise,
-            "measurement": self.scenario.measurement,
+            # the effective settings (the scenario's keys over the defaults)
+            "measurement": {
+                "accelerations": "exact",
+                "impulses": "simpson",
+                "momentum_point": "base",
+                **self.scenario.measurement,
+            },
             "methods": {},
             **self.extra,
         }

@@ -152,7 +152,9 @@ def _central_difference(
 
 def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = None) -> eq.Measurements:
     """Samples every `sample_period`: state, exact accelerations, thruster wrench, and the impulses
-    ∫F and ∫(M + x_F × F) integrated from the step-rate thrust by Simpson's rule. With `sc.noise`
+    ∫F and ∫M_B about the base point with the transport term ∫ v_B × P (measurement.momentum_point: base, the
+    default), or ∫(M + x_F × F) about the inertial origin (momentum_point: origin, the paper's eqs. 9-10),
+    integrated from the step-rate thrust by Simpson's rule. With `sc.noise`
     (and rng) white noise is added: `velocity` to v, `acceleration` to ddq at the samples, `force`
     (N, and N·m) to the thrust at the step rate before integration."""
     planar = model.joint_types[0] == "planar"
@@ -177,7 +179,11 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
     else:
         fb, tb = wrench[:, :3], wrench[:, 3:]
     F = eq.mv(A, fb)
-    M = eq.mv(A, tb) + np.cross(rb, F)  # tb holds M + r'_jet × f about the sensor; add r_b × F
+    point = sc.measurement.get("momentum_point", "base")
+    if point not in ("base", "origin"):
+        raise InputError(f"measurement.momentum_point: expected 'base' or 'origin', got {point!r}")
+    # tb holds M + r'_jet × f about the sensor (the base point B); about the inertial origin add r_b × F
+    M = eq.mv(A, tb) if point == "base" else eq.mv(A, tb) + np.cross(rb, F)
     idx = np.arange(0, len(t), step)
     h = sc.dt
 
@@ -191,6 +197,7 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         return np.concatenate([np.zeros((1,) + f.shape[1:]), np.cumsum(0.5 * (fs[1:] + fs[:-1]) * sc.sample_period, 0)])
 
     qs, tel = q[idx], None
+    dense = (t, q, v, idx)  # the record between the samples (for the base point's transport term)
     if sc.sensors is not None and noise:
         raise InputError(
             f"{sc.source}: key 'noise': the scenario has sensors, whose errors are the measurement noise; give "
@@ -204,6 +211,7 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         v = v.copy()
         v[idx] = tel_v[rows]
         tel = (rows, tel_q, tel_v, float(tel_t[1] - tel_t[0]))
+        dense = (tel_t, tel_q, tel_v, rows)
     mode = sc.measurement
     vs, as_ = v[idx], ddq[idx]
     if noise and rng is not None:
@@ -233,6 +241,24 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
     integ = {"simpson": simpson, "trapezoid": trapezoid}.get(mode.get("impulses", "simpson"))
     if integ is None:
         raise InputError(f"measurement.impulses: expected 'simpson' or 'trapezoid', got {mode['impulses']!r}")
+    # about the base point: the transport term ∫ v_B × P dτ on the dense record (the telemetry frames with
+    # sensors, else the simulator's steps)
+    if point == "base" and noise and rng is not None and float(noise.get("velocity", 0.0)) > 0:
+        # the `noise` block's velocity noise on the steps too, at the samples' noise density (σ per sample every
+        # sample_period is σ √(sample_period/dt) per step), drawn after the samples' noise (whose streams stay
+        # as they were); at the sample instants the record holds the noisy samples themselves
+        dt_, q_, v_, at_ = dense
+        vd = v_ + rng.normal(0.0, float(noise["velocity"]) * np.sqrt(sc.sample_period / sc.dt), v_.shape)
+        vd[at_] = vs
+        dense = (dt_, q_, vd, at_)
+    transport = eq.momentum_transport(model, *dense) if point == "base" else None
     return eq.Measurements(
-        t[idx][keep], qs[keep], vs[keep], as_[keep], wrench[idx][keep], integ(F)[keep], integ(M)[keep]
+        t[idx][keep],
+        qs[keep],
+        vs[keep],
+        as_[keep],
+        wrench[idx][keep],
+        integ(F)[keep],
+        integ(M)[keep],
+        None if transport is None else transport[keep],
     )

@@ -236,7 +236,8 @@ impl Layout {
 /// What the identification sees at the sample instants, row-major with a leading time axis of `T` samples:
 /// `q` (T × nq), `v`, `ddq` (T × nv), `base_wrench` (T × nb: thruster generalized force `[f; τ]` in the base
 /// frame at the sensor), `impulse_f` (T × 3: ∫ F dτ, inertial), `impulse_m` (T × 3: ∫ (M + x_F × F) dτ
-/// about the inertial origin).
+/// about the inertial origin, or with `transport` ∫ M_B dτ about the moving base point, see
+/// `momentum_point`).
 #[derive(Clone, Copy, Debug)]
 pub struct Measurements<'a> {
     /// Sample times (s), T.
@@ -251,8 +252,12 @@ pub struct Measurements<'a> {
     pub base_wrench: &'a [f64],
     /// ∫ F dτ (N s), inertial, T × 3.
     pub impulse_f: &'a [f64],
-    /// ∫ (M + x_F × F) dτ about the inertial origin (N m s), T × 3.
+    /// ∫ (M + x_F × F) dτ about the inertial origin (N m s), T × 3; with `transport`, ∫ M_B dτ about the
+    /// moving base point (the base reference body's frame origin).
     pub impulse_m: &'a [f64],
+    /// `∫ [v_B]× K_lin dτ` (T × 3 × 10·nbodies, `momentum_point::momentum_transport`): when given, the
+    /// momentum form's angular rows are about the moving base point, not the inertial origin.
+    pub transport: Option<&'a [f64]>,
 }
 
 impl Measurements<'_> {
@@ -269,7 +274,10 @@ impl Measurements<'_> {
             ("base_wrench", self.base_wrench, m.nvs[0]),
             ("impulse_F", self.impulse_f, 3),
             ("impulse_M", self.impulse_m, 3),
-        ] {
+        ]
+        .into_iter()
+        .chain(self.transport.map(|x| ("transport", x, 30 * m.nbodies())))
+        {
             if x.len() != n * w {
                 return Err(FfError::arg(
                     name,
@@ -422,9 +430,23 @@ fn planar_wrench_3d(l: &Layout, w: &[f64]) -> (V3, V3) {
     }
 }
 
+/// With a transport term, the momentum regressor `[K_lin; K_ang]` (about the origin) turned into the rows of
+/// the base-point balance `L_B + ∫ v_B × P dτ` (`momentum_point`): `K_ang − [r_B]× K_lin + transport`.
+fn to_base_point(k: &mut DMatrix<f64>, r_b: &V3, transport: &[f64]) {
+    let w = k.ncols();
+    let shift = skew(r_b) * k.rows(0, 3);
+    for r in 0..3 {
+        for c in 0..w {
+            k[(3 + r, c)] += transport[r * w + c] - shift[(r, c)];
+        }
+    }
+}
+
 /// Momentum form, Zhang 2020 eqs. (11)-(19): rows as cumulative differences from the first sample t₀
 /// (eq. (16) needs `H(t) − H(t₀)`; the printed `H(t)` is a typo, see docs/postcapture.md). One row block
-/// per sample after the first.
+/// per sample after the first. With `meas.transport`, the angular rows are about the moving base point
+/// (`momentum_point`): H from positions relative to it, and the transport term's mass and first-moment
+/// columns of each unknown body added to H's (they multiply the same `m`, `m b'` of `D(μ)`).
 pub fn paper_momentum_rows(m: &Model, meas: &Measurements, base: usize, target: usize) -> Result<PaperRows> {
     let l = Layout::of(m)?;
     check_bodies(m, base, target)?;
@@ -438,17 +460,33 @@ pub fn paper_momentum_rows(m: &Model, meas: &Measurements, base: usize, target: 
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k).map_err(|e| at(e, s))?;
-        let (p1, pn) = (PointMotion::of_body(&d, base, false), PointMotion::of_body(&d, target, false));
+        let (mut p1, mut pn) = (PointMotion::of_body(&d, base, false), PointMotion::of_body(&d, target, false));
+        let tr = meas.transport.map(|x| &x[s * 3 * k.ncols()..(s + 1) * 3 * k.ncols()]);
+        if let Some(tr) = tr {
+            to_base_point(&mut k, &p1.r, tr);
+            (p1, pn) = (p1.shifted(&p1.r), pn.shifted(&p1.r));
+        }
         let kn: [f64; 6] = std::array::from_fn(|r| row_dot(&k, r, &known)); // Σ_known [m v; m r × v + I ω]
         let imp_f = V3::from_column_slice(&meas.impulse_f[3 * s..3 * s + 3]);
         let imp_m = V3::from_column_slice(&meas.impulse_m[3 * s..3 * s + 3]);
-        let sample = PaperSample {
+        let mut sample = PaperSample {
             a: pair(&b_block(&p1), &b_block(&pn)),   // eq. (12)
             b: imp_f - V3::new(kn[0], kn[1], kn[2]), // eq. (13)
             phi: pair(&d_block(&p1), &d_block(&pn)), // eq. (17)
             y: imp_m - V3::new(kn[3], kn[4], kn[5]), // eq. (18)
             psi: pair(&h_block(&p1), &h_block(&pn)), // eq. (19)
         };
+        if let Some(tr) = tr {
+            // ∫ v_B × (m v_c) dτ of the unknown bodies: columns [m, m b'] of their standard parameters
+            let w = k.ncols();
+            for (off, body) in [(0, base), (10, target)] {
+                for r in 0..3 {
+                    for c in 0..4 {
+                        sample.psi[(r, off + c)] += tr[r * w + 10 * body + c];
+                    }
+                }
+            }
+        }
         match &first {
             None => first = Some(sample),
             Some(f0) => {
@@ -505,7 +543,8 @@ fn std_columns(l: &Layout, base: usize, target: usize) -> Vec<usize> {
 
 /// The standard form's momentum rows: the engine's momentum-regressor columns of base and target (standard
 /// parameters about the sensor / capture point) against the impulses minus the known links' momentum,
-/// cumulative differences from t₀ (Zhang 2020 eqs. (9)-(10) with the bodies in standard parameters).
+/// cumulative differences from t₀ (Zhang 2020 eqs. (9)-(10) with the bodies in standard parameters). With
+/// `meas.transport`, the angular rows are about the moving base point (`momentum_point`).
 pub fn standard_momentum_rows(m: &Model, meas: &Measurements, base: usize, target: usize) -> Result<StandardRows> {
     let l = Layout::of(m)?;
     check_bodies(m, base, target)?;
@@ -522,6 +561,11 @@ pub fn standard_momentum_rows(m: &Model, meas: &Measurements, base: usize, targe
     for s in 0..n {
         let q = m.checked_q(&meas.q[s * m.nq..(s + 1) * m.nq], &mut buf).map_err(|e| at(e, s))?;
         momentum_regressor(m, &mut d, q, &meas.v[s * m.nv..(s + 1) * m.nv], &mut k).map_err(|e| at(e, s))?;
+        if let Some(tr) = meas.transport {
+            let r_b = PointMotion::of_body(&d, base, false).r;
+            let w = 3 * k.ncols();
+            to_base_point(&mut k, &r_b, &tr[s * w..(s + 1) * w]);
+        }
         for (i, &r) in rows.iter().enumerate() {
             let imp = if r < 3 { meas.impulse_f[3 * s + r] } else { meas.impulse_m[3 * s + r - 3] };
             let yr = imp - row_dot(&k, r, &known);

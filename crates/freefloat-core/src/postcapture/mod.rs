@@ -15,8 +15,10 @@
 pub mod capture;
 mod control;
 pub mod equations;
+pub mod momentum_point;
 mod simulate;
 
 pub use capture::{capture_impact, CaptureImpact};
 pub use control::{saturate, PostcaptureControl};
+pub use momentum_point::momentum_transport;
 pub use simulate::{simulate_postcapture, simulate_postcapture_with, thruster_base_wrench};
