@@ -142,7 +142,8 @@ def main() -> None:
         "|---|---|---|",
     ]
     for k, v in phases_med.items():
-        lines.append(f"| {k} | {v:.3f} | {share.get(k, float('nan')):.0%} |")
+        # berth_total sums the berth's phases above it: it has no share of its own
+        lines.append(f"| {k} | {v:.3f} | {f'{share[k]:.0%}' if k in share else '(sum of the berth rows)'} |")
     lines += ["", f"dominant phase: {dominant}; model updates {res['model_updates']}; MPC: {res['mpc']}"]
     (out / "mission_bench.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
