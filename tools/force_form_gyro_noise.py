@@ -1,7 +1,7 @@
 """Force-form identification with a noisy gyro: the parameter error of the post-capture force form against the
-gyro's noise density, with the angular accelerations from central differences or a Savitzky-Golay derivative of
-the measured rates, and the momentum form (which needs no accelerations) beside them, about the inertial origin
-(the paper's eqs. 9-10) and about the moving base point (the default).
+gyro's noise density, with the angular accelerations from central differences, a Savitzky-Golay derivative of
+the measured rates or their RTS smoother, and the momentum form (which needs no accelerations) beside them,
+about the inertial origin (the paper's eqs. 9-10) and about the moving base point (the default).
 
 Two built-in scenarios, each simulated once: `zhang2020_3d` (the paper's 3-D capture, its ideal jets: the momentum
 form holds) given the 100 Hz gyro, base-velocity and tachometer telemetry of `zhang2020_3d_thrusters`, and
@@ -52,6 +52,7 @@ VARIANTS = [
     _sg(21, 3),
     _sg(21, 2),
     _sg(51, 2),
+    ("force, RTS smoother (GCV bandwidth)", "force", {"accelerations": "rts"}),
     ("momentum about the origin (the paper's eqs. 9-10)", "momentum", {"momentum_point": "origin"}),
     ("momentum about the base point (default)", "momentum", {"momentum_point": "base"}),
 ]

@@ -742,6 +742,13 @@ def simulate_many(model: Model, q0: ArrayLike, v0: ArrayLike, t_final: float, dt
 def skew(v: ArrayLike) -> Any:
     """Cross-product matrices (…, 3, 3): `skew(a) @ b == a × b`."""
 
+def smooth_rates(y: ArrayLike, h: ArrayLike, log_ratio: ArrayLike | None = None) -> Any:
+    """Accelerations from noisy rates (`freefloat_core::sensors::smooth_rates`): the Rauch-Tung-Striebel smoother
+of the white-jerk rate model, per column of `y` (N, k) sampled every `h` seconds. `log_ratio`:
+log10(q h³ / r) for every column, or None for each column's maximum-likelihood ratio. Returns a dict: rate
+and accel (N, k), log_ratio and sigma (k,) (the estimated white rate noise per sample).
+    """
+
 def step(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, dt: float, method: str = 'euler') -> Any:
     """One step of the forward dynamics with tau held over it: (q_next (nq), v_next (nv)).
 method "euler": semi-implicit Euler v+ = v + a dt, q+ = q ⊕ v+ dt (Crocoddyl's

@@ -65,6 +65,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(simulate::actuator_fields, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::measure, m)?)?;
     m.add_function(wrap_pyfunction!(sensors::check_sensors, m)?)?;
+    m.add_function(wrap_pyfunction!(sensors::smooth_rates, m)?)?;
     m.add_function(wrap_pyfunction!(simulate_many::simulate_many, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::identify_momentum, m)?)?;
     m.add_function(wrap_pyfunction!(estimation::momentum_regressor_stream, m)?)?;

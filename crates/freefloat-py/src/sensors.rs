@@ -83,3 +83,32 @@ pub fn measure<'py>(
 pub fn check_sensors(sensors: &str) -> PyResult<Vec<String>> {
     Ok(guard(|| parse_sensors(sensors))?.into_iter().map(|s| s.name).collect())
 }
+
+/// Accelerations from noisy rates (`freefloat_core::sensors::smooth_rates`): the Rauch-Tung-Striebel smoother
+/// of the white-jerk rate model, per column of `y` (N, k) sampled every `h` seconds. `log_ratio`:
+/// log10(q h³ / r) for every column, or None for each column's ratio by generalised cross-validation. Returns a dict: rate
+/// and accel (N, k), log_ratio and sigma (k,) (the estimated white rate noise per sample).
+#[pyfunction]
+#[pyo3(signature = (y, h, log_ratio = None))]
+pub fn smooth_rates<'py>(
+    py: Python<'py>,
+    y: &Bound<'py, PyAny>,
+    h: f64,
+    log_ratio: Option<f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = array_arg(y, "y")?;
+    let shape = a.shape().to_vec();
+    if shape.len() != 2 {
+        return Err(input_err(format!("argument `y`: expected shape (samples, channels), got {shape:?}")));
+    }
+    let data = contiguous(&a);
+    let (n, k) = (shape[0], shape[1]);
+    let r = py.detach(|| guard(|| freefloat_core::sensors::smooth_rates(&data, k, h, log_ratio)))?;
+    let d = PyDict::new(py);
+    let as2 = |v: Vec<f64>| -> PyResult<Bound<'py, PyAny>> { Ok(v.into_pyarray(py).reshape([n, k])?.into_any()) };
+    d.set_item("rate", as2(r.rate)?)?;
+    d.set_item("accel", as2(r.accel)?)?;
+    d.set_item("log_ratio", r.log_ratio.into_pyarray(py))?;
+    d.set_item("sigma", r.sigma.into_pyarray(py))?;
+    Ok(d)
+}

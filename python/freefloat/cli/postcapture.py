@@ -44,10 +44,11 @@ from .._core import Interrupted
 )
 @click.option(
     "--accelerations",
-    type=click.Choice(["exact", "central_difference", "savgol"]),
+    type=click.Choice(["exact", "central_difference", "savgol", "rts"]),
     help="Accelerations for the force form: exact at the samples (default), central differences of the sampled "
-    "velocities, or their Savitzky-Golay derivative (measurement.savgol_window, savgol_polyorder in the scenario; "
-    "default a cubic over 21 samples).",
+    "velocities, their Savitzky-Golay derivative (measurement.savgol_window, savgol_polyorder in the scenario; "
+    "default a cubic over 21 samples), or a Rauch-Tung-Striebel smoother of the rates whose bandwidth is set by "
+    "generalised cross-validation from the noise in the record.",
 )
 @click.option(
     "--impulses",

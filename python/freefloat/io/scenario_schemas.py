@@ -97,7 +97,7 @@ class PcIdentification(Block):
 
 
 class PcMeasurement(Block):
-    accelerations: literal("exact", "central_difference", "savgol") = "exact"
+    accelerations: literal("exact", "central_difference", "savgol", "rts") = "exact"
     impulses: literal("simpson", "trapezoid") = "simpson"
     # the point the momentum form balances angular momentum about: the moving base point (robust to a drifting
     # system measured with an integrated attitude) or the inertial origin (the paper's eqs. 9-10)

@@ -99,10 +99,19 @@ def _derivative(mode: dict, n: int, where: str):
       degree 3 or 4 fit has 2.5 times more than that), but the fit is centred, so an online estimator can use a
       sample only (w − 1)/2 samples later (its lag: 0.1 s for 21 samples at 100 Hz), and motion faster than
       about (polyorder + 1)/(3.2 w − 4.6) cycles per sample (Schafer 2011) is attenuated, which biases the
-      accelerations of fast joints."""
+      accelerations of fast joints.
+    - `rts`: the Rauch-Tung-Striebel smoother of the white-jerk rate model (state: rate and its derivative; the
+      rate measured with white noise), each column with its own ratio of jerk to rate noise chosen by
+      generalised cross-validation (the engine's `sensors::smooth_rates`; equal to the cubic smoothing spline of
+      the rates with that ratio as its penalty). No window to choose: the bandwidth follows the noise the record
+      shows. It is a whole-record (two-pass) smoother; online it would run as a fixed-lag smoother."""
     kind = mode.get("accelerations", "exact")
     if kind == "central_difference":
         return lambda x, h: np.gradient(x, h, axis=0)
+    if kind == "rts":
+        from ..sensors import smooth_rates
+
+        return lambda x, h: smooth_rates(x, h)["accel"]
     w = int(mode.get("savgol_window", SAVGOL_WINDOW))
     p = int(mode.get("savgol_polyorder", SAVGOL_POLYORDER))
     if w < 3 or w % 2 == 0:
@@ -218,10 +227,11 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         vs = vs + rng.normal(0.0, float(noise.get("velocity", 0.0)), vs.shape)
         as_ = as_ + rng.normal(0.0, float(noise.get("acceleration", 0.0)), as_.shape)
     keep = slice(None)
-    if mode.get("accelerations", "exact") in ("central_difference", "savgol"):
-        # v̇ from the sampled (possibly noisy) velocities by central differences or a Savitzky-Golay derivative
-        # (_derivative). The first and last samples are dropped (an online estimator runs one sample behind with
-        # central differences; (savgol_window - 1)/2 telemetry samples behind with Savitzky-Golay).
+    if mode.get("accelerations", "exact") in ("central_difference", "savgol", "rts"):
+        # v̇ from the sampled (possibly noisy) velocities by central differences, a Savitzky-Golay derivative or
+        # the RTS smoother (_derivative). The first and last samples are dropped (an online estimator runs one
+        # sample behind with central differences; (savgol_window - 1)/2 telemetry samples behind with
+        # Savitzky-Golay; a few of the smoother's bandwidths behind with a fixed-lag RTS smoother).
         if tel is None:
             d = _derivative(mode, len(vs), "samples (one every sample_period)")
             as_ = _central_difference(model, planar, qs, vs, sc.sample_period, d)
@@ -233,7 +243,7 @@ def measure(model, sim: dict, sc: Scenario, rng: np.random.Generator | None = No
         keep = slice(1, -1)
     elif mode.get("accelerations", "exact") != "exact":
         raise InputError(
-            "measurement.accelerations: expected 'exact', 'central_difference' or 'savgol', got "
+            "measurement.accelerations: expected 'exact', 'central_difference', 'savgol' or 'rts', got "
             f"{mode['accelerations']!r}"
         )
     elif "savgol_window" in mode or "savgol_polyorder" in mode:

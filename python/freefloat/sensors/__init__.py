@@ -40,6 +40,7 @@ __all__ = [
     "naveen",
     "load",
     "measure",
+    "smooth_rates",
 ]
 
 
@@ -415,3 +416,16 @@ def measure(model, run, sensors, seed: int = 0) -> Measurement:
         rate_noise=[float(x) for x in sig] if np.any(sig > 0) else None,
     )
     return Measurement(streams=streams, telemetry=telem, sensors=sset, seed=int(seed))
+
+
+def smooth_rates(y, h: float, log_ratio: float | None = None) -> dict:
+    """Accelerations from noisy rates: the Rauch-Tung-Striebel smoother of the white-jerk rate model (the state is
+    a rate and its derivative, the jerk white with density q, the rate measured with white noise of variance r),
+    applied to each column of `y` (N, k), sampled every `h` seconds. `log_ratio` fixes log10(q h³ / r) for every
+    column; None (the default) gives each column the ratio that minimises its generalised cross-validation score
+    (Craven & Wahba 1979), so the bandwidth follows the noise the record shows. The prior on the first sample is
+    diffuse, which makes the smoothed rate the cubic smoothing spline of the rates with penalty r/q. Returns
+    {"rate": (N, k), "accel": (N, k), "log_ratio": (k,), "sigma": (k,) the estimated white rate noise per
+    sample}. Computed by the engine (`sensors::smooth_rates`); docs/postcapture.md measures it against central
+    differences and Savitzky-Golay."""
+    return _core.smooth_rates(np.ascontiguousarray(np.asarray(y, float)), float(h), log_ratio)
