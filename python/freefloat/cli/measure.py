@@ -34,10 +34,14 @@ def _load_run(path: Path):
     "--sensors",
     "sensors_spec",
     required=True,
-    help="A sensors file (YAML or JSON: a `sensors:` list, each entry with `type:` gyro, star_tracker, encoder, "
-    "tachometer, base_velocity, base_position or force_torque, its `rate:` [Hz], `latency:` [s] and error "
-    "parameters; optionally `telemetry: {poses: integrate|measured, rate: Hz}`; see docs/sensors.md), or a "
-    "preset name: naveen (Naveen, Shah, Misra's white rate noise at every sample of the run).",
+    help="A preset name or a sensors file. Presets by hardware class, each a gyro, base velocity, joint "
+    "tachometers and encoders at 100 Hz with datasheet figures: mems (industrial MEMS IMU, ADIS16470 class), "
+    "tactical (tactical fibre-optic gyro, KVH DSP-1750 class), navigation (navigation-grade IMU, Honeywell HG9900 "
+    "class); and naveen (Naveen, Shah, Misra's white rate noise at every sample of the run). A sensors file is "
+    "YAML or JSON: a `sensors:` list, each entry with `type:` gyro, star_tracker, encoder, tachometer, "
+    "base_velocity, base_position or force_torque, its `rate:` [Hz], `latency:` [s] and error parameters, "
+    "optionally `telemetry: {poses: integrate|measured, rate: Hz}`; or `preset: tactical` (or "
+    "`preset: {name: tactical, rate: 50}`) plus more `sensors:`. Numbers and sources: docs/sensors.md.",
 )
 @click.option("--out", required=True, type=click.Path(path_type=Path), help="Directory for the telemetry files.")
 @click.option("--seed", type=int, default=0, show_default=True, help="Seed of the sensors' random errors.")
@@ -59,8 +63,8 @@ def measure_cmd(run, sensors_spec, out, seed, model_spec):
     the rate sensors' white noise, so the errors-in-variables bias removal is applied), OUT/sensor_<name>.csv
     (each sensor's own samples, force/torque included) and OUT/results.json.
 
-    Example:  freefloat simulate naveen_robot --t-final 20 --out run &&
-    freefloat measure run --sensors naveen --out telem"""
+    Example:  freefloat simulate naveen_dual_arm --t-final 20 --out run &&
+    freefloat measure run --sensors tactical --out telem"""
     from .. import sensors as sn
 
     traj = _load_run(run)

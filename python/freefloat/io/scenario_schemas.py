@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any
 
-from pydantic import Field, PlainValidator, model_validator
+from pydantic import BeforeValidator, Field, PlainValidator, model_validator
 
 from ..actuators import WHEEL_DEFAULTS
 from .schema import (
@@ -760,6 +760,29 @@ Sensor = Annotated[
 ]
 
 
+def _sensors_preset(x):
+    """`sensors: {preset: NAME}` or `{preset: {name: NAME, rate: Hz, ...}}`: a preset of freefloat.sensors
+    written out as its list of sensors, then checked as if the file had listed them."""
+    if not isinstance(x, dict):
+        return x
+    if set(x) != {"preset"}:
+        raise _Bad(
+            "expected a list of sensors or a mapping {preset: NAME} (or {preset: {name: NAME, rate: Hz, ...}}), "
+            f"got the keys {', '.join(map(str, x))}"
+        )
+    from .. import sensors
+    from .._core import InputError
+
+    try:
+        return sensors.load({"preset": x["preset"]}).to_dicts()
+    except InputError as e:
+        raise _Bad(str(e)) from None
+
+
+#: a list of sensors, or a preset that stands for one
+SensorsBlock = Annotated[list[Sensor], BeforeValidator(_sensors_preset)]
+
+
 class TelemetryBlock(Block):
     poses: literal("integrate", "measured") = "integrate"
     rate: Positive | None = None
@@ -798,7 +821,7 @@ _NOT_APPLIED = {
 for _name, _block in (
     ("actuators", ActuatorsBlock),
     ("environment", EnvironmentBlock),
-    ("sensors", list[Sensor]),
+    ("sensors", SensorsBlock),
     ("telemetry", TelemetryBlock),
 ):
     # a mission's detumble is a post-capture run: its own sensors replace the detumble scenario's; actuators and

@@ -15,7 +15,9 @@ identification method reads (docs/sensors.md).
 
 from __future__ import annotations
 
+import inspect
 import json
+import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -38,6 +40,14 @@ __all__ = [
     "Measurement",
     "PRESETS",
     "naveen",
+    "mems",
+    "tactical",
+    "navigation",
+    "GyroSheet",
+    "EncoderSheet",
+    "ForceTorqueSheet",
+    "HARDWARE",
+    "FORCE_TORQUE",
     "load",
     "measure",
     "smooth_rates",
@@ -202,13 +212,283 @@ def naveen(
     )
 
 
-#: built-in sensor sets by name (`--preset` on the command line)
-PRESETS = {"naveen": naveen}
+# -- presets by hardware class ------------------------------------------------------------------------------
+# Each preset stands for a class of hardware through one product's datasheet figures, kept below in the
+# datasheet's own units with the document they come from; the SI values are computed from them here (and the
+# tests recompute them), and docs/sensors.md tabulates both. Conversions:
+#   1 °/√h = (π/180)/60 rad/√s ≈ 2.909e-4 rad/s/√Hz (angle random walk N; a rad/√s is a rad/s/√Hz)
+#   1 °/s/√Hz = π/180 rad/s/√Hz ≈ 1.745e-2 rad/s/√Hz
+#   1 °/h = (π/180)/3600 rad/s ≈ 4.848e-6 rad/s (bias instability B)
+DEG = math.pi / 180.0
+DEG_PER_SQRT_HOUR = DEG / 60.0
+DEG_PER_HOUR = DEG / 3600.0
+
+
+@dataclass(frozen=True)
+class GyroSheet:
+    """A rate gyro's datasheet figures in the datasheet's units: angle random walk `arw_deg_per_sqrt_h` [°/√h]
+    or a rate noise density `density_deg_per_s_per_sqrt_hz` [°/s/√Hz] (the same white noise in other units),
+    bias instability `bias_instability_deg_per_h` [°/h]; `correlation_time_s` is the Gauss-Markov stand-in's
+    T_c, which the datasheets do not give (an assumption, see docs/sensors.md). No rate random walk: none of
+    the cited datasheets specifies one."""
+
+    product: str
+    document: str
+    bias_instability_deg_per_h: float
+    correlation_time_s: float
+    arw_deg_per_sqrt_h: float | None = None
+    density_deg_per_s_per_sqrt_hz: float | None = None
+
+    @property
+    def noise_density(self) -> float:
+        """N [rad/s/√Hz]."""
+        if self.arw_deg_per_sqrt_h is not None:
+            return self.arw_deg_per_sqrt_h * DEG_PER_SQRT_HOUR
+        return self.density_deg_per_s_per_sqrt_hz * DEG
+
+    @property
+    def bias_instability(self) -> float:
+        """B [rad/s]."""
+        return self.bias_instability_deg_per_h * DEG_PER_HOUR
+
+
+@dataclass(frozen=True)
+class EncoderSheet:
+    """A joint angle sensor's datasheet figures: `counts_per_rev` (the output's resolution) and its white
+    `noise` [rad rms] (0 when the datasheet gives none), with how the noise was read (`noise_note`)."""
+
+    product: str
+    document: str
+    counts_per_rev: float
+    noise: float = 0.0
+    noise_note: str = ""
+
+    @property
+    def resolution(self) -> float:
+        """Δ [rad]."""
+        return 2.0 * math.pi / self.counts_per_rev
+
+
+@dataclass(frozen=True)
+class ForceTorqueSheet:
+    """A six-axis force/torque sensor's noise [N, N·m] and where it comes from."""
+
+    product: str
+    document: str
+    force_noise: float
+    torque_noise: float
+
+
+#: RESOLUTE's ring: the smallest listed diameter [m] (the largest angle for a given jitter)
+_RESOLUTE_RING_DIAMETER = 0.052
+
+#: the hardware each preset stands for (docs/sensors.md, "Presets by hardware class", cites each document)
+HARDWARE = {
+    "mems": {
+        "gyro": GyroSheet(
+            product="Analog Devices ADIS16470 (industrial MEMS IMU)",
+            document="ADIS16470 data sheet, features list: 0.008 °/s/√Hz rms rate noise density, 8 °/h in-run "
+            "bias stability",
+            density_deg_per_s_per_sqrt_hz=0.008,
+            bias_instability_deg_per_h=8.0,
+            correlation_time_s=100.0,
+        ),
+        "encoder": EncoderSheet(
+            product="ams AS5048A (14-bit magnetic rotary encoder)",
+            document="AS5048A/AS5048B data sheet v1-06: 14-bit resolution (0.0219 °/LSB), sensor output noise "
+            "0.06 ° rms (maximum)",
+            counts_per_rev=2.0**14,
+            noise=0.06 * DEG,
+            noise_note="the data sheet's maximum output noise, 0.06 ° rms, taken as the noise",
+        ),
+    },
+    "tactical": {
+        "gyro": GyroSheet(
+            product="KVH DSP-1750 / DSP-1760 (tactical fibre-optic gyro)",
+            document="KVH DSP-1760 data sheet: angle random walk ≤ 0.012 °/√h (≤ 0.7 °/h/√Hz); KVH DSP-1750 "
+            "technical manual: bias instability 0.05 °/h",
+            arw_deg_per_sqrt_h=0.012,
+            bias_instability_deg_per_h=0.05,
+            correlation_time_s=1000.0,
+        ),
+        "encoder": EncoderSheet(
+            product="ROBOTIS DYNAMIXEL-P PH54-200-S500-R (geared servo actuator)",
+            document="ROBOTIS e-Manual, PH54-200-S500-R specifications: resolution 1,003,846 pulse/rev at the "
+            "output (gear ratio 501.923:1, backlash < 6 arcmin)",
+            counts_per_rev=1_003_846.0,
+            noise=0.0,
+            noise_note="no noise figure in the specification; quantisation only",
+        ),
+    },
+    "navigation": {
+        "gyro": GyroSheet(
+            product="Honeywell HG9900 (navigation-grade ring-laser-gyro IMU)",
+            document="HG9900 IMU brochure N61-1638-000-000: angle random walk 0.002 °/√h (max), gyro bias "
+            "0.0035 °/h (1σ)",
+            arw_deg_per_sqrt_h=0.002,
+            bias_instability_deg_per_h=0.0035,
+            correlation_time_s=3600.0,
+        ),
+        "encoder": EncoderSheet(
+            product="Renishaw RESOLUTE absolute optical encoder with a Ø52 mm RESA/REXA ring",
+            document="Renishaw RESOLUTE rotary (angle) product pages: resolutions to 32 bits/rev, jitter "
+            "< 10 nm RMS, rings from Ø52 mm",
+            counts_per_rev=2.0**32,
+            noise=10e-9 / (_RESOLUTE_RING_DIAMETER / 2.0),
+            noise_note="10 nm RMS jitter at the scale, on the Ø52 mm ring's radius: 10 nm / 26 mm rad",
+        ),
+    },
+}
+
+#: one force/torque class for every preset (the F/T sensor does not follow the IMU's grade)
+FORCE_TORQUE = ForceTorqueSheet(
+    product="ATI Axia80-M20, calibration SI-500-20 (Fx, Fy 500 N; Fz 900 N; Tx, Ty, Tz 20 N·m)",
+    document="ATI manual 9610-05-Ethernet Axia: unloaded jumps above 0.05 % of full scale are abnormal; 0.05 % of "
+    "500 N and of 20 N·m, taken as the noise (an upper bound, not a measured noise)",
+    force_noise=0.0005 * 500.0,
+    torque_noise=0.0005 * 20.0,
+)
+
+
+def _preset_rate(rate) -> float:
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (math.isfinite(rate) and rate > 0):
+        raise InputError(f"preset rate: expected a positive number of Hz, got {rate!r}")
+    return float(rate)
+
+
+def _hardware_class(cls: str, rate, force_torque, base_velocity_noise) -> SensorSet:
+    rate = _preset_rate(rate)
+    period = 1.0 / rate
+    g, e = HARDWARE[cls]["gyro"], HARDWARE[cls]["encoder"]
+    n = g.noise_density
+    if base_velocity_noise is None:
+        # modelling convention, not a datasheet figure (see `mems`): the gyro's density times a 1 m lever arm
+        base_velocity_noise = n * 1.0 / math.sqrt(period)
+    elif isinstance(base_velocity_noise, bool) or not isinstance(base_velocity_noise, (int, float)):
+        raise InputError(f"preset base_velocity_noise: expected a number of m/s, got {base_velocity_noise!r}")
+    # joint rates: the difference of two successive encoder readings over one period (see `mems`)
+    tach_noise = math.sqrt(2.0 * e.noise**2 + e.resolution**2 / 6.0) / period
+    sensors = [
+        BaseVelocity(rate=rate, noise=float(base_velocity_noise)),
+        Gyro(
+            rate=rate,
+            noise_density=n,
+            bias_instability=g.bias_instability,
+            bias_correlation_time=g.correlation_time_s,
+        ),
+        Tachometer(rate=rate, noise=tach_noise),
+        Encoder(rate=rate, counts_per_rev=e.counts_per_rev, noise=e.noise),
+    ]
+    if force_torque is not None:
+        if not isinstance(force_torque, str) or not force_torque:
+            raise InputError(f"preset force_torque: expected a joint name, got {force_torque!r}")
+        ft = FORCE_TORQUE
+        sensors.append(
+            ForceTorque(rate=rate, joint=force_torque, force_noise=ft.force_noise, torque_noise=ft.torque_noise)
+        )
+    return SensorSet(sensors, poses="integrate")
+
+
+def mems(rate: float = 100.0, force_torque: str | None = None, base_velocity_noise: float | None = None) -> SensorSet:
+    """Industrial MEMS class: the sensors of a low-cost free-flyer, sampled at `rate` [Hz] (100: the usual
+    telemetry rate), poses rebuilt by integrating the rates (as `naveen`). Figures in `HARDWARE["mems"]`,
+    sources and SI values in docs/sensors.md ("Presets by hardware class").
+
+    - gyro: Analog Devices ADIS16470, N = 0.008 °/s/√Hz = 1.396e-4 rad/s/√Hz, B = 8 °/h = 3.879e-5 rad/s
+      as a Gauss-Markov bias of T_c = 100 s (T_c assumed; the data sheet gives none), no rate random walk and
+      no constant bias (a turn-on bias is taken as calibrated out);
+    - joint encoders: ams AS5048A, 14 bits/rev, white noise 0.06 ° rms (the data sheet's maximum), every
+      revolute joint (a prismatic joint needs its own encoder with `resolution` [m]);
+    - joint tachometers: the encoder differenced, below;
+    - base velocity: a modelling convention, below;
+    - `force_torque`: a joint name adds a six-axis force/torque sensor of class `FORCE_TORQUE` (ATI Axia80)
+      measuring the wrench that joint transmits.
+
+    Joint rates. A joint with only a position sensor reports its rate as the difference of two successive
+    readings over the period P: ω̃_k = (θ̃_k − θ̃_{k−1})/P. The reading errors (white noise σ_n and quantisation
+    of variance Δ²/12, independent from one reading to the next when the joint crosses many counts) give the
+    rate an error of variance (2σ_n² + Δ²/6)/P², so the tachometer's white noise is derived from the encoder
+    and the rate rather than quoted: σ_ω = √(2σ_n² + Δ²/6)/P, which grows as the rate rises (0.149 rad/s here
+    at 100 Hz, the AS5048A's noise dominating). A dedicated rate sensor or a filter in the joint's controller
+    would do better; give your own `Tachometer` then. Two things the white model leaves out: successive
+    differences share a reading (their errors have a lag-one correlation of −1/2, so the angle integrated from
+    them stays within the encoder's error where the white model lets it random-walk), and a difference is the
+    mean rate over the period, not the rate at its end.
+
+    Base velocity. No inertial sensor measures the base's linear velocity: an accelerometer's integral drifts
+    as a random walk, which the `base_velocity` model (white noise and bias) cannot represent, and relative
+    navigation (a camera or lidar on the target) has no single datasheet class. So its noise is a modelling
+    convention, not a datasheet figure: a white density equal to the gyro's N times a 1 m lever arm,
+    σ_v = N·(1 m)/√P per sample, which keeps the classes in order; `base_velocity_noise` [m/s per sample]
+    overrides it."""
+    return _hardware_class("mems", rate, force_torque, base_velocity_noise)
+
+
+def tactical(
+    rate: float = 100.0, force_torque: str | None = None, base_velocity_noise: float | None = None
+) -> SensorSet:
+    """Tactical fibre-optic-gyro class, built as `mems` (read its notes on joint rates and base velocity):
+
+    - gyro: KVH DSP-1750 / DSP-1760, N = 0.012 °/√h = 3.491e-6 rad/s/√Hz, B = 0.05 °/h = 2.424e-7 rad/s as
+      a Gauss-Markov bias of T_c = 1000 s (assumed);
+    - joint encoders: ROBOTIS DYNAMIXEL-P PH54-200-S500-R geared actuator, 1,003,846 pulses per output
+      revolution, no noise figure (quantisation only; its backlash, < 6 arcmin, is not modelled);
+    - joint tachometers: the encoder differenced, σ_ω = Δ/(P√6) = 2.56e-4 rad/s at 100 Hz;
+    - base velocity: N·(1 m)/√P per sample (convention), or `base_velocity_noise`;
+    - `force_torque`: a joint name adds the ATI Axia80 class force/torque sensor."""
+    return _hardware_class("tactical", rate, force_torque, base_velocity_noise)
+
+
+def navigation(
+    rate: float = 100.0, force_torque: str | None = None, base_velocity_noise: float | None = None
+) -> SensorSet:
+    """Navigation-grade class (ring-laser-gyro IMU, precision optical joint encoders), built as `mems` (read
+    its notes on joint rates and base velocity):
+
+    - gyro: Honeywell HG9900, N = 0.002 °/√h = 5.818e-7 rad/s/√Hz, B = 0.0035 °/h = 1.697e-8 rad/s as a
+      Gauss-Markov bias of T_c = 3600 s (assumed);
+    - joint encoders: Renishaw RESOLUTE, 32 bits/rev, white noise of its < 10 nm RMS jitter on a Ø52 mm
+      ring, 10 nm / 26 mm = 3.85e-7 rad;
+    - joint tachometers: the encoder differenced, 5.44e-5 rad/s at 100 Hz (the jitter dominating);
+    - base velocity: N·(1 m)/√P per sample (convention), or `base_velocity_noise`;
+    - `force_torque`: a joint name adds the ATI Axia80 class force/torque sensor."""
+    return _hardware_class("navigation", rate, force_torque, base_velocity_noise)
+
+
+#: built-in sensor sets by name (`--sensors NAME` on the command line, `preset:` in a sensors file)
+PRESETS = {"naveen": naveen, "mems": mems, "tactical": tactical, "navigation": navigation}
+
+
+def _known_presets() -> str:
+    return ", ".join(PRESETS)
+
+
+def _from_preset(spec) -> SensorSet:
+    """A preset's SensorSet from `NAME` or `{name: NAME, <option>: value, ...}` (the preset function's keyword
+    arguments: `rate`, `force_torque`, `base_velocity_noise`; naveen: `sigma_lin`, `sigma_ang`, `sigma_joint`,
+    `rate`)."""
+    if isinstance(spec, dict):
+        opts = dict(spec)
+        name = opts.pop("name", None)
+        if name is None:
+            raise InputError(f"preset: a mapping needs `name:` (one of {_known_presets()}), got {spec!r}")
+    else:
+        name, opts = spec, {}
+    if not isinstance(name, str) or name not in PRESETS:
+        raise InputError(f"preset: unknown preset {name!r} (known: {_known_presets()})")
+    fn = PRESETS[name]
+    params = list(inspect.signature(fn).parameters)
+    for k in opts:
+        if k not in params:
+            raise InputError(f"preset.{k}: not an option of preset '{name}' (its options: {', '.join(params)})")
+    return fn(**opts)
 
 
 def load(spec) -> SensorSet:
     """A SensorSet from a SensorSet, a list of sensors (objects or dicts), a dict with `sensors:` and optionally
-    `telemetry: {rate, poses}`, a preset name, or a YAML/JSON file holding one of those."""
+    `telemetry: {rate, poses}`, a preset name (see PRESETS), a dict with `preset:` (a name, or
+    `{name: NAME, rate: Hz, ...}` with the preset's options) plus optionally more `sensors:`, or a YAML/JSON file
+    holding one of those."""
     if isinstance(spec, SensorSet):
         return spec
     if isinstance(spec, str) and spec in PRESETS:
@@ -216,7 +496,12 @@ def load(spec) -> SensorSet:
     if isinstance(spec, (str, Path)):
         p = Path(spec)
         if not p.exists():
-            raise FileNotFoundError(f"sensors file not found: {p} (or a preset: {', '.join(PRESETS)})")
+            if isinstance(spec, str) and not p.suffix and len(p.parts) == 1:
+                # a bare word: meant as a preset, most likely
+                raise InputError(
+                    f"sensors: unknown preset {spec!r} (known: {_known_presets()}) and no sensors file of that name"
+                )
+            raise FileNotFoundError(f"sensors file not found: {p} (or a preset: {_known_presets()})")
         import yaml
 
         try:
@@ -235,10 +520,7 @@ def load(spec) -> SensorSet:
         if not isinstance(tel, dict) or set(tel) - {"rate", "poses"}:
             raise InputError(f"telemetry: expected a mapping with keys rate, poses; got {tel!r}")
         if "preset" in spec:
-            name = spec["preset"]
-            if name not in PRESETS:
-                raise InputError(f"preset: unknown preset {name!r} (known: {', '.join(PRESETS)})")
-            base = PRESETS[name]()
+            base = _from_preset(spec["preset"])
             sensors = base.sensors + list(spec.get("sensors") or [])
             poses = tel.get("poses", base.poses)
         else:
@@ -246,7 +528,10 @@ def load(spec) -> SensorSet:
                 raise InputError("sensors file: missing the `sensors:` list (or `preset:`)")
             sensors, poses = list(spec["sensors"] or []), tel.get("poses", "integrate")
         return SensorSet(sensors, poses=poses, telemetry_rate=tel.get("rate"))
-    raise InputError(f"argument `sensors`: expected a SensorSet, a list, a dict, a preset name or a file, got {spec!r}")
+    raise InputError(
+        f"argument `sensors`: expected a SensorSet, a list, a dict, a preset name ({_known_presets()}) or a file, "
+        f"got {spec!r}"
+    )
 
 
 @dataclass
