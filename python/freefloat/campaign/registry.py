@@ -264,6 +264,31 @@ def run_minimal(scenario: dict, seed: int) -> dict:
     return out
 
 
+# -- identification error by sensor class (every estimator on the sensor presets) ----------------------------
+SENSOR_CLASSES_DEFAULTS = {"estimator": "zhang", "sensor_class": "tactical", "horizons": [10.0, 30.0, 100.0]}
+
+
+def _scl_load(ref) -> dict:
+    d = copy.deepcopy(SENSOR_CLASSES_DEFAULTS)
+    if not isinstance(ref, dict):
+        raise InputError(f"scenario of kind sensor_classes: expected a mapping with keys {', '.join(d)}, got {ref!r}")
+    unknown = [k for k in ref if k not in d and k != "name"]
+    if unknown:
+        raise InputError(f"sensor_classes scenario: unknown key '{unknown[0]}'; keys: {', '.join(d)}")
+    d.update({k: v for k, v in ref.items() if k != "name"})
+    return _json_roundtrip(d)
+
+
+def run_sensor_classes(scenario: dict, seed: int) -> dict:
+    """One estimator on telemetry from one sensor preset with `seed` -> relative errors of mass, centre of mass
+    and inertia at each horizon (`identification.sensor_classes.run`)."""
+    from ..identification import sensor_classes as scl
+
+    t0 = time.perf_counter()
+    out = scl.run(scenario["estimator"], scenario["sensor_class"], seed, scenario.get("horizons", scl.HORIZONS))
+    return {**out, "wall_s": time.perf_counter() - t0}
+
+
 def _builtin_kinds() -> None:
     register(
         Kind(
@@ -288,6 +313,19 @@ def _builtin_kinds() -> None:
             run=run_minimal,
             normalize=_json_roundtrip,
             headline=("ls.median_rel_error_pct", "eiv.median_rel_error_pct", "ls.max_rel_error_pct"),
+        )
+    )
+    register(
+        Kind(
+            name="sensor_classes",
+            description="identification error by sensor class: an estimator (zhang, naveen, cl) on telemetry "
+            "from a sensor preset (navigation, tactical, mems), errors of mass, centre of mass and inertia at each "
+            "horizon (scenario: a mapping over estimator, sensor_class, horizons)",
+            load=_scl_load,
+            parameters=lambda base: ["estimator", "sensor_class", "horizons"],
+            run=run_sensor_classes,
+            normalize=_json_roundtrip,
+            headline=("zhang_momentum.inertia.100", "zhang_force.inertia.100", "naveen_eiv.inertia.100"),
         )
     )
     from .file_kinds import register_all

@@ -44,8 +44,9 @@ def campaign_cmd(spec, out, list_, runs, workers, scheduler, retry_failed, repai
     random parameters). Each run's inputs and summary numbers become one row of a Parquet dataset in
     OUT/runs/ (readable by pyarrow, pandas, polars, DuckDB), written as runs finish. Kinds: postcapture
     (Zhang 2020), identify_minimal (Naveen et al.), identify_cl, control_adaptive and control_ddp (Valverde 2018
-    ch. 9, 4 and 8; their scenario files, e.g. valverde_ch9_two_arm with noise.wrench / noise.rate) and mission
-    (capture missions, e.g. zhang2020_capture_monte_carlo over target inertia and gyro noise).
+    ch. 9, 4 and 8; their scenario files, e.g. valverde_ch9_two_arm with noise.wrench / noise.rate), mission
+    (capture missions, e.g. zhang2020_capture_monte_carlo over target inertia and gyro noise) and sensor_classes
+    (every estimator on the navigation / tactical / MEMS sensor presets: sensor_class_monte_carlo).
 
     Re-running the same command skips the runs already in OUT (each run is keyed by a hash of its inputs), so
     an interrupted campaign (Ctrl-C) continues where it stopped. A run that raises is recorded with its error;

@@ -68,6 +68,8 @@ def _build(out: Path, page: Page) -> list[Path]:
             pngs += _postcapture(out, page, done, grid, paper)
         elif kind == "identify_minimal":
             pngs += _minimal(out, page, done, grid, paper)
+        elif kind == "sensor_classes":
+            _sensor_classes(page, done)
         else:
             _generic(page, done, grid)
     else:
@@ -365,6 +367,21 @@ def _png_minimal(out, t, lab, groups) -> Path:
     fig.savefig(p, dpi=110)
     plt.close(fig)
     return p
+
+
+# -- identification error by sensor class ---------------------------------------------------------------------
+def _sensor_classes(page, t):
+    from ..identification import sensor_classes as scl
+
+    rows = t.to_pylist()
+    horizons = scl.horizons_of(rows)
+    page.section("Identification error by sensor class (median / 95th percentile over the seeds)")
+    page.text(
+        "Relative error ‖θ̂ − θ‖/‖θ‖ of each parameter group (mass; centre of mass or first moments; inertia), the "
+        "worst body where there are several; — where the estimator gives none (ch. 9 knows the centres of mass)."
+    )
+    head = ["estimator", "class", "quantity", *[f"{h:g} s" for h in horizons], "runs"]
+    page.table(head, scl.table_rows(rows, horizons), left=3)
 
 
 # -- any kind ---------------------------------------------------------------------------------------------
