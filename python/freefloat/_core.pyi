@@ -648,11 +648,12 @@ def integrate(model: Model, q: ArrayLike, dq: ArrayLike) -> Any:
 a base-frame displacement and rotation vector), on R³ × SO(3).
     """
 
-def integrate_base_poses(t: ArrayLike, twists: ArrayLike, pose0: ArrayLike) -> Any:
+def integrate_base_poses(t: ArrayLike, twists: ArrayLike, pose0: ArrayLike, rates: ArrayLike | None = None) -> Any:
     """Base poses from sampled base twists by the trapezoidal rule on the group (`sim::integrate_base_poses`).
 Free base: `twists` (T, 6) = [v; ω] in the base frame, `pose0` (7) = position, quaternion x y z w;
 returns (T, 7). Planar base: `twists` (T, 3) = [vx, vy, yaw rate], `pose0` (3) = [x, y, yaw]; returns
-(T, 3). `t` (T,) the increasing sample times.
+(T, 3). `t` (T,) the increasing sample times. `rates` (the twists' shape): their time derivatives, for the
+fourth-order (Hermite) correction.
     """
 
 def integrate_jacobians(model: Model, q: ArrayLike, dq: ArrayLike) -> Any:
@@ -745,7 +746,7 @@ def skew(v: ArrayLike) -> Any:
 def smooth_rates(y: ArrayLike, h: ArrayLike, log_ratio: ArrayLike | None = None) -> Any:
     """Accelerations from noisy rates (`freefloat_core::sensors::smooth_rates`): the Rauch-Tung-Striebel smoother
 of the white-jerk rate model, per column of `y` (N, k) sampled every `h` seconds. `log_ratio`:
-log10(q h³ / r) for every column, or None for each column's maximum-likelihood ratio. Returns a dict: rate
+log10(q h³ / r) for every column, or None for each column's ratio by generalised cross-validation. Returns a dict: rate
 and accel (N, k), log_ratio and sigma (k,) (the estimated white rate noise per sample).
     """
 

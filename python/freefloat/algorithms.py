@@ -67,12 +67,14 @@ def base_twist_for_momentum(model, q, joint_rates, momentum=None):
     return _core.base_twist_for_momentum(model, q, joint_rates, momentum)
 
 
-def integrate_base_poses(t, twists, pose0):
+def integrate_base_poses(t, twists, pose0, rates=None):
     """Base poses from sampled base twists by the trapezoidal rule on the group (the engine's
     `sim::integrate_base_poses`). Free base: twists (T, 6) [v; ω] in the base frame, pose0 (7,) position and
     quaternion x y z w, returns (T, 7). Planar base: twists (T, 3) [vx, vy, yaw rate], pose0 (3,)
-    [x, y, yaw], returns (T, 3). t (T,) increasing times (steps may be uneven)."""
-    return _core.integrate_base_poses(as_f64(t, "t"), as_f64(twists, "twists"), as_f64(pose0, "pose0"))
+    [x, y, yaw], returns (T, 3). t (T,) increasing times (steps may be uneven). `rates` (the twists' shape):
+    their time derivatives at the samples, which add the fourth-order (Hermite) correction to every step."""
+    r = None if rates is None else as_f64(rates, "rates")
+    return _core.integrate_base_poses(as_f64(t, "t"), as_f64(twists, "twists"), as_f64(pose0, "pose0"), r)
 
 
 def generalized_jacobian(model, q, name: str, reference: str = "world", h0=None):

@@ -448,29 +448,29 @@ fn base_twist_base_poses_and_postcapture_rows_refuse_bad_input() {
     for (label, x) in bad(&tw) {
         let mut out = vec![0.0; 21];
         must_err(&format!("integrate_base_poses twists {label}"), &mut failures, || {
-            integrate_base_poses(Steps::Uniform(0.01), &x, &pose0, &mut out)
+            integrate_base_poses(Steps::Uniform(0.01), &x, None, &pose0, &mut out)
         });
     }
     for (label, x) in bad(&pose0) {
         let mut out = vec![0.0; 21];
         must_err(&format!("integrate_base_poses pose0 {label}"), &mut failures, || {
-            integrate_base_poses(Steps::Uniform(0.01), &tw, &x, &mut out)
+            integrate_base_poses(Steps::Uniform(0.01), &tw, None, &x, &mut out)
         });
     }
     for len in [0usize, 20, 22] {
         let mut out = vec![0.0; len];
         must_err(&format!("integrate_base_poses out {len}"), &mut failures, || {
-            integrate_base_poses(Steps::Uniform(0.01), &tw, &pose0, &mut out)
+            integrate_base_poses(Steps::Uniform(0.01), &tw, None, &pose0, &mut out)
         });
         let mut out = vec![0.0; len];
         must_err(&format!("integrate_planar_base_poses out {len}"), &mut failures, || {
-            integrate_planar_base_poses(Steps::Uniform(0.01), &tw[..9], &[0.0; 3], &mut out)
+            integrate_planar_base_poses(Steps::Uniform(0.01), &tw[..9], None, &[0.0; 3], &mut out)
         });
     }
     for times in [&[0.0, 0.1][..], &[][..], &[0.0, 0.1, 0.2, 0.3][..]] {
         let mut out = vec![0.0; 21];
         must_err(&format!("integrate_base_poses {} times", times.len()), &mut failures, || {
-            integrate_base_poses(Steps::Times(times), &tw, &pose0, &mut out)
+            integrate_base_poses(Steps::Times(times), &tw, None, &pose0, &mut out)
         });
     }
     // post-capture rows on the Zhang, Yue, Yuan 2020 robot (base 0, target = last body)

@@ -102,13 +102,16 @@ pub fn skew<'py>(py: Python<'py>, v: Arr<'_, 'py>) -> PyResult<Bound<'py, PyAny>
 /// Base poses from sampled base twists by the trapezoidal rule on the group (`sim::integrate_base_poses`).
 /// Free base: `twists` (T, 6) = [v; ω] in the base frame, `pose0` (7) = position, quaternion x y z w;
 /// returns (T, 7). Planar base: `twists` (T, 3) = [vx, vy, yaw rate], `pose0` (3) = [x, y, yaw]; returns
-/// (T, 3). `t` (T,) the increasing sample times.
+/// (T, 3). `t` (T,) the increasing sample times. `rates` (the twists' shape): their time derivatives, for the
+/// fourth-order (Hermite) correction.
 #[pyfunction]
+#[pyo3(signature = (t, twists, pose0, rates = None))]
 pub fn integrate_base_poses<'py>(
     py: Python<'py>,
     t: Arr<'_, 'py>,
     twists: Arr<'_, 'py>,
     pose0: Arr<'_, 'py>,
+    rates: Option<Arr<'_, 'py>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let (tl, t) = trailing("t", t, &[])?;
     let tw = array_arg(twists, "twists")?;
@@ -124,13 +127,26 @@ pub fn integrate_base_poses<'py>(
     let tw: Vec<f64> = tw.as_array().iter().copied().collect();
     let (_, p0) = trailing("pose0", pose0, &[])?;
     let n = shape[0];
+    let rates = match rates {
+        None => None,
+        Some(r) => {
+            let r = array_arg(r, "rates")?;
+            if r.shape() != shape.as_slice() {
+                return Err(input_err(format!(
+                    "argument `rates`: expected the twists' shape {shape:?}, got {:?}",
+                    r.shape()
+                )));
+            }
+            Some(r.as_array().iter().copied().collect::<Vec<f64>>())
+        }
+    };
     let mut out = vec![0.0; n * if width == 6 { 7 } else { 3 }];
     py.detach(|| {
         guard(|| {
             if width == 6 {
-                integrate_free(Steps::Times(&t), &tw, &p0, &mut out)
+                integrate_free(Steps::Times(&t), &tw, rates.as_deref(), &p0, &mut out)
             } else {
-                integrate_planar_base_poses(Steps::Times(&t), &tw, &p0, &mut out)
+                integrate_planar_base_poses(Steps::Times(&t), &tw, rates.as_deref(), &p0, &mut out)
             }
         })
     })?;

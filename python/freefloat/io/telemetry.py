@@ -355,7 +355,7 @@ def add_noise(
     )
 
 
-def integrate_poses(model, t, v, q0) -> np.ndarray:
+def integrate_poses(model, t, v, q0, rule: str = "trapezoid") -> np.ndarray:
     """Configurations (T, nq) obtained by integrating velocities v (T, nv) from q0 at times t (T,).
 
     The paper (Appendix C, eqs. 44–47) uses explicit Euler on the base position, Z-X-Y Euler angles and
@@ -369,9 +369,17 @@ def integrate_poses(model, t, v, q0) -> np.ndarray:
     pose. Time steps may be uneven.
 
     The base pose is the engine's `integrate_base_poses` (one copy of the rule, shared with the exciting-
-    trajectory design); the joints' trapezoid is a cumulative sum here."""
+    trajectory design); the joints' trapezoid is a cumulative sum here.
+
+    `rule="hermite"`: fourth order. Every step adds the endpoint correction of the cubic Hermite interpolant,
+    h²/12 (a_k − a_{k+1}) for the joints (a the rates' derivative), and the engine's fourth-order correction for the
+    base (its Magnus term for the attitude). The derivatives are the rates' second-order differences
+    (`np.gradient`, one-sided at the ends), whose O(h²) error changes the step only at O(h⁵). On noisy rates the
+    correction adds about a twelfth of the trapezoid's own noise per step."""
     from ..algorithms import integrate_base_poses
 
+    if rule not in ("trapezoid", "hermite"):
+        raise InputError(f"integrate_poses: rule must be 'trapezoid' or 'hermite', got {rule!r}")
     t = np.asarray(t, dtype=float)
     v = np.asarray(v, dtype=float)
     q = np.empty((len(t), model.nq))
@@ -379,12 +387,16 @@ def integrate_poses(model, t, v, q0) -> np.ndarray:
     dt = np.diff(t)[:, None]
     nb = _base_dofs(model)
     jq, jv = _joint_slices(model)
-    # Joints: cumulative trapezoid, vectorised.
-    q[1:, jq] = q0[jq] + np.cumsum((v[:-1, jv] + v[1:, jv]) * dt / 2, axis=0)
+    a = np.gradient(v, t, axis=0, edge_order=2) if rule == "hermite" and len(t) >= 3 else None
+    # Joints: cumulative trapezoid (and its Hermite correction), vectorised.
+    step = (v[:-1, jv] + v[1:, jv]) * dt / 2
+    if a is not None:
+        step = step + (a[:-1, jv] - a[1:, jv]) * dt**2 / 12
+    q[1:, jq] = q0[jq] + np.cumsum(step, axis=0)
     if nb == 6:
-        q[:, 0:7] = integrate_base_poses(t, v[:, 0:6], q0[0:7])
+        q[:, 0:7] = integrate_base_poses(t, v[:, 0:6], q0[0:7], None if a is None else a[:, 0:6])
     elif nb == 3:
-        q[:, 0:3] = integrate_base_poses(t, v[:, 0:3], q0[0:3])
+        q[:, 0:3] = integrate_base_poses(t, v[:, 0:3], q0[0:3], None if a is None else a[:, 0:3])
     return q
 
 

@@ -157,21 +157,33 @@ _TYPES = {c.TYPE: c for c in (Gyro, StarTracker, Encoder, Tachometer, BaseVeloci
 #: rebuilt by integrating the measured rates from the true initial configuration) or "measured" (from a
 #: star tracker, encoders and a base position sensor)
 POSES = ("integrate", "measured")
+#: the rule that integrates the rates into poses (poses="integrate"): "trapezoid" (second order) or "hermite"
+#: (fourth order, the default: the trapezoid plus the endpoint correction from the rates' derivatives, differenced
+#: from the telemetry; `io.telemetry.integrate_poses`)
+INTEGRATION = ("trapezoid", "hermite")
+#: the default rule: fourth order (the trapezoid's error dominated the momentum form's with tactical sensors:
+#: docs/sensors.md, "Identification error by sensor class"); the `naveen` preset keeps the paper's trapezoid
+DEFAULT_INTEGRATION = "hermite"
 
 
 @dataclass
 class SensorSet:
-    """A list of sensors and how their streams become one telemetry table: `poses` (see POSES) and
-    `telemetry_rate` [Hz] (None: the rate of the fastest sensor feeding q or v; slower sensors are held, as a
-    flight computer's telemetry frame holds the latest sample)."""
+    """A list of sensors and how their streams become one telemetry table: `poses` (see POSES), `integration`
+    (see INTEGRATION) and `telemetry_rate` [Hz] (None: the rate of the fastest sensor feeding q or v; slower sensors
+    are held, as a flight computer's telemetry frame holds the latest sample)."""
 
     sensors: list = field(default_factory=list)
     poses: str = "integrate"
     telemetry_rate: float | None = None
+    integration: str = DEFAULT_INTEGRATION
 
     def __post_init__(self):
         if self.poses not in POSES:
             raise InputError(f"telemetry.poses: expected one of {', '.join(POSES)}, got {self.poses!r}")
+        if self.integration not in INTEGRATION:
+            raise InputError(
+                f"telemetry.integration: expected one of {', '.join(INTEGRATION)}, got {self.integration!r}"
+            )
         if self.telemetry_rate is not None and not (float(self.telemetry_rate) > 0):
             raise InputError(f"telemetry.rate: must be a positive number of Hz, got {self.telemetry_rate!r}")
 
@@ -189,6 +201,7 @@ class SensorSet:
         d = {"sensors": self.to_dicts(), "telemetry": {"poses": self.poses}}
         if self.telemetry_rate is not None:
             d["telemetry"]["rate"] = float(self.telemetry_rate)
+        d["telemetry"]["integration"] = self.integration
         return d
 
 
@@ -209,6 +222,7 @@ def naveen(
             Tachometer(rate=rate, noise=float(sigma_joint)),
         ],
         poses="integrate",
+        integration="trapezoid",  # Appendix C's reconstruction, as `add_noise` (a second-order rule)
     )
 
 
@@ -486,7 +500,7 @@ def _from_preset(spec) -> SensorSet:
 
 def load(spec) -> SensorSet:
     """A SensorSet from a SensorSet, a list of sensors (objects or dicts), a dict with `sensors:` and optionally
-    `telemetry: {rate, poses}`, a preset name (see PRESETS), a dict with `preset:` (a name, or
+    `telemetry: {rate, poses, integration}`, a preset name (see PRESETS), a dict with `preset:` (a name, or
     `{name: NAME, rate: Hz, ...}` with the preset's options) plus optionally more `sensors:`, or a YAML/JSON file
     holding one of those."""
     if isinstance(spec, SensorSet):
@@ -517,17 +531,18 @@ def load(spec) -> SensorSet:
                 f"sensors file: unknown top-level key(s) {sorted(unknown)} (known: sensors, telemetry, preset)"
             )
         tel = spec.get("telemetry") or {}
-        if not isinstance(tel, dict) or set(tel) - {"rate", "poses"}:
-            raise InputError(f"telemetry: expected a mapping with keys rate, poses; got {tel!r}")
+        if not isinstance(tel, dict) or set(tel) - {"rate", "poses", "integration"}:
+            raise InputError(f"telemetry: expected a mapping with keys rate, poses, integration; got {tel!r}")
         if "preset" in spec:
             base = _from_preset(spec["preset"])
             sensors = base.sensors + list(spec.get("sensors") or [])
-            poses = tel.get("poses", base.poses)
+            poses, integration = tel.get("poses", base.poses), tel.get("integration", base.integration)
         else:
             if "sensors" not in spec:
                 raise InputError("sensors file: missing the `sensors:` list (or `preset:`)")
             sensors, poses = list(spec["sensors"] or []), tel.get("poses", "integrate")
-        return SensorSet(sensors, poses=poses, telemetry_rate=tel.get("rate"))
+            integration = tel.get("integration", DEFAULT_INTEGRATION)
+        return SensorSet(sensors, poses=poses, telemetry_rate=tel.get("rate"), integration=integration)
     raise InputError(
         f"argument `sensors`: expected a SensorSet, a list, a dict, a preset name ({_known_presets()}) or a file, "
         f"got {spec!r}"
@@ -688,7 +703,7 @@ def measure(model, run, sensors, seed: int = 0) -> Measurement:
     if sset.poses == "measured":
         qm = np.column_stack([column(c) for c in need_q])
     else:
-        qm = integrate_poses(model, grid, vm, q[k_true[0]])
+        qm = integrate_poses(model, grid, vm, q[k_true[0]], rule=sset.integration)
     sig = np.array([streams[owner[c][0]].white_sigma[owner[c][1]] for c in need_v])
     telem = Telemetry(
         t=grid.copy(),

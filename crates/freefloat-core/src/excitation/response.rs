@@ -239,7 +239,7 @@ pub(crate) fn sample_blocks(
     // (2) base poses by the trapezoidal rule on the group (the engine's one copy, `sim::integrate_base_poses`)
     let flat: Vec<f64> = twists.iter().flat_map(|t| t.iter().copied()).collect();
     let mut pose_rows = vec![0.0; 7 * samples];
-    integrate_base_poses(Steps::Uniform(path.step), &flat, &q0[..7], &mut pose_rows)?;
+    integrate_base_poses(Steps::Uniform(path.step), &flat, None, &q0[..7], &mut pose_rows)?;
     let poses: Vec<Se3> =
         pose_rows.chunks_exact(7).map(|p| Se3::new(rot_from_quat(&p[3..7]), V3::new(p[0], p[1], p[2]))).collect();
 

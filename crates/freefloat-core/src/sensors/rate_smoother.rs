@@ -51,7 +51,7 @@ pub fn smooth_rates(y: &[f64], channels: usize, h: f64, log_ratio: Option<f64>) 
     if channels == 0 {
         return Err(FfError::arg("channels", "at least one channel".to_string()));
     }
-    if y.len() % channels != 0 {
+    if !y.len().is_multiple_of(channels) {
         return Err(FfError::arg("y", format!("{} numbers do not divide into {channels} channels", y.len())));
     }
     let n = y.len() / channels;
