@@ -20,7 +20,9 @@ def zhang_tactical():
 
 
 def test_zhang_errors_are_the_relative_norms_of_the_target_groups(zhang_tactical):
-    """Recompute the momentum form's errors at 100 s from the estimator's own history and the model file."""
+    """Recompute the momentum form's errors at 100 s from the estimator's own history and the model file (the
+    study integrates the poses by the Hermite rule)."""
+    assert scl.INTEGRATION == "hermite"
     import dataclasses
 
     import freefloat.postcapture as pc
@@ -29,7 +31,7 @@ def test_zhang_errors_are_the_relative_norms_of_the_target_groups(zhang_tactical
     sc, m, sim = scl._zhang_motion()
     s2 = dataclasses.replace(
         sc,
-        sensors=sensors.load("tactical"),
+        sensors=dataclasses.replace(sensors.load("tactical"), integration=scl.INTEGRATION),
         sensor_seed=0,
         measurement={"accelerations": "rts", "momentum_point": "base"},
     )

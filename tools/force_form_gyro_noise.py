@@ -1,7 +1,8 @@
 """Force-form identification with a noisy gyro: the parameter error of the post-capture force form against the
 gyro's noise density, with the angular accelerations from central differences, a Savitzky-Golay derivative of
 the measured rates or their RTS smoother, and the momentum form (which needs no accelerations) beside them,
-about the inertial origin (the paper's eqs. 9-10) and about the moving base point (the default).
+about the inertial origin (the paper's eqs. 9-10) and about the moving base point (the default); the poses
+integrated from the rates by the trapezoid (the default) or the fourth-order Hermite rule.
 
 Two built-in scenarios, each simulated once: `zhang2020_3d` (the paper's 3-D capture, its ideal jets: the momentum
 form holds) given the 100 Hz gyro, base-velocity and tachometer telemetry of `zhang2020_3d_thrusters`, and
@@ -53,8 +54,10 @@ VARIANTS = [
     _sg(21, 2),
     _sg(51, 2),
     ("force, RTS smoother (GCV bandwidth)", "force", {"accelerations": "rts"}),
+    ("force, RTS smoother, Hermite poses", "force", {"accelerations": "rts", "integration": "hermite"}),
     ("momentum about the origin (the paper's eqs. 9-10)", "momentum", {"momentum_point": "origin"}),
     ("momentum about the base point (default)", "momentum", {"momentum_point": "base"}),
+    ("momentum about the base point, Hermite poses", "momentum", {"momentum_point": "base", "integration": "hermite"}),
 ]
 
 
@@ -78,7 +81,10 @@ def scenario(name: str, duration: float):
 
 
 def _with(sc, level: float, measurement: dict, seed: int):
-    sens = copy.deepcopy(sc.sensors)
+    """The scenario with the gyro at `level`, the measurement settings, and `integration` (a variant's key for the
+    telemetry's pose rule, not a measurement setting) on the sensor set."""
+    measurement = dict(measurement)
+    sens = dataclasses.replace(copy.deepcopy(sc.sensors), integration=measurement.pop("integration", "trapezoid"))
     sens.sensors = [dict(s) for s in sens.sensors]
     for s in sens.sensors:
         if s["type"] == "gyro":

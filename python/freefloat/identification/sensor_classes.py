@@ -12,8 +12,9 @@ The campaign kind `sensor_classes` runs the same function on Dask; the built-in 
 Estimators and what each run measures (the motion is simulated once per process and measured with the seed):
 
 - `zhang`: Zhang, Yue, Yuan 2020 on the built-in `zhang2020_3d` capture (100 s), the telemetry of the preset at
-  100 Hz (poses integrated), standard RLS of the momentum form (about the moving base point) and of the force form
-  (accelerations from the RTS smoother). Error of the target's mass mₙ, centre of mass b'ₙ and inertia I'ₙ.
+  100 Hz (poses integrated by the fourth-order Hermite rule, `INTEGRATION`), standard RLS of the momentum form
+  (about the moving base point) and of the force form (accelerations from the RTS smoother). Error of the
+  target's mass mₙ, centre of mass b'ₙ and inertia I'ₙ.
 - `naveen`: Naveen, Shah, Misra's minimal parameters of `naveen_dual_arm` along the shipped exciting trajectory
   (63 s, so the last horizon is its end), plain least squares and with the errors-in-variables bias removed (the
   telemetry declares its rate noise). Minimal parameters group the bodies' parameters, so the groups are by kind:
@@ -61,6 +62,9 @@ ESTIMATORS = {
 CLASSES = ("navigation", "tactical", "mems")
 HORIZONS = (10.0, 30.0, 100.0)
 QUANTITIES = ("mass", "com", "inertia")
+#: the telemetry's pose rule in these runs: the fourth-order Hermite rule (the motions here have continuous
+#: accelerations between samples, where it pays: docs/sensors.md, "Poses")
+INTEGRATION = "hermite"
 
 
 def _rel(est, truth) -> float:
@@ -93,7 +97,7 @@ def _zhang(sensor_class: str, seed: int, horizons) -> dict:
     sc, m, sim = _zhang_motion()
     s2 = dataclasses.replace(
         sc,
-        sensors=sensors.load(sensor_class),
+        sensors=dataclasses.replace(sensors.load(sensor_class), integration=INTEGRATION),
         sensor_seed=int(seed),
         measurement={"accelerations": "rts", "momentum_point": "base"},
     )
@@ -154,7 +158,8 @@ def _naveen(sensor_class: str, seed: int, horizons) -> dict:
 
     m, sim = _naveen_motion()
     run = {"t": sim.t, "q": sim.q, "v": sim.v, "momentum": sim.momentum}
-    tel = sensors.measure(m, run, sensors.load(sensor_class), seed=int(seed)).require_telemetry()
+    sset = dataclasses.replace(sensors.load(sensor_class), integration=INTEGRATION)
+    tel = sensors.measure(m, run, sset, seed=int(seed)).require_telemetry()
     out = {}
     end = float(tel.t[-1])
     for T in horizons:

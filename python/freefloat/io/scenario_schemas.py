@@ -786,8 +786,8 @@ SensorsBlock = Annotated[list[Sensor], BeforeValidator(_sensors_preset)]
 class TelemetryBlock(Block):
     poses: literal("integrate", "measured") = "integrate"
     rate: Positive | None = None
-    # poses: integrate only: the trapezoid (second order) or its Hermite correction (fourth order, the default)
-    integration: literal("trapezoid", "hermite") = "hermite"
+    # poses: integrate only: the trapezoid (second order) or its Hermite correction (fourth order)
+    integration: literal("trapezoid", "hermite") = "trapezoid"
 
 
 def check_sensor_names(sensors) -> None:
