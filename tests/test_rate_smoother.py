@@ -227,7 +227,6 @@ def test_force_form_with_a_fibre_optic_gyro(tmp_path):
         sc = dataclasses.replace(base, duration=60.0, sensors=sens, sensor_seed=0, measurement={"accelerations": kind})
         res = pc.identify(m, pc.measure(m, sim, sc), sc, methods=("force",))
         res.truth_history = truth_history(m, sim, False, target_index(m))
-        e = res.rel_error("force", "standard_rls")
-        err[kind] = float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in cols])))
+        err[kind] = res.rms_rel_error("force", "standard_rls", cols)
     print("force form, gyro N = 1e-6, RMS relative error:", err)
     assert err["rts"] < err["central_difference"] / 4, err

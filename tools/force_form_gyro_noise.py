@@ -109,8 +109,7 @@ def error(m, sim, sc, level: float, method: str, measurement: dict, seed: int) -
     meas = pc.measure(m, sim, s2)
     res = pc.identify(m, meas, s2, methods=(method,))
     res.truth_history = truth_history(m, sim, False, target_index(m))
-    e = res.rel_error(method, "standard_rls")
-    return float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in COLS])))
+    return res.rms_rel_error(method, "standard_rls", COLS)
 
 
 def study(name: str, duration: float, seeds: int, variants) -> list:
@@ -133,8 +132,7 @@ def study(name: str, duration: float, seeds: int, variants) -> list:
         s0 = dataclasses.replace(sc, sensors=None, measurement={"accelerations": "exact", "momentum_point": point})
         res = pc.identify(m, pc.measure(m, sim, s0), s0, methods=("momentum",))
         res.truth_history = truth_history(m, sim, False, target_index(m))
-        e = res.rel_error("momentum", "standard_rls")
-        floor = float(np.sqrt(np.mean([e[res.names.index(c)] ** 2 for c in COLS])))
+        floor = res.rms_rel_error("momentum", "standard_rls", COLS)
         label = f"momentum about the {point}{' point' if point == 'base' else ''}, true states (no sensors; reference)"
         rows.append((label, [(floor, floor, floor)] * len(LEVELS), None))
         print(label, floor, flush=True)

@@ -72,6 +72,12 @@ class PostcaptureResult:
         est = self.final(method, solver)
         return np.where(tr != 0, np.abs(est - tr) / np.where(tr != 0, np.abs(tr), 1), np.abs(est - tr))
 
+    def rms_rel_error(self, method, solver, names) -> float:
+        """RMS over the parameters `names` (e.g. ["m1", "mn", "Inxx", "Inyy", "Inzz"]) of `rel_error`: one number
+        for a study's table."""
+        e = self.rel_error(method, solver)
+        return float(np.sqrt(np.mean([e[self.names.index(n)] ** 2 for n in names])))
+
     def transits(self, method, solver):
         t, h = self.histories[(method, solver)]
         return transit_times(t, h, self.truth_at(t), self.scenario.tolerance)
