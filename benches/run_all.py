@@ -366,6 +366,23 @@ def rows_sensors(res: dict) -> list[Row]:
     ]
 
 
+def rows_rate_smoother(res: dict) -> list[Row]:
+    lo_f, hi_f = res["spread_s"]["freefloat"]
+    lo_s, hi_s = res["spread_s"]["scipy"]
+    p = res["problem"]
+    return [
+        Row(
+            f"smooth_rates (RTS smoother, GCV): {p['samples']:,} samples × {p['channels']} channels",
+            "scipy make_smoothing_spline (GCV)",
+            res["speedup_vs_scipy"],
+            _range(lo_s / hi_f, hi_s / lo_f),
+            fmt_s(res["median_s"]["freefloat"]),
+            fmt_s(res["median_s"]["scipy"]),
+            note="same spline, GCV choices agree" if res.get("agreement_passed") else "DISAGREE",
+        )
+    ]
+
+
 #: name -> (script, full args, fast args, modules needed, extractor[, the JSON file the script writes in --out
 #: when it has no --json option])
 BENCHES = {
@@ -403,6 +420,14 @@ BENCHES = {
     "basilisk": ("basilisk_wheels.py", [], ["--repeats", "3"], ("Basilisk",), rows_basilisk, "basilisk_wheels.json"),
     "environment": ("environment_bench.py", [], ["--repeats", "3"], (), rows_environment, "environment_bench.json"),
     "sensors": ("sensors_bench.py", [], ["--repeats", "5"], ("scipy",), rows_sensors, "sensors_bench.json"),
+    "rate_smoother": (
+        "rate_smoother_bench.py",
+        [],
+        ["--quick"],
+        ("scipy",),
+        rows_rate_smoother,
+        "rate_smoother_bench.json",
+    ),
 }
 RLS_LINE = re.compile(r"^(\S+)\s+wall\s+([\d.]+) ns/update .*?cpu\s+([\d.]+) ns/update")
 

@@ -139,6 +139,15 @@ def _check_sensors(out: Path) -> list[str]:
     return bad
 
 
+def _check_rate_smoother(out: Path) -> list[str]:
+    res = json.loads((out / "rate_smoother_bench.json").read_text())
+    a = res["agreement"]
+    bad = [] if res["agreement_passed"] is True else [f"agreement_passed is not true: {a}"]
+    if not a["same_penalty_max_rel_diff"] < 1e-6:
+        bad.append(f"same penalty: derivatives differ by {a['same_penalty_max_rel_diff']:.3g}")
+    return bad
+
+
 def _check_kernels(out: Path) -> list[str]:
     res = json.loads((out / "kernels_vs_pinocchio.json").read_text())
     bad = []
@@ -207,6 +216,7 @@ BENCHES = {
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
     "cl": ("cl_vs_numpy.py", [], (), _check_cl),
     "sensors": ("sensors_bench.py", [], ("scipy",), _check_sensors),
+    "rate_smoother": ("rate_smoother_bench.py", [], ("scipy",), _check_rate_smoother),
     "kernels": ("kernels_vs_pinocchio.py", [], ("pinocchio",), _check_kernels),
     "mujoco": ("sim_vs_mujoco.py", [], ("mujoco",), _check_sim_vs_mujoco),
     "basilisk_wheels": ("basilisk_wheels.py", [], ("Basilisk",), _check_basilisk_wheels),
