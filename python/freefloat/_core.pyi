@@ -46,9 +46,9 @@ class ConcurrentEstimator:
     """The concurrent-learning estimator of Valverde 2018 ch. 9 for `nbodies` bodies, driven from the caller's own
 loop: `add_sample(R, F)` offers a data point (Algorithm 3 while the time is below t_th), `step(dt)` advances
 the estimate by one RK4 step of (9.15), or of (9.23) with the SVD gain once the time reaches t_th2.
-`m0` is the initial estimate (7 per body: [I11, I12, I13, I22, I23, I33, m]).
+`m0` is the initial estimate (7 per body: [I11, I12, I13, I22, I23, I33, m]); `gain`, `kappa` as in `cl_run`.
     """
-    def __init__(self, nbodies: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1) -> None: ...
+    def __init__(self, nbodies: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, gain: ArrayLike = 'thesis', kappa: ArrayLike = 6.0, seed: ArrayLike = 1) -> None: ...
     def add_sample(self, r: ArrayLike, f: ArrayLike) -> Any:
         """Offer the data point (R, F): R as (B, 8, 7) per-body blocks or the (8B, 7B) block-diagonal matrix 𝐑 of
 (9.9), F as (B, 8) or (8B,). Returns what Algorithm 3 did: "appended", "replaced", "rejected", "full"
@@ -67,8 +67,18 @@ the estimate by one RK4 step of (9.15), or of (9.23) with the SVD gain once the 
     def gain_active(self) -> Any:
         """Whether the SVD gain K is in use (time ≥ t_th2 at the last step, aggressive mode)."""
     @property
+    def gain_withheld(self) -> Any:
+        """Per body, the directions the truncated gain withheld (left at the plain law's rate although the thesis'
+(9.27) would accelerate them) when the gain was last formed; zeros with gain="thesis".
+        """
+    @property
     def nbodies(self) -> int:
         """Number of bodies."""
+    @property
+    def noise_sigma(self) -> Any:
+        """Per body, the noise estimate σ̂ = ρ/√(n − r) of the stored data (least-squares residual norm ρ over the
+n stored rows that are not identically zero, r the block's rank); infinite without redundancy.
+        """
     @property
     def rf(self) -> Any:
         """Rf = Σ𝐑_kᵀ𝐅_k per body, shape (B, 7)."""
@@ -432,23 +442,27 @@ def centroidal_momentum_matrix(model: Model, q: ArrayLike) -> np.ndarray:
 def check_sensors(sensors: ArrayLike) -> Any:
     """Check a sensor set (YAML or JSON text) without running it; returns the sensors' names in order."""
 
-def cl_estimate(r: ArrayLike, f: ArrayLike, dt: float, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1) -> Any:
+def cl_estimate(r: ArrayLike, f: ArrayLike, dt: float, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, gain: ArrayLike = 'thesis', kappa: ArrayLike = 6.0, seed: ArrayLike = 1) -> Any:
     """The ch. 9 estimator alone over recorded data points: R (n, B, 8, 7), F (n, B, 8) taken every `dt` from
-t = 0; the same sequence as `cl_run` (offer, record, step) without the robot. Returns the estimates (n, 7B).
+t = 0; the same sequence as `cl_run` (offer, record, step) without the robot (`gain`, `kappa` as there).
+Returns the estimates (n, 7B).
 Ctrl-C stops it within ~20 ms: `Interrupted.partial` holds the estimates finished, (k, 7B), equal to the
 first k rows of an uninterrupted call.
     """
 
-def cl_run(model: Model, q0: ArrayLike, v0: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, seed: ArrayLike = 1, dt: float = 0.01, t_final: float = 10.0, amplitude: ArrayLike = 0.5, frequency: ArrayLike = 1.0, phase: ArrayLike = 0.0, t_start: ArrayLike = 2.0, t_end: ArrayLike = 3.0, wrench_noise: ArrayLike = 0.0, rate_noise: ArrayLike = 0.0, noise_seed: ArrayLike = 7, progress: Callable[[float], Any] | None = None) -> Any:
+def cl_run(model: Model, q0: ArrayLike, v0: ArrayLike, m0: ArrayLike, ns: ArrayLike = 10, sigma_th: ArrayLike = 0.001, t_th: ArrayLike = 5.0, aggressive: ArrayLike = True, t_th2: ArrayLike = 4.9, sigma_th2: ArrayLike = 0.5, sigma_new: ArrayLike = 100.0, gain: ArrayLike = 'thesis', kappa: ArrayLike = 6.0, seed: ArrayLike = 1, dt: float = 0.01, t_final: float = 10.0, amplitude: ArrayLike = 0.5, frequency: ArrayLike = 1.0, phase: ArrayLike = 0.0, t_start: ArrayLike = 2.0, t_end: ArrayLike = 3.0, wrench_noise: ArrayLike = 0.0, rate_noise: ArrayLike = 0.0, noise_seed: ArrayLike = 7, progress: Callable[[float], Any] | None = None) -> Any:
     """Run Valverde 2018 ch. 9 on `model` (free base, no gravity) from (q0, v0): the robot under the joint
 actuation `amplitude·sin(frequency·t + phase)` on every joint DOF for t_start ≤ t ≤ t_end, integrated with
 RK4 at `dt` to `t_final`, and the concurrent-learning estimator (Algorithms 3-4, law (9.15), SVD gain
 (9.22-9.27)) fed one data point per step. `m0`: initial estimate, 7 per body ([I11, I12, I13, I22, I23, I33,
-m], model order). `wrench_noise`, `rate_noise`: standard deviations of the joint force/torque sensors and of
-the measured body twists and twist rates. `progress(t)` is called with the simulated time; returning False
+m], model order). `gain`: "thesis" (9.27, the default) or "truncated" (a direction is accelerated only when
+the current estimate's residual along it is at least `kappa` times the stored data's noise estimate).
+`wrench_noise`, `rate_noise`: standard deviations of the joint force/torque sensors and of the measured body
+twists and twist rates. `progress(t)` is called with the simulated time; returning False
 (or Ctrl-C) stops the run, which then returns what it has with `interrupted = True`. Returns a dict of numpy
 arrays: t, estimates (n, 7B), singular_values (n, 7B, descending), block_singular_values (n, B, 7), offers
-(n,), truth, final_estimate, realisable (B,), max_residual, stack_changes, stack_trials, interrupted.
+(n,), truth, final_estimate, realisable (B,), max_residual, noise_sigma (B,), gain_withheld (B,),
+stack_changes, stack_trials, interrupted.
     """
 
 def cl_sample(model: Model, q: ArrayLike, v: ArrayLike, tau: ArrayLike, wrench_noise: ArrayLike = 0.0, rate_noise: ArrayLike = 0.0, noise_seed: ArrayLike = 7) -> Any:

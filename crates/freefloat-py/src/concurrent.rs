@@ -7,7 +7,7 @@ use crate::errors::{guard, guard_raw, input_err, interrupted_with, reraise_forei
 use freefloat_core::dqdynamics::dq_dynamics;
 use freefloat_core::error::{FfError, Partial};
 use freefloat_core::estimation::concurrent::{
-    estimate_recorded_interruptible, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Noise, Offer,
+    estimate_recorded_interruptible, run_cl, ClParams, ClScenario, ConcurrentEstimator, Excitation, Gain, Noise, Offer,
     SampleBuilder, SplitMix, M87, NP, V8,
 };
 use numpy::{PyArray1, PyArrayMethods, PyReadonlyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -24,9 +24,12 @@ fn params(
     t_th2: f64,
     sigma_th2: f64,
     sigma_new: f64,
+    gain: &str,
+    kappa: f64,
     seed: u64,
-) -> ClParams {
-    ClParams { ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, seed }
+) -> PyResult<ClParams> {
+    let gain = Gain::parse(gain).map_err(to_py)?;
+    Ok(ClParams { ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, gain, kappa, seed })
 }
 
 fn offer_name(o: Option<Offer>) -> &'static str {
@@ -43,16 +46,19 @@ fn offer_name(o: Option<Offer>) -> &'static str {
 /// actuation `amplitude·sin(frequency·t + phase)` on every joint DOF for t_start ≤ t ≤ t_end, integrated with
 /// RK4 at `dt` to `t_final`, and the concurrent-learning estimator (Algorithms 3-4, law (9.15), SVD gain
 /// (9.22-9.27)) fed one data point per step. `m0`: initial estimate, 7 per body ([I11, I12, I13, I22, I23, I33,
-/// m], model order). `wrench_noise`, `rate_noise`: standard deviations of the joint force/torque sensors and of
-/// the measured body twists and twist rates. `progress(t)` is called with the simulated time; returning False
+/// m], model order). `gain`: "thesis" (9.27, the default) or "truncated" (a direction is accelerated only when
+/// the current estimate's residual along it is at least `kappa` times the stored data's noise estimate).
+/// `wrench_noise`, `rate_noise`: standard deviations of the joint force/torque sensors and of the measured body
+/// twists and twist rates. `progress(t)` is called with the simulated time; returning False
 /// (or Ctrl-C) stops the run, which then returns what it has with `interrupted = True`. Returns a dict of numpy
 /// arrays: t, estimates (n, 7B), singular_values (n, 7B, descending), block_singular_values (n, B, 7), offers
-/// (n,), truth, final_estimate, realisable (B,), max_residual, stack_changes, stack_trials, interrupted.
+/// (n,), truth, final_estimate, realisable (B,), max_residual, noise_sigma (B,), gain_withheld (B,),
+/// stack_changes, stack_trials, interrupted.
 #[pyfunction]
 #[pyo3(signature = (model, q0, v0, m0, *, ns = 10, sigma_th = 0.001, t_th = 5.0, aggressive = true, t_th2 = 4.9,
-    sigma_th2 = 0.5, sigma_new = 100.0, seed = 1, dt = 0.01, t_final = 10.0, amplitude = 0.5, frequency = 1.0,
-    phase = 0.0, t_start = 2.0, t_end = 3.0, wrench_noise = 0.0, rate_noise = 0.0, noise_seed = 7,
-    progress = None))]
+    sigma_th2 = 0.5, sigma_new = 100.0, gain = "thesis", kappa = 6.0, seed = 1, dt = 0.01, t_final = 10.0,
+    amplitude = 0.5, frequency = 1.0, phase = 0.0, t_start = 2.0, t_end = 3.0, wrench_noise = 0.0, rate_noise = 0.0,
+    noise_seed = 7, progress = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn cl_run<'py>(
     py: Python<'py>,
@@ -67,6 +73,8 @@ pub fn cl_run<'py>(
     t_th2: f64,
     sigma_th2: f64,
     sigma_new: f64,
+    gain: &str,
+    kappa: f64,
     seed: u64,
     dt: f64,
     t_final: f64,
@@ -87,7 +95,7 @@ pub fn cl_run<'py>(
         q0: q0.as_array().to_vec(),
         v0: v0.as_array().to_vec(),
         excitation: Excitation { amplitude, frequency, phase, t_start, t_end },
-        params: params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, seed),
+        params: params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, gain, kappa, seed)?,
         m0: m0.as_array().to_vec(),
         dt,
         t_final,
@@ -132,6 +140,8 @@ pub fn cl_run<'py>(
     d.set_item("final_estimate", PyArray1::from_slice(py, &res.final_estimate))?;
     d.set_item("realisable", res.realisable.clone())?;
     d.set_item("max_residual", res.max_residual)?;
+    d.set_item("noise_sigma", PyArray1::from_slice(py, &res.noise_sigma))?;
+    d.set_item("gain_withheld", res.gain_withheld.clone())?;
     d.set_item("stack_changes", res.stack_changes)?;
     d.set_item("stack_trials", res.stack_trials)?;
     d.set_item("interrupted", res.interrupted)?;
@@ -139,12 +149,13 @@ pub fn cl_run<'py>(
 }
 
 /// The ch. 9 estimator alone over recorded data points: R (n, B, 8, 7), F (n, B, 8) taken every `dt` from
-/// t = 0; the same sequence as `cl_run` (offer, record, step) without the robot. Returns the estimates (n, 7B).
+/// t = 0; the same sequence as `cl_run` (offer, record, step) without the robot (`gain`, `kappa` as there).
+/// Returns the estimates (n, 7B).
 /// Ctrl-C stops it within ~20 ms: `Interrupted.partial` holds the estimates finished, (k, 7B), equal to the
 /// first k rows of an uninterrupted call.
 #[pyfunction]
 #[pyo3(signature = (r, f, dt, m0, *, ns = 10, sigma_th = 0.001, t_th = 5.0, aggressive = true, t_th2 = 4.9,
-    sigma_th2 = 0.5, sigma_new = 100.0, seed = 1))]
+    sigma_th2 = 0.5, sigma_new = 100.0, gain = "thesis", kappa = 6.0, seed = 1))]
 #[allow(clippy::too_many_arguments)]
 pub fn cl_estimate<'py>(
     py: Python<'py>,
@@ -159,6 +170,8 @@ pub fn cl_estimate<'py>(
     t_th2: f64,
     sigma_th2: f64,
     sigma_new: f64,
+    gain: &str,
+    kappa: f64,
     seed: u64,
 ) -> PyResult<Bound<'py, PyAny>> {
     let sh = r.shape().to_vec();
@@ -175,7 +188,7 @@ pub fn cl_estimate<'py>(
     // row-major (…, 8, 7) blocks into nalgebra's column-major 8×7
     let rb: Vec<M87> = rs.chunks_exact(56).map(M87::from_row_slice).collect();
     let fb: Vec<V8> = fs.chunks_exact(8).map(V8::from_column_slice).collect();
-    let p = params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, seed);
+    let p = params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, gain, kappa, seed)?;
     let m0 = m0.as_array().to_vec();
     let mut out = vec![0.0; n * NP * nb];
     // Ctrl-C: the engine polls the hook after each sample (GIL re-taken for the signal check only); the
@@ -261,7 +274,7 @@ pub fn cl_sample<'py>(
 /// The concurrent-learning estimator of Valverde 2018 ch. 9 for `nbodies` bodies, driven from the caller's own
 /// loop: `add_sample(R, F)` offers a data point (Algorithm 3 while the time is below t_th), `step(dt)` advances
 /// the estimate by one RK4 step of (9.15), or of (9.23) with the SVD gain once the time reaches t_th2.
-/// `m0` is the initial estimate (7 per body: [I11, I12, I13, I22, I23, I33, m]).
+/// `m0` is the initial estimate (7 per body: [I11, I12, I13, I22, I23, I33, m]); `gain`, `kappa` as in `cl_run`.
 #[pyclass(name = "ConcurrentEstimator", module = "freefloat._core")]
 pub struct PyConcurrentEstimator {
     inner: ConcurrentEstimator,
@@ -273,7 +286,7 @@ pub struct PyConcurrentEstimator {
 impl PyConcurrentEstimator {
     #[new]
     #[pyo3(signature = (nbodies, m0, *, ns = 10, sigma_th = 0.001, t_th = 5.0, aggressive = true, t_th2 = 4.9,
-        sigma_th2 = 0.5, sigma_new = 100.0, seed = 1))]
+        sigma_th2 = 0.5, sigma_new = 100.0, gain = "thesis", kappa = 6.0, seed = 1))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         nbodies: usize,
@@ -285,9 +298,11 @@ impl PyConcurrentEstimator {
         t_th2: f64,
         sigma_th2: f64,
         sigma_new: f64,
+        gain: &str,
+        kappa: f64,
         seed: u64,
     ) -> PyResult<Self> {
-        let p = params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, seed);
+        let p = params(ns, sigma_th, t_th, aggressive, t_th2, sigma_th2, sigma_new, gain, kappa, seed)?;
         let m0 = m0.as_array().to_vec();
         let inner = guard(|| ConcurrentEstimator::new(nbodies, p, &m0))?;
         Ok(PyConcurrentEstimator { inner, r: vec![M87::zeros(); nbodies], f: vec![V8::zeros(); nbodies] })
@@ -402,6 +417,22 @@ impl PyConcurrentEstimator {
         }
         self.inner.set_time(t);
         Ok(())
+    }
+
+    /// Per body, the noise estimate σ̂ = ρ/√(n − r) of the stored data (least-squares residual norm ρ over the
+    /// n stored rows that are not identically zero, r the block's rank); infinite without redundancy.
+    #[getter]
+    fn noise_sigma<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let st = self.inner.stack();
+        let v: Vec<f64> = (0..self.r.len()).map(|i| st.noise_sigma(i).unwrap_or(f64::NAN)).collect();
+        PyArray1::from_vec(py, v)
+    }
+
+    /// Per body, the directions the truncated gain withheld (left at the plain law's rate although the thesis'
+    /// (9.27) would accelerate them) when the gain was last formed; zeros with gain="thesis".
+    #[getter]
+    fn gain_withheld(&self) -> Vec<usize> {
+        self.inner.withheld().to_vec()
     }
 
     /// Whether the SVD gain K is in use (time ≥ t_th2 at the last step, aggressive mode).

@@ -1,6 +1,8 @@
 """Concurrent-learning estimation of every body's mass properties of a spacecraft-mounted manipulator (Valverde
 2018, ch. 9): the stacked Newton–Euler equations 𝐑𝐌 = 𝐅 with the known joint (reaction + actuation) wrenches, the
-data stack of Algorithms 3 and 4, the estimation law (9.15) and the "aggressive" SVD gain (9.22-9.27).
+data stack of Algorithms 3 and 4, the estimation law (9.15) and the "aggressive" SVD gain (9.22-9.27), or its
+noise-robust truncated form (`gain="truncated"`: a weak direction is accelerated only where the data outweigh their
+noise, docs/identification.md).
 
     from freefloat.identification import concurrent
     res = concurrent.run("valverde_ch9_two_arm")          # the whole 10 s run in the engine
@@ -31,6 +33,7 @@ __all__ = [
     "ClResult",
     "ClScenario",
     "ConcurrentLearningEstimator",
+    "GAINS",
     "load_scenario",
     "parameter_scales",
     "realisable",
@@ -40,6 +43,11 @@ __all__ = [
 
 #: the seven parameters of one body, in the order of Valverde 2018 §4.1
 PARAM_NAMES = ("I11", "I12", "I13", "I22", "I23", "I33", "m")
+#: the SVD gains: the thesis' (9.27) (the default) and the truncated one (9.27') that accelerates a weak direction only
+#: when the estimate's residual along it is at least `kappa` noise standard deviations
+GAINS = ("thesis", "truncated")
+#: default κ of the truncated gain (the engine's `KAPPA`)
+KAPPA = 6.0
 
 
 def realisable(v) -> bool:
@@ -58,8 +66,10 @@ class ConcurrentLearningEstimator:
     (8B, 7B) block-diagonal 𝐑 of (9.9), F as (B, 8) or (8B,)); `add_state(model, q, v, tau)` builds that point
     from a multibody state with the engine's dual-quaternion dynamics; `step(dt)` advances the estimate by one RK4
     step of (9.15), or of (9.23) with the SVD gain once `time >= t_th2` (with `aggressive`). The thesis' values
-    are the defaults (§9.5). Bad input raises InputError naming the argument; a step that would make the estimate
-    non-finite or RK4 unstable raises instead of returning NaN."""
+    are the defaults (§9.5). `gain="truncated"` keeps (9.27) only for the directions whose data reach `kappa` times
+    the stored data's noise estimate (`noise_sigma`), the others at the plain law's rate (`gain_withheld` counts
+    them). Bad input raises InputError naming the argument; a step that would make the estimate non-finite or RK4
+    unstable raises instead of returning NaN."""
 
     def __init__(
         self,
@@ -73,6 +83,8 @@ class ConcurrentLearningEstimator:
         t_th2: float = 4.9,
         sigma_th2: float = 0.5,
         sigma_new: float = 100.0,
+        gain: str = "thesis",
+        kappa: float = KAPPA,
         seed: int = 1,
     ):
         m0 = np.ascontiguousarray(m0, dtype=float).ravel()
@@ -86,6 +98,8 @@ class ConcurrentLearningEstimator:
             t_th2=float(t_th2),
             sigma_th2=float(sigma_th2),
             sigma_new=float(sigma_new),
+            gain=str(gain),
+            kappa=float(kappa),
             seed=int(seed),
         )
         self._warned: set[int] = set()
@@ -121,6 +135,14 @@ class ConcurrentLearningEstimator:
     rr = property(lambda self: self._core.rr, doc="(B, 7, 7) diagonal blocks of RR = Σ𝐑_kᵀ𝐑_k.")
     rf = property(lambda self: self._core.rf, doc="(B, 7) blocks of Rf = Σ𝐑_kᵀ𝐅_k.")
     gain = property(lambda self: self._core.gain, doc="(B, 7, 7) blocks of the gain K (identity before t_th2).")
+    noise_sigma = property(
+        lambda self: self._core.noise_sigma,
+        doc="(B,) noise estimate σ̂ = ρ/√(n − r) of the stored data per body (inf without redundancy).",
+    )
+    gain_withheld = property(
+        lambda self: np.asarray(self._core.gain_withheld),
+        doc="(B,) directions the truncated gain left at the plain rate when it was last formed (0 for the thesis).",
+    )
     stack_size = property(lambda self: self._core.stack_size, doc="Stored points N_c.")
     gain_active = property(lambda self: self._core.gain_active)
 
@@ -168,6 +190,8 @@ _ESTIMATOR_KEYS = {
     "t_th2": float,
     "sigma_th2": float,
     "sigma_new": float,
+    "gain": str,
+    "kappa": float,
     "seed": int,
 }
 _EXCITATION_KEYS = {"amplitude": float, "frequency": float, "phase": float, "t_start": float, "t_end": float}
@@ -199,6 +223,10 @@ def _err(source: str, key: str, msg: str) -> InputError:
 
 
 def _num(source, key, x, kind=float):
+    if kind is str:  # the gain: one of GAINS
+        if x not in GAINS:
+            raise _err(source, key, f"expected one of {', '.join(GAINS)}, got {x!r}")
+        return x
     if kind is bool:
         if not isinstance(x, bool):
             raise _err(source, key, f"expected true or false, got {x!r}")
@@ -379,6 +407,8 @@ class ClResult:
     stack_trials: int
     interrupted: bool
     wall_time_s: float
+    noise_sigma: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    gain_withheld: list = field(default_factory=list)
     extra: dict = field(default_factory=dict)
 
     @property
@@ -435,6 +465,8 @@ class ClResult:
             "singular_values_constant_after_s": self.last_stack_change_s,
             "sup_error_9p7_to_10s": self.sup_error(9.7),
             "max_residual_RM_minus_F": None if not np.isfinite(self.max_residual) else self.max_residual,
+            "noise_sigma_final": [float(x) if np.isfinite(x) else None for x in self.noise_sigma],
+            "gain_withheld": [int(x) for x in self.gain_withheld],
             "realisable_final": list(self.realisable),
             "realisable_check": "temporary local check (m > 0, inertia PD, triangle inequality)",
             "stack_changes": self.stack_changes,
@@ -464,6 +496,12 @@ class ClResult:
         )
         bad = [names[i] for i, ok in enumerate(self.realisable) if not ok]
         lines.append("every body's estimate is a realisable rigid body" if not bad else f"NOT realisable: {bad}")
+        if self.settings.get("gain") == "truncated" and self.settings.get("aggressive", True):
+            w = [int(x) for x in self.gain_withheld]
+            lines.append(
+                f"truncated gain (kappa {self.settings.get('kappa', KAPPA):g}): {sum(w)} weak directions left at the "
+                f"plain law's rate (per body {w})"
+            )
         return "\n".join(lines)
 
     def save(self, out, figures: bool = True) -> Path:
@@ -484,10 +522,13 @@ def run(
     wrench_noise: float = 0.0,
     rate_noise: float = 0.0,
     aggressive: bool | None = None,
+    gain: str | None = None,
+    kappa: float | None = None,
     noise_seed: int | None = None,
     progress=None,
 ) -> ClResult:
     """Run chapter 9 for `scenario` (a ClScenario, a built-in name or a .yaml path) entirely in the engine.
+    `ns`, `aggressive`, `gain` ("thesis" or "truncated") and `kappa` override the scenario's estimator settings.
     `progress(t)` gets the simulated time (return False to stop; Ctrl-C stops too and keeps what was done)."""
     sc = scenario if isinstance(scenario, ClScenario) else load_scenario(scenario)
     est = dict(sc.estimator)
@@ -495,6 +536,10 @@ def run(
         est["ns"] = int(ns)
     if aggressive is not None:
         est["aggressive"] = bool(aggressive)
+    if gain is not None:
+        est["gain"] = str(gain)
+    if kappa is not None:
+        est["kappa"] = float(kappa)
     t0 = time.perf_counter()
     r = _core.cl_run(
         sc.model._core,
@@ -519,6 +564,8 @@ def run(
         "t_th2": est.get("t_th2", 4.9),
         "sigma_th2": est.get("sigma_th2", 0.5),
         "sigma_new": est.get("sigma_new", 100.0),
+        "gain": est.get("gain", "thesis"),
+        "kappa": est.get("kappa", KAPPA),
         "dt": sc.dt,
         "duration": sc.duration,
         "excitation": {"amplitude": 0.5, "frequency": 1.0, "phase": 0.0, "t_start": 2.0, "t_end": 3.0, **sc.excitation},
@@ -541,6 +588,8 @@ def run(
         stack_trials=r["stack_trials"],
         interrupted=r["interrupted"],
         wall_time_s=wall,
+        noise_sigma=r["noise_sigma"],
+        gain_withheld=list(r["gain_withheld"]),
     )
     bad = [sc.model.body_names[i] for i, ok in enumerate(res.realisable) if not ok]
     if bad:

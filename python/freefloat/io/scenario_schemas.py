@@ -269,6 +269,8 @@ class ClEstimator(Block):
     t_th2: NonNegative = None
     sigma_th2: NonNegative = None
     sigma_new: NonNegative = None
+    gain: literal("thesis", "truncated") = None  # (9.27) for every weak direction, or only where data beat noise
+    kappa: Positive = None  # the truncated gain's evidence threshold (in noise standard deviations)
     seed: integer(lo=0) = None
     initial_estimate: Anything = None  # body name -> 7 numbers: checked against the robot by the command
 

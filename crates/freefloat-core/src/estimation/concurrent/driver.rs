@@ -98,6 +98,12 @@ pub struct ClRun {
     /// Largest |R̂_i v(M_i) − F_i| over the run with the true parameters and exact measurements (a check that
     /// the reaction wrenches and the regressor agree with the dynamics); NaN with noise.
     pub max_residual: f64,
+    /// Per body, at the end: the noise estimate σ̂ of the stored data (`DataStack::noise_sigma`; round-off
+    /// without noise, infinite without redundancy).
+    pub noise_sigma: Vec<f64>,
+    /// Per body: the directions the truncated gain withheld (left at the plain law's rate although (9.27) would
+    /// accelerate them) when it was last formed; zeros with the thesis gain.
+    pub gain_withheld: Vec<usize>,
     /// Number of changes of the stored set and trial decompositions in Algorithm 3.
     pub stack_changes: u64,
     /// Trial decompositions made by Algorithm 3.
@@ -285,6 +291,8 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
     out.final_estimate = est_row;
     out.realisable = est.estimate().iter().map(realisable).collect();
     out.max_residual = if exact { max_res } else { f64::NAN };
+    out.noise_sigma = (0..n).map(|i| est.stack().noise_sigma(i).unwrap_or(f64::NAN)).collect();
+    out.gain_withheld = est.withheld().to_vec();
     let (c, tr) = est.stack().counters();
     out.stack_changes = c;
     out.stack_trials = tr;

@@ -1,7 +1,7 @@
 //! Concurrent-learning estimation of every body's mass properties of a spacecraft-mounted manipulator
 //! (Valverde 2018, ch. 9): the stacked Newton–Euler equations 𝐑𝐌 = 𝐅 with the known reaction wrenches
 //! (9.8)–(9.11), the data stack of Algorithms 3 and 4, the estimation law (9.15) and the aggressive SVD gain
-//! (9.22)–(9.27).
+//! (9.22)–(9.27), with a noise-robust variant of that gain ([`Gain::Truncated`], see `law.rs`).
 //!
 //! Files by job: `samples.rs` builds 𝐑_k, 𝐅_k from the multibody state; `stack.rs` holds the data stack
 //! (Algorithms 3, 4); `law.rs` the law and the gain; `driver.rs` the whole run coupled to a simulated robot.
@@ -17,7 +17,7 @@ mod stack;
 pub use driver::{
     estimate_recorded, estimate_recorded_interruptible, run_cl, ClRun, ClScenario, Excitation, ProgressFn,
 };
-pub use law::{block_rate, rk4_step, svd_gain, ZERO_RTOL};
+pub use law::{block_rate, direction_evidence, rk4_step, svd_gain, truncated_svd_gain, ZERO_RTOL};
 pub use samples::{Noise, SampleBuilder};
 pub use stack::{block_singular_values, DataStack, Offer, SplitMix};
 
@@ -26,6 +26,9 @@ use nalgebra::{SMatrix, SVector};
 
 /// Parameters per body.
 pub const NP: usize = 7;
+/// The default κ of the truncated gain (9.27′): a weak direction is accelerated when its least-squares value lies
+/// at least this many standard errors from the estimate (`law.rs`: the rule and the measurement behind 6).
+pub const KAPPA: f64 = 6.0;
 /// A body's 8×7 regressor block R̂ (same type as `dualquat::M87`).
 pub type M87 = SMatrix<f64, 8, 7>;
 /// A 7×7 block of RR or of the gain.
@@ -34,6 +37,36 @@ pub type M7 = SMatrix<f64, 7, 7>;
 pub type V7 = SVector<f64, 7>;
 /// A body's wrench as an 8-vector.
 pub type V8 = SVector<f64, 8>;
+
+/// Which σ̄_i the SVD gain K of (9.24) uses for a direction with 0 < σ_i < σ_th,2.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Gain {
+    /// The thesis' (9.27): σ̄_i = σ_new/σ_i for every such direction (the reproduction; the default).
+    #[default]
+    Thesis,
+    /// (9.27) only for the directions whose data outweigh the noise, σ̄_i = 1 (the plain law's rate) for the
+    /// others: accelerate direction i only if |p_iᵀ(g − T𝐌̂_ref)| ≥ κ σ̂ (9.27′), 𝐌̂_ref the estimate when the
+    /// gain switched on, σ̂ the stack's noise estimate (`law.rs`, [`truncated_svd_gain`]).
+    Truncated,
+}
+
+impl Gain {
+    /// The gain by name: "thesis" or "truncated" (an error naming `gain` otherwise).
+    pub fn parse(name: &str) -> Result<Self> {
+        match name {
+            "thesis" => Ok(Gain::Thesis),
+            "truncated" => Ok(Gain::Truncated),
+            _ => Err(FfError::arg("gain", format!("must be \"thesis\" or \"truncated\", got {name:?}"))),
+        }
+    }
+    /// The name `parse` reads.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Gain::Thesis => "thesis",
+            Gain::Truncated => "truncated",
+        }
+    }
+}
 
 /// The concurrent-learning parameters of Valverde 2018 ch. 9 (§9.3–9.5).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,6 +85,11 @@ pub struct ClParams {
     pub sigma_th2: f64,
     /// σ_new of (9.27).
     pub sigma_new: f64,
+    /// Which directions (9.27) accelerates: all those below σ_th,2 (the thesis) or only the trusted ones.
+    pub gain: Gain,
+    /// κ of the truncated gain's rule: a direction is accelerated when its data exceed κ times the noise
+    /// estimate σ̂ (used with `Gain::Truncated` only).
+    pub kappa: f64,
     /// Seed of Algorithm 3's random visiting order π.
     pub seed: u64,
 }
@@ -67,6 +105,8 @@ impl Default for ClParams {
             t_th2: 4.9,
             sigma_th2: 0.5,
             sigma_new: 100.0,
+            gain: Gain::Thesis,
+            kappa: KAPPA,
             seed: 1,
         }
     }
@@ -93,6 +133,7 @@ impl ClParams {
         fin("t_th2", self.t_th2, false)?;
         fin("sigma_th2", self.sigma_th2, true)?;
         fin("sigma_new", self.sigma_new, true)?;
+        fin("kappa", self.kappa, true)?;
         Ok(())
     }
 }
@@ -113,6 +154,10 @@ pub struct ConcurrentEstimator {
     m: Vec<V7>,
     saved: Vec<V7>,
     k: Vec<M7>,
+    /// per body, when the gain was last formed: the directions the truncated rule withheld
+    withheld: Vec<usize>,
+    /// the estimate when the gain switched on: the truncated rule's reference (9.27′), kept while it stays on
+    m_ref: Vec<V7>,
     gain_on: bool,
     gain_stale: bool,
     t: f64,
@@ -130,6 +175,8 @@ impl ConcurrentEstimator {
             m: (0..nbodies).map(|i| V7::from_column_slice(&m0[NP * i..NP * (i + 1)])).collect(),
             saved: vec![V7::zeros(); nbodies],
             k: vec![M7::identity(); nbodies],
+            withheld: vec![0; nbodies],
+            m_ref: vec![V7::zeros(); nbodies],
             gain_on: false,
             gain_stale: true,
             t: 0.0,
@@ -170,6 +217,11 @@ impl ConcurrentEstimator {
     pub fn gain(&self) -> &[M7] {
         &self.k
     }
+    /// Per body: how many directions the truncated gain left at the plain law's rate although (9.27) would
+    /// accelerate them, when the gain was last formed (zeros with the thesis gain and before T_th,2).
+    pub fn withheld(&self) -> &[usize] {
+        &self.withheld
+    }
 
     /// Offer the sample (𝐑_k, 𝐅_k) at the current time: Algorithm 4 feeds it to Algorithm 3 while t < T_th and
     /// ignores it afterwards (`Ok(None)`).
@@ -194,10 +246,27 @@ impl ConcurrentEstimator {
         let p = self.params;
         // the switch is decided at the step's start time (half a microstep of slack against 4.9 = 490·0.01)
         let on = p.aggressive && self.t >= p.t_th2 - 1e-9 * dt;
+        if on && !self.gain_on {
+            self.m_ref.copy_from_slice(&self.m);
+        }
         if on && (!self.gain_on || self.gain_stale) {
             let sref = self.stack.singular_values().first().copied().unwrap_or(0.0).sqrt();
-            for (k, t) in self.k.iter_mut().zip(self.stack.tri()) {
-                *k = svd_gain(t, p.sigma_th2, p.sigma_new, sref);
+            match p.gain {
+                Gain::Thesis => {
+                    for (k, t) in self.k.iter_mut().zip(self.stack.tri()) {
+                        *k = svd_gain(t, p.sigma_th2, p.sigma_new, sref);
+                    }
+                }
+                Gain::Truncated => {
+                    for i in 0..self.m.len() {
+                        let sh = self.stack.noise_sigma(i).unwrap_or(f64::INFINITY);
+                        let (t, g) = (&self.stack.tri()[i], &self.stack.g()[i]);
+                        let (k, w) =
+                            truncated_svd_gain(t, g, &self.m_ref[i], sh, p.kappa, p.sigma_th2, p.sigma_new, sref);
+                        self.k[i] = k;
+                        self.withheld[i] = w;
+                    }
+                }
             }
             self.gain_stale = false;
         }

@@ -343,8 +343,10 @@ impl DataStack {
             if cand_trace == 0.0 && p_trace == 0.0 {
                 // both carry no information (e.g. a robot at rest: R̂ = 0 exactly): the replacement passes the
                 // test and changes neither RR nor T; store the point without recomputing what cannot change
-                // (with R̂ = 0 on both sides Rf and g are unchanged too: the F column only enters ρ)
-                self.store_raw(p, x, fw);
+                // (with R̂ = 0 on both sides Rf and g are unchanged too: the F column only enters ρ, whose tree
+                // path `store` redoes; T and g come out of it the same to the bit, a zero column of a
+                // reflection's input skipping that reflection)
+                self.store(p, x, fw);
                 return Ok(Offer::Replaced(p));
             }
             self.trials += 1;
@@ -407,17 +409,6 @@ impl DataStack {
         true
     }
 
-    fn store_raw(&mut self, s: usize, x: &[M87], fw: &[V8]) {
-        let nb = self.nb;
-        for i in 0..nb {
-            self.r[s * nb + i] = x[i];
-            self.f[s * nb + i] = fw[i];
-            self.g[s * nb + i] = self.cand_g[i];
-            self.gf[s * nb + i] = self.cand_gf[i];
-        }
-        self.changes += 1;
-    }
-
     fn store(&mut self, s: usize, x: &[M87], fw: &[V8]) {
         let nb = self.nb;
         let p2 = self.leaves;
@@ -439,6 +430,34 @@ impl DataStack {
             }
         }
         self.changes += 1;
+    }
+
+    /// Body i's least-squares residual norm ρ_i over the stored points: `[R̂_1|F_1; …; R̂_N|F_N] = Q [T g; 0 ρ]`,
+    /// so ρ_i = min_𝐌 ‖[R̂_k] 𝐌 − [F_k]‖ (0 while empty); None for i ≥ B.
+    pub fn residual_norm(&self, i: usize) -> Option<f64> {
+        (i < self.nb).then(|| self.qtree[i * 2 * self.leaves + 1][(7, 7)].abs())
+    }
+
+    /// Body i's noise estimate σ̂_i = ρ_i / √(n_i − r_i): n_i the stored rows of `[R̂|F]` that are not identically
+    /// zero (a robot at rest gives zero rows, which carry nothing), r_i the rank of its block (singular values of
+    /// T above `ZERO_RTOL` of the largest over all blocks). The unbiased estimate of the variance per row for
+    /// independent equal-variance noise on the wrenches; infinite when there is no redundancy (n_i ≤ r_i); None
+    /// for i ≥ B.
+    pub fn noise_sigma(&self, i: usize) -> Option<f64> {
+        let rho = self.residual_norm(i)?;
+        let nb = self.nb;
+        let mut rows = 0usize;
+        for s in 0..self.nc {
+            let (r, f) = (&self.r[s * nb + i], &self.f[s * nb + i]);
+            rows += (0..8).filter(|&row| f[row] != 0.0 || r.row(row).iter().any(|x| *x != 0.0)).count();
+        }
+        let s_ref = self.sv.first().copied().unwrap_or(0.0).sqrt();
+        let zero = super::ZERO_RTOL * s_ref;
+        let rank = self.block_sv[NP * i..NP * (i + 1)].iter().filter(|x| x.sqrt() > zero).count();
+        if rows <= rank {
+            return Some(f64::INFINITY);
+        }
+        Some(rho / ((rows - rank) as f64).sqrt())
     }
 
     /// Algorithm 4's sums, reset first (the printed algorithm accumulates onto the previous call's RR, Rf),
