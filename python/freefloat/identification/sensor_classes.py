@@ -21,9 +21,10 @@ Estimators and what each run measures (the motion is simulated once per process 
   mass is the base's mass (the only mass parameter), centre of mass the first moments of each body, inertia the
   inertia combinations of each body; the worst body counts.
 - `cl`: Valverde 2018 ch. 9 concurrent learning on `valverde_ch9_two_arm` (run to 100 s; the excitation is the
-  thesis' 2-3 s), the preset's gyro white noise per sample on the body twists and twist rates, and the preset's
-  force/torque class (its force noise, N, on every wrench component) on the joint wrenches. Its centres of mass
-  are known, so it has no centre-of-mass error. Worst body.
+  thesis' 2-3 s) with the thesis' SVD gain and with the truncated gain (docs/identification.md), the preset's
+  gyro white noise per sample on the body twists and twist rates, and the preset's force/torque class (its force
+  noise, N, on every wrench component) on the joint wrenches. Its centres of mass are known, so it has no
+  centre-of-mass error. Worst body.
 
 Each error is a relative norm: `‖θ̂ − θ‖ / ‖θ‖` over the group's parameters (the inertia as a 3×3 matrix where the
 group is one, Frobenius norm), NaN when the estimator gave no estimate at that horizon (too few samples for the
@@ -57,7 +58,7 @@ __all__ = [
 ESTIMATORS = {
     "zhang": ("zhang_momentum", "zhang_force"),
     "naveen": ("naveen_ls", "naveen_eiv"),
-    "cl": ("cl_thesis",),
+    "cl": ("cl_thesis", "cl_truncated"),
 }
 CLASSES = ("navigation", "tactical", "mems")
 HORIZONS = (10.0, 30.0, 100.0)
@@ -203,19 +204,18 @@ def _cl(sensor_class: str, seed: int, horizons) -> dict:
     gyro = next(s for s in sensors.load(sensor_class).to_dicts() if s["type"] == "gyro")
     rate_sigma = float(gyro["noise_density"]) * math.sqrt(1.0 / sc.dt)  # white part per sample
     wrench_sigma = float(sensors.FORCE_TORQUE.force_noise)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # unrealisable estimates are the result here, not a failure
-        r = cl.run(sc, wrench_noise=wrench_sigma, rate_noise=rate_sigma, noise_seed=int(seed))
     out = {}
-    truth = np.asarray(r.truth).reshape(-1, 7)
-    for T in horizons:
-        k = int(np.searchsorted(r.t, T + 1e-9, side="right")) - 1
-        est = np.asarray(r.estimates[k]).reshape(-1, 7)
-        out[f"cl_thesis.mass.{T:g}"] = max(_rel(e[6], t[6]) for e, t in zip(est, truth))
-        out[f"cl_thesis.com.{T:g}"] = math.nan  # known in ch. 9
-        out[f"cl_thesis.inertia.{T:g}"] = max(
-            _rel(_sym(e[[0, 1, 2, 3, 4, 5]]), _sym(t[:6])) for e, t in zip(est, truth)
-        )
+    for gain in ("thesis", "truncated"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # unrealisable estimates are the result here, not a failure
+            r = cl.run(sc, wrench_noise=wrench_sigma, rate_noise=rate_sigma, noise_seed=int(seed), gain=gain)
+        truth = np.asarray(r.truth).reshape(-1, 7)
+        for T in horizons:
+            k = int(np.searchsorted(r.t, T + 1e-9, side="right")) - 1
+            est = np.asarray(r.estimates[k]).reshape(-1, 7)
+            out[f"cl_{gain}.mass.{T:g}"] = max(_rel(e[6], t[6]) for e, t in zip(est, truth))
+            out[f"cl_{gain}.com.{T:g}"] = math.nan  # known in ch. 9
+            out[f"cl_{gain}.inertia.{T:g}"] = max(_rel(_sym(e[:6]), _sym(t[:6])) for e, t in zip(est, truth))
     out["cl_rate_sigma"] = rate_sigma
     out["cl_wrench_sigma"] = wrench_sigma
     return out
