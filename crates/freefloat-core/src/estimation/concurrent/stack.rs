@@ -174,6 +174,8 @@ pub struct DataStack {
     tri: Vec<M7>,
     leaves: usize,
     qtree: Vec<M8>,
+    /// whether the tree's ρ (its root's last entry) misses a replacement made without refactoring (`offer`)
+    rho_stale: bool,
     gvec: Vec<V7>,
     /// sorted (descending) union of the blocks' singular values of RR, from T (σ = s(T)², accurate down to
     /// ε·σ_max instead of the Gram eigenvalues' √ε·… floor)
@@ -228,6 +230,7 @@ impl DataStack {
             tri: vec![z7; nb],
             leaves: ns.next_power_of_two(),
             qtree: vec![M8::zeros(); 2 * ns.next_power_of_two() * nb],
+            rho_stale: false,
             gvec: vec![V7::zeros(); nb],
             sv: vec![0.0; NP * nb],
             sv_test: vec![0.0; NP * nb],
@@ -343,10 +346,12 @@ impl DataStack {
             if cand_trace == 0.0 && p_trace == 0.0 {
                 // both carry no information (e.g. a robot at rest: R̂ = 0 exactly): the replacement passes the
                 // test and changes neither RR nor T; store the point without recomputing what cannot change
-                // (with R̂ = 0 on both sides Rf and g are unchanged too: the F column only enters ρ, whose tree
-                // path `store` redoes; T and g come out of it the same to the bit, a zero column of a
-                // reflection's input skipping that reflection)
-                self.store(p, x, fw);
+                // (with R̂ = 0 on both sides Rf, g and the tree's T, g are unchanged too: the F column only enters
+                // ρ, so the tree's ρ is marked stale and `residual_norm` refactors from the stored points; redoing
+                // the tree path here cost the thesis run 7-12 % of its estimator time at N_s = 10-50, in the
+                // stretch at rest before the excitation)
+                self.store_raw(p, x, fw);
+                self.rho_stale = true;
                 return Ok(Offer::Replaced(p));
             }
             self.trials += 1;
@@ -409,6 +414,18 @@ impl DataStack {
         true
     }
 
+    /// Store point s without touching the QR tree (for a point whose R̂ is zero replacing one whose R̂ is zero).
+    fn store_raw(&mut self, s: usize, x: &[M87], fw: &[V8]) {
+        let nb = self.nb;
+        for i in 0..nb {
+            self.r[s * nb + i] = x[i];
+            self.f[s * nb + i] = fw[i];
+            self.g[s * nb + i] = self.cand_g[i];
+            self.gf[s * nb + i] = self.cand_gf[i];
+        }
+        self.changes += 1;
+    }
+
     fn store(&mut self, s: usize, x: &[M87], fw: &[V8]) {
         let nb = self.nb;
         let p2 = self.leaves;
@@ -433,9 +450,23 @@ impl DataStack {
     }
 
     /// Body i's least-squares residual norm ρ_i over the stored points: `[R̂_1|F_1; …; R̂_N|F_N] = Q [T g; 0 ρ]`,
-    /// so ρ_i = min_𝐌 ‖[R̂_k] 𝐌 − [F_k]‖ (0 while empty); None for i ≥ B.
+    /// so ρ_i = min_𝐌 ‖[R̂_k] 𝐌 − [F_k]‖ (0 while empty); None for i ≥ B. From the tree's root, or, when a
+    /// replacement at rest left the tree's ρ stale (`offer`), by refactoring body i's stored points in turn.
     pub fn residual_norm(&self, i: usize) -> Option<f64> {
-        (i < self.nb).then(|| self.qtree[i * 2 * self.leaves + 1][(7, 7)].abs())
+        if i >= self.nb {
+            return None;
+        }
+        if !self.rho_stale {
+            return Some(self.qtree[i * 2 * self.leaves + 1][(7, 7)].abs());
+        }
+        let mut acc = M8::zeros();
+        for s in 0..self.nc {
+            let mut leaf = M8::zeros();
+            leaf.fixed_view_mut::<8, 7>(0, 0).copy_from(&self.r[s * self.nb + i]);
+            leaf.fixed_view_mut::<8, 1>(0, 7).copy_from(&self.f[s * self.nb + i]);
+            acc = merge(&acc, &triangularize(&leaf));
+        }
+        Some(acc[(7, 7)].abs())
     }
 
     /// Body i's noise estimate σ̂_i = ρ_i / √(n_i − r_i): n_i the stored rows of `[R̂|F]` that are not identically
