@@ -382,6 +382,36 @@ def _sensor_classes(page, t):
     )
     head = ["estimator", "class", "quantity", *[f"{h:g} s" for h in horizons], "runs"]
     page.table(head, scl.table_rows(rows, horizons), left=3)
+    if not horizons:
+        return
+    import plotly.graph_objects as go
+
+    # one chart per quantity: the median at the last horizon, estimator by sensor class, log scale (errors span
+    # 1e-5 to 1e4), the 95th percentile as the error bar's top
+    last = horizons[-1]
+    summary = [x for x in scl.summary(rows, horizons) if x["horizon_s"] == last and x["finite"]]
+    for q in scl.QUANTITIES:
+        fig = go.Figure()
+        for cls in scl.CLASSES:
+            mine = [x for x in summary if x["quantity"] == q and x["sensor_class"] == cls]
+            if not mine:
+                continue
+            med = [x["median"] for x in mine]
+            fig.add_trace(
+                go.Bar(
+                    x=[x["estimator"] for x in mine],
+                    y=med,
+                    name=cls,
+                    error_y={"type": "data", "symmetric": False, "array": [x["p95"] - m for x, m in zip(mine, med)]},
+                )
+            )
+        if fig.data:
+            fig.update_layout(
+                title=f"{q} error after {last:g} s (median; bar to the 95th percentile)",
+                yaxis={"type": "log", "title": "relative error"},
+                barmode="group",
+            )
+            page.figure(fig, height=360)
 
 
 # -- any kind ---------------------------------------------------------------------------------------------
