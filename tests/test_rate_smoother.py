@@ -205,28 +205,11 @@ def test_rts_accelerations_of_a_post_capture_run_with_a_mems_gyro(tmp_path):
     assert e["rts"][1] < e["sg"][1] and e["rts"][1] < e["cd"][1] / 5, e
 
 
-def test_force_form_with_a_fibre_optic_gyro(tmp_path):
+def test_force_form_with_a_fibre_optic_gyro(zhang3d_measured_60s):
     """The force form on the built-in `zhang2020_3d` run (60 s) measured with `zhang2020_3d_thrusters`' 100 Hz
     telemetry (gyro at 1e-6 rad/s/√Hz): RMS relative error of m1, mn and the target's principal moments with the
     smoother's accelerations several times below central differences' (docs/postcapture.md: 0.28 % against 4.7 %
     after 100 s)."""
-    import dataclasses
-
-    import freefloat.postcapture as pc
-    from freefloat import models
-    from freefloat.postcapture.estimators import target_index
-    from freefloat.postcapture.spacecraft import truth_history
-
-    base = pc.load_scenario("zhang2020_3d")
-    sens = pc.load_scenario("zhang2020_3d_thrusters").sensors
-    m = models.load(base.model)
-    sim = pc.simulate(dataclasses.replace(base, duration=60.0), m)
-    cols = ["m1", "mn", "Inxx", "Inyy", "Inzz"]
-    err = {}
-    for kind in ("central_difference", "rts"):
-        sc = dataclasses.replace(base, duration=60.0, sensors=sens, sensor_seed=0, measurement={"accelerations": kind})
-        res = pc.identify(m, pc.measure(m, sim, sc), sc, methods=("force",))
-        res.truth_history = truth_history(m, sim, False, target_index(m))
-        err[kind] = res.rms_rel_error("force", "standard_rls", cols)
+    err = {kind: zhang3d_measured_60s("force", {"accelerations": kind}) for kind in ("central_difference", "rts")}
     print("force form, gyro N = 1e-6, RMS relative error:", err)
     assert err["rts"] < err["central_difference"] / 4, err
