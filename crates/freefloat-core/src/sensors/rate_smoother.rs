@@ -99,7 +99,7 @@ pub fn smooth_rates(y: &[f64], channels: usize, h: f64, log_ratio: Option<f64>) 
 /// Golden-section refinement after a grid search of the GCV score.
 fn best_ratio(y: &[f64], h: f64, ws: &mut Workspace) -> f64 {
     let n = y.len() as f64;
-    let nll = |s: f64, ws: &mut Workspace| {
+    let log_gcv = |s: f64, ws: &mut Workspace| {
         let (rss, trace) = ws.run(y, h, 10f64.powf(s) / (h * h * h));
         // log GCV; an interpolating fit (tr A → N) is the worst, never a division by zero
         let dof = (n - trace).max(1e-12 * n);
@@ -107,27 +107,27 @@ fn best_ratio(y: &[f64], h: f64, ws: &mut Workspace) -> f64 {
     };
     let steps = ((S_MAX - S_MIN) / S_STEP).round() as usize;
     let grid: Vec<f64> = (0..=steps).map(|i| S_MIN + S_STEP * i as f64).collect();
-    let vals: Vec<f64> = grid.iter().map(|&s| nll(s, ws)).collect();
+    let vals: Vec<f64> = grid.iter().map(|&s| log_gcv(s, ws)).collect();
     let i = (0..vals.len()).fold(0, |b, i| if vals[i] < vals[b] { i } else { b });
     let (mut lo, mut hi) = (grid[i.saturating_sub(1)], grid[(i + 1).min(steps)]);
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut x1, mut x2) = (hi - g * (hi - lo), lo + g * (hi - lo));
-    let (mut f1, mut f2) = (nll(x1, ws), nll(x2, ws));
+    let (mut f1, mut f2) = (log_gcv(x1, ws), log_gcv(x2, ws));
     while hi - lo > 1e-3 {
         if f1 <= f2 {
             hi = x2;
             (x2, f2) = (x1, f1);
             x1 = hi - g * (hi - lo);
-            f1 = nll(x1, ws);
+            f1 = log_gcv(x1, ws);
         } else {
             lo = x1;
             (x1, f1) = (x2, f2);
             x2 = lo + g * (hi - lo);
-            f2 = nll(x2, ws);
+            f2 = log_gcv(x2, ws);
         }
     }
     let best = if f1 <= f2 { (x1, f1) } else { (x2, f2) };
-    // the grid point itself when the bracket's interior is no better (a flat or monotone likelihood)
+    // the grid point itself when the bracket's interior is no better (a flat or monotone score)
     if vals[i] < best.1 {
         grid[i]
     } else {
