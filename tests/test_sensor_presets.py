@@ -195,60 +195,6 @@ def test_presets_with_a_force_torque_sensor_measure_the_joint_wrench(run):
 
 
 # ---------------------------------------------------------------------------------------------------------------
-HUB = """name: hub_wheel
-base: free
-gravity: [0, 0, 0]
-bodies:
-  - name: hub
-    inertial: {mass: 10.0, com: [0, 0, 0], inertia: [2.0, 2.0, 2.0]}
-  - name: rotor
-    parent: hub
-    joint: {name: rw, type: revolute, axis: [0, 0, 1]}
-    origin: {xyz: [0, 0, 0], rpy: [0, 0, 0]}
-    inertial: {mass: 1.0, com: [0, 0, 0], inertia: [0.06, 0.06, 0.1]}
-"""
-SCENARIO = "kind: simulate\nmodel: robot.yaml\nduration: 1.0\ndt: 0.001\ntorques: {constant: {rw: 0.1}}\n"
-
-
-def test_a_scenario_sensors_block_may_name_a_preset(tmp_path):
-    (tmp_path / "robot.yaml").write_text(HUB)
-    p = tmp_path / "sc.yaml"
-    p.write_text(SCENARIO + "sensors: {preset: tactical}\n")
-    r = ff.run_simulation_scenario(p)
-    assert r.measurement.sensors.to_dict() == sn.tactical().to_dict()
-    assert {k: len(s.t) for k, s in r.measurement.streams.items()} == {
-        "base_velocity": 101,
-        "gyro": 101,
-        "tachometer": 101,
-        "encoder": 101,
-    }
-    p.write_text(SCENARIO + "sensors:\n  preset: {name: navigation, rate: 50, force_torque: rw}\n")
-    r = ff.run_simulation_scenario(p)
-    assert r.measurement.sensors.to_dict() == sn.navigation(rate=50, force_torque="rw").to_dict()
-    assert len(r.measurement.streams["force_torque"].t) == 51
-
-
-@pytest.mark.parametrize(
-    "block, words",
-    [
-        ("sensors: {preset: tactcal}\n", ["line 6", "unknown preset 'tactcal'", "naveen, mems, tactical, navigation"]),
-        ("sensors: {preset: mems, sensors: []}\n", ["line 6", "{preset: NAME}", "preset, sensors"]),
-        ("sensors: {preset: {name: mems, rte: 5}}\n", ["line 6", "preset.rte"]),
-        ("sensors: {preset: {name: mems, rate: 5000}}\n", ["sensors[0].rate", "above the integration rate"]),
-        ("sensors: {preset: {name: mems, force_torque: J9}}\n", ["sensors[4].joint", "no joint 'J9'"]),
-    ],
-)
-def test_a_bad_preset_in_a_scenario_names_the_file_line_and_key(tmp_path, block, words):
-    (tmp_path / "robot.yaml").write_text(HUB)
-    p = tmp_path / "sc.yaml"
-    p.write_text(SCENARIO + block)
-    with pytest.raises(InputError) as e:
-        ff.run_simulation_scenario(p)
-    msg = str(e.value)
-    assert "sc.yaml" in msg and all(w in msg for w in words), msg
-
-
-# ---------------------------------------------------------------------------------------------------------------
 def test_cli_measure_takes_a_preset_and_its_help_lists_them(tmp_path):
     from click.testing import CliRunner
 

@@ -17,6 +17,7 @@ import pytest
 import freefloat as ff
 import freefloat.postcapture as pc
 from freefloat import InputError, models
+from freefloat import sensors as sn
 from freefloat.io import data
 
 MU = 3.986004418e14
@@ -298,3 +299,40 @@ def test_the_built_in_simulate_scenario_runs_from_the_command_line(tmp_path):
     res = json.loads((out / "results.json").read_text())
     assert res["scenario"] == "valverde_ch5_leo" and "measurement" in res
     assert res["momentum_drift_angular_abs"] > 1e-6 and res["momentum_drift_linear_rel"] < 1e-6
+
+
+# -- a sensors block that names a preset (freefloat.sensors.PRESETS) ---------------------------------------
+PRESET_SCENARIO = "kind: simulate\nmodel: robot.yaml\nduration: 1.0\ndt: 0.001\ntorques: {constant: {rw: 0.1}}\n"
+
+
+def test_a_scenario_sensors_block_may_name_a_preset(tmp_path):
+    r = ff.run_simulation_scenario(write(tmp_path, PRESET_SCENARIO + "sensors: {preset: tactical}\n"))
+    assert r.measurement.sensors.to_dict() == sn.tactical().to_dict()
+    assert {k: len(s.t) for k, s in r.measurement.streams.items()} == {
+        "base_velocity": 101,
+        "gyro": 101,
+        "tachometer": 101,
+        "encoder": 101,
+    }
+    r = ff.run_simulation_scenario(
+        write(tmp_path, PRESET_SCENARIO + "sensors:\n  preset: {name: navigation, rate: 50, force_torque: rw}\n")
+    )
+    assert r.measurement.sensors.to_dict() == sn.navigation(rate=50, force_torque="rw").to_dict()
+    assert len(r.measurement.streams["force_torque"].t) == 51
+
+
+@pytest.mark.parametrize(
+    "block, words",
+    [
+        ("sensors: {preset: tactcal}\n", ["line 6", "unknown preset 'tactcal'", "naveen, mems, tactical, navigation"]),
+        ("sensors: {preset: mems, sensors: []}\n", ["line 6", "{preset: NAME}", "preset, sensors"]),
+        ("sensors: {preset: {name: mems, rte: 5}}\n", ["line 6", "preset.rte"]),
+        ("sensors: {preset: {name: mems, rate: 5000}}\n", ["sensors[0].rate", "above the integration rate"]),
+        ("sensors: {preset: {name: mems, force_torque: J9}}\n", ["sensors[4].joint", "no joint 'J9'"]),
+    ],
+)
+def test_a_bad_preset_in_a_scenario_names_the_file_line_and_key(tmp_path, block, words):
+    with pytest.raises(InputError) as e:
+        ff.run_simulation_scenario(write(tmp_path, PRESET_SCENARIO + block))
+    msg = str(e.value)
+    assert "sc.yaml" in msg and all(w in msg for w in words), msg
