@@ -106,9 +106,9 @@ every `replan` nodes (warm-started by the previous window shifted in time; the f
 window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
 `first_max_iter` bounds the first solve. `shrink`: no window reaches past the task's last node (the
 terminal cost lands on the task's end, a deadline); off, every window has `mpc_horizon` nodes. `stats()`: re-plans, iterations, solve time, slowest re-plan,
-troubled re-plans, last stop reason, the cost of each re-plan.
+troubled re-plans, last stop reason, the cost of each re-plan. `rate_joints` as in `ddp_solve`.
     """
-    def __init__(self, model: Model, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, mpc_horizon: ArrayLike, replan: ArrayLike, keep_out: ArrayLike | None = None, options: ArrayLike | None = None, first_max_iter: ArrayLike = 50, guess_xs: ArrayLike | None = None, guess_us: ArrayLike | None = None, shrink: ArrayLike = False) -> None: ...
+    def __init__(self, model: Model, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, mpc_horizon: ArrayLike, replan: ArrayLike, keep_out: ArrayLike | None = None, options: ArrayLike | None = None, first_max_iter: ArrayLike = 50, guess_xs: ArrayLike | None = None, guess_us: ArrayLike | None = None, shrink: ArrayLike = False, rate_joints: ArrayLike | None = None) -> None: ...
     def control(self, k: ArrayLike, x: Any) -> Any:
         """Control (nv,) at task node k for the measured state x = [q; v] (re-plans when due; Ctrl-C is checked
 between re-plans by the caller's loop).
@@ -283,6 +283,10 @@ class Model:
     @property
     def joint_types(self) -> list[str]:
         ...
+    def leading_bodies(self, n: ArrayLike) -> Any:
+        """A new Model of the first `n` bodies (the last ones, and the frames on them, dropped): the dynamics of the
+rest when the dropped tail is massless (the rate-driven wrist of the chapter 8 DDP robot).
+        """
     @property
     def limits(self) -> Any:
         """Joint limits as a dict of arrays (lower, upper, velocity, effort), NaN where not given."""
@@ -488,13 +492,14 @@ w x y z]) for `t_hold`, then `start · exp(½ θ̂ ŝ)` with `ŝ = axis + ε mom
 k = 0..=n. Returns (n + 1, 8); never properised.
     """
 
-def ddp_solve(model: Model, x0: ArrayLike, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, us0: ArrayLike, keep_out: ArrayLike | None = None, xs0: ArrayLike | None = None, options: ArrayLike | None = None, callback: ArrayLike | None = None) -> Any:
+def ddp_solve(model: Model, x0: ArrayLike, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, us0: ArrayLike, keep_out: ArrayLike | None = None, xs0: ArrayLike | None = None, options: ArrayLike | None = None, callback: ArrayLike | None = None, rate_joints: ArrayLike | None = None) -> Any:
     """Solve a floating-robot optimal-control problem by DDP (Valverde 2018, ch. 8).
 
 State `x = [q; v]` (nq + nv), control `u = τ` (nv: base force and torque in the base frame, then joint
 torques), semi-implicit Euler steps of `dt` over `horizon` nodes. `running` / `terminal`: lists of cost
 dicts with keys `name`, `kind` ('frame_placement' with `frame` and `reference` (M, 7) [p, quat xyzw];
-'frame_dq' with `frame` and `reference` (M, 8) thesis-layout dual quaternions; 'state' with optional
+'frame_dq' with `frame`, `reference` (M, 8) thesis-layout dual quaternions and optional `sign` ('literal',
+the thesis' q_G − q_D, or 'nearest': q_G − s q_D with s the sign of q_G,r · q_D,r); 'state' with optional
 `reference` (M, nx); 'control' with optional `reference` (M, nu)), and `weights` (one per residual
 entry) or `weights_start`/`weights_medium`/`weights_end` + `breakpoints` [i1, i2, i3, i4] (Table 8.2
 schedule). M is 1 or one per node. Cost = Σ w r² (no ½, no Δt). `keep_out`: dicts with `joint`,
@@ -506,6 +511,8 @@ the best iterate. Returns a dict: xs, us, gains (horizon, nu, ndx), cost, initia
 stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
 and rollout blocks). Option `refresh_gains` (default False): recompute the gains at the returned iterate
 (one more derivative evaluation and backward pass), as closed-loop use of the policy needs.
+`rate_joints`: names of the model's last joints to drive by their rates (a massless tail, the thesis' wrist of
+eq. (8.51)): their bodies' inertia is ignored and their controls are joint rates, not torques.
     """
 
 def difference(model: Model, q0: ArrayLike, q1: ArrayLike) -> Any:

@@ -126,6 +126,12 @@ class Model:
         (for algorithms that take moving joints only, such as DDP)."""
         return Model(self._core.with_fixed_leaves_merged())
 
+    def leading_bodies(self, n: int) -> Model:
+        """The model of the first `n` bodies: the last ones and their frames dropped, q and v the leading entries of
+        this model's. The dynamics of the rest equal this model's when the dropped tail is massless (the chapter 8
+        DDP robot's rate-driven wrist)."""
+        return Model(self._core.leading_bodies(int(n)))
+
     def with_gravity(self, g) -> Model:
         g = as_f64(g, "g")
         if g.shape != (3,):

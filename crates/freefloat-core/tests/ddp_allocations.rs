@@ -33,7 +33,7 @@ fn robot(n: usize) -> (FloatingRobot, Vec<f64>) {
         },
         CostTerm {
             name: "ee_dq".into(),
-            residual: Residual::FrameDualQuat { body, placement: place, refs: vec![dq] },
+            residual: Residual::FrameDualQuat { body, placement: place, refs: vec![dq], nearest_sign: false },
             weights: Weights::scheduled(vec![10.0; 8], vec![20.0; 8], vec![30.0; 8], [1, 2, 3, 4]).unwrap(),
         },
         CostTerm {

@@ -159,7 +159,7 @@ fn robot_with_all_costs(n: usize) -> FloatingRobot {
         },
         CostTerm {
             name: "ee_dq".into(),
-            residual: Residual::FrameDualQuat { body, placement: place, refs: dq.clone() },
+            residual: Residual::FrameDualQuat { body, placement: place, refs: dq.clone(), nearest_sign: false },
             weights: Weights::constant(w(8)).unwrap(),
         },
         CostTerm {
@@ -288,4 +288,56 @@ fn bad_references_and_weights_name_the_argument() {
     assert!(e.to_string().contains("dt"), "{e}");
     let e = FloatingRobot::new(m, 0.05, 0, vec![], vec![], vec![]).err().unwrap();
     assert!(e.to_string().contains("horizon"), "{e}");
+}
+
+#[test]
+fn nearest_sign_dual_quaternion_cost_measures_the_pose_not_the_sheet() {
+    // The reference is the end effector's own pose on the other sheet (−q_G, as the §8.7 reference is after its
+    // 2π screw): the thesis' literal cost is 4 Σ w_i g_i², the nearest-sign cost is zero; a reference turned a
+    // little off it gives a gradient that central differences confirm.
+    let m = builtin::load("valverde_ch8_arm").unwrap();
+    let (body, place) = m.frame_or_body("ee").unwrap();
+    let mut x = x0(&m);
+    x[11] = 0.3;
+    let mut data = freefloat_core::Data::new(&m);
+    freefloat_core::kinematics::forward_kinematics(&m, &mut data, &x[..m.nq]).unwrap();
+    let o_mf = data.o_mi[body].compose(&place);
+    let g =
+        freefloat_core::control::ddp::costs::frame_dual_quat(&m, &x[..m.nq], body, &place, &o_mf).unwrap().to_array();
+    let w: Vec<f64> = (0..8).map(|i| 1.0 + 0.25 * i as f64).collect();
+    let robot = |refs: Vec<[f64; 8]>, nearest_sign: bool| {
+        let term = CostTerm {
+            name: "pose".into(),
+            residual: Residual::FrameDualQuat { body, placement: place, refs, nearest_sign },
+            weights: Weights::constant(w.clone()).unwrap(),
+        };
+        FloatingRobot::new(m.clone(), 0.05, 2, vec![], vec![term], vec![]).unwrap()
+    };
+    let minus_g: [f64; 8] = std::array::from_fn(|i| -g[i]);
+    let literal = robot(vec![minus_g], false).calc_terminal(&x).unwrap();
+    let expect: f64 = (0..8).map(|i| w[i] * 4.0 * g[i] * g[i]).sum();
+    assert!((literal - expect).abs() < 1e-12 * expect, "literal {literal} vs {expect}");
+    assert!(robot(vec![minus_g], true).calc_terminal(&x).unwrap() < 1e-28);
+    // a nearby reference on the other sheet: 0.2 rad about z and 5 cm away
+    let turn = DualQuat::new(Quat::from_axis_angle(&V3::z(), 0.2), Quat::new(0.0, 0.0, 0.0, 0.0));
+    let shift = pose::from_rotation_translation(&Quat::new(1.0, 0.0, 0.0, 0.0), &V3::new(0.05, 0.0, 0.0));
+    let gq = DualQuat::from_slice(&g);
+    let near = shift.mul(&gq).mul(&turn).to_array();
+    let near_minus: [f64; 8] = std::array::from_fn(|i| -near[i]);
+    let (mut rn, mut rp) = (robot(vec![near_minus], true), robot(vec![near], false));
+    assert!((rn.calc_terminal(&x).unwrap() - rp.calc_terminal(&x).unwrap()).abs() < 1e-12);
+    let mut d = NodeDiff::zeros(rn.ndx(), rn.nu());
+    rn.calc_diff_terminal(&x, &mut d).unwrap();
+    let (h, mut xp) = (1e-6, vec![0.0; rn.nx()]);
+    for i in 0..rn.ndx() {
+        let mut t = vec![0.0; rn.ndx()];
+        t[i] = h;
+        rn.integrate(&x, &t, &mut xp);
+        let cp = rn.calc_terminal(&xp.clone()).unwrap();
+        t[i] = -h;
+        rn.integrate(&x, &t, &mut xp);
+        let cm = rn.calc_terminal(&xp.clone()).unwrap();
+        let fd = (cp - cm) / (2.0 * h);
+        assert!((fd - d.lx[i]).abs() < 1e-5 * (1.0 + fd.abs()), "Lx[{i}]: fd {fd} vs {}", d.lx[i]);
+    }
 }

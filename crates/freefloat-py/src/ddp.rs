@@ -73,7 +73,14 @@ fn cost_term(m: &Model, d: &Bound<'_, PyDict>, i: usize) -> PyResult<CostTerm> {
                 .iter()
                 .map(|p| [p[0], p[1], p[2], p[3], p[4], p[5], p[6], p[7]])
                 .collect();
-            Residual::FrameDualQuat { body, placement, refs }
+            let nearest_sign = match get::<String>(d, &ctx, "sign")?.as_deref() {
+                None | Some("literal") => false,
+                Some("nearest") => true,
+                Some(other) => {
+                    return Err(input_err(format!("{ctx}: key `sign`: expected 'literal' or 'nearest', got '{other}'")))
+                }
+            };
+            Residual::FrameDualQuat { body, placement, refs, nearest_sign }
         }
         "state" => {
             let refs = match reference {
@@ -217,6 +224,7 @@ fn build_robot(
     running: &Bound<'_, PyList>,
     terminal: &Bound<'_, PyList>,
     keep_out: Option<&Bound<'_, PyList>>,
+    rate_joints: Option<Vec<String>>,
 ) -> PyResult<FloatingRobot> {
     let mb = model_arg(model)?;
     let m: Model = (*mb.get().inner).clone();
@@ -245,7 +253,21 @@ fn build_robot(
             });
         }
     }
-    guard(|| FloatingRobot::new(m, dt, horizon, run_terms, term_terms, kos))
+    // Rate-driven joints: named, and they must be the model's last ones (a massless tail: the thesis' wrist).
+    let k = rate_joints.as_ref().map_or(0, |v| v.len());
+    if let Some(names) = &rate_joints {
+        let n = m.nbodies();
+        if k >= n || m.joint_names[n - k..] != names[..] {
+            return Err(input_err(format!(
+                "argument `rate_joints`: the rate-driven joints must be the model's last joints, in order (a massless \
+                 tail after the base); got {names:?}, the model's joints are {:?}",
+                &m.joint_names[1..]
+            )));
+        }
+    }
+    let mut robot = guard(|| FloatingRobot::new(m, dt, horizon, run_terms, term_terms, kos))?;
+    guard(|| robot.set_rate_driven(k))?;
+    Ok(robot)
 }
 
 fn check_x0(x0: &[f64], nx: usize) -> PyResult<()> {
@@ -263,7 +285,8 @@ fn check_x0(x0: &[f64], nx: usize) -> PyResult<()> {
 /// State `x = [q; v]` (nq + nv), control `u = τ` (nv: base force and torque in the base frame, then joint
 /// torques), semi-implicit Euler steps of `dt` over `horizon` nodes. `running` / `terminal`: lists of cost
 /// dicts with keys `name`, `kind` ('frame_placement' with `frame` and `reference` (M, 7) [p, quat xyzw];
-/// 'frame_dq' with `frame` and `reference` (M, 8) thesis-layout dual quaternions; 'state' with optional
+/// 'frame_dq' with `frame`, `reference` (M, 8) thesis-layout dual quaternions and optional `sign` ('literal',
+/// the thesis' q_G − q_D, or 'nearest': q_G − s q_D with s the sign of q_G,r · q_D,r); 'state' with optional
 /// `reference` (M, nx); 'control' with optional `reference` (M, nu)), and `weights` (one per residual
 /// entry) or `weights_start`/`weights_medium`/`weights_end` + `breakpoints` [i1, i2, i3, i4] (Table 8.2
 /// schedule). M is 1 or one per node. Cost = Σ w r² (no ½, no Δt). `keep_out`: dicts with `joint`,
@@ -275,8 +298,10 @@ fn check_x0(x0: &[f64], nx: usize) -> PyResult<()> {
 /// stop_message, history (list of dicts), gap, timings (seconds and calls of the derivative, backward-pass
 /// and rollout blocks). Option `refresh_gains` (default False): recompute the gains at the returned iterate
 /// (one more derivative evaluation and backward pass), as closed-loop use of the policy needs.
+/// `rate_joints`: names of the model's last joints to drive by their rates (a massless tail, the thesis' wrist of
+/// eq. (8.51)): their bodies' inertia is ignored and their controls are joint rates, not torques.
 #[pyfunction]
-#[pyo3(signature = (model, x0, dt, horizon, running, terminal, us0, keep_out = None, xs0 = None, options = None, callback = None))]
+#[pyo3(signature = (model, x0, dt, horizon, running, terminal, us0, keep_out = None, xs0 = None, options = None, callback = None, rate_joints = None))]
 #[allow(clippy::too_many_arguments)]
 pub fn ddp_solve<'py>(
     py: Python<'py>,
@@ -291,8 +316,9 @@ pub fn ddp_solve<'py>(
     xs0: Option<PyReadonlyArray2<'py, f64>>,
     options: Option<&Bound<'py, PyDict>>,
     callback: Option<Bound<'py, PyAny>>,
+    rate_joints: Option<Vec<String>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let mut robot = build_robot(model, dt, horizon, running, terminal, keep_out)?;
+    let mut robot = build_robot(model, dt, horizon, running, terminal, keep_out, rate_joints)?;
     let (nx, nu) = (robot.nx(), robot.nu());
     check_x0(&x0, nx)?;
     let s = us0.shape();
@@ -525,7 +551,7 @@ impl PyDdpPolicy {
 /// window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
 /// `first_max_iter` bounds the first solve. `shrink`: no window reaches past the task's last node (the
 /// terminal cost lands on the task's end, a deadline); off, every window has `mpc_horizon` nodes. `stats()`: re-plans, iterations, solve time, slowest re-plan,
-/// troubled re-plans, last stop reason, the cost of each re-plan.
+/// troubled re-plans, last stop reason, the cost of each re-plan. `rate_joints` as in `ddp_solve`.
 #[pyclass(name = "DdpMpc", module = "freefloat._core")]
 pub struct PyDdpMpc {
     mpc: Mpc,
@@ -535,7 +561,7 @@ pub struct PyDdpMpc {
 #[pymethods]
 impl PyDdpMpc {
     #[new]
-    #[pyo3(signature = (model, dt, horizon, running, terminal, mpc_horizon, replan, keep_out = None, options = None, first_max_iter = 50, guess_xs = None, guess_us = None, shrink = false))]
+    #[pyo3(signature = (model, dt, horizon, running, terminal, mpc_horizon, replan, keep_out = None, options = None, first_max_iter = 50, guess_xs = None, guess_us = None, shrink = false, rate_joints = None))]
     #[allow(clippy::too_many_arguments)]
     fn new(
         model: &Bound<'_, PyAny>,
@@ -551,8 +577,9 @@ impl PyDdpMpc {
         guess_xs: Option<PyReadonlyArray2<'_, f64>>,
         guess_us: Option<PyReadonlyArray2<'_, f64>>,
         shrink: bool,
+        rate_joints: Option<Vec<String>>,
     ) -> PyResult<Self> {
-        let robot = build_robot(model, dt, horizon, running, terminal, keep_out)?;
+        let robot = build_robot(model, dt, horizon, running, terminal, keep_out, rate_joints)?;
         let (nx, nu) = (robot.nx(), robot.nu());
         let (solver, _) = parse_options(options)?;
         let guess = match (guess_xs, guess_us) {

@@ -230,6 +230,12 @@ impl PyModel {
         guard(|| self.inner.with_fixed_leaves_merged()).map(PyModel::wrap)
     }
 
+    /// A new Model of the first `n` bodies (the last ones, and the frames on them, dropped): the dynamics of the
+    /// rest when the dropped tail is massless (the rate-driven wrist of the chapter 8 DDP robot).
+    fn leading_bodies(&self, n: usize) -> PyResult<PyModel> {
+        guard(|| self.inner.leading_bodies(n)).map(PyModel::wrap)
+    }
+
     fn with_gravity(&self, g: [f64; 3]) -> PyResult<PyModel> {
         guard(|| self.inner.with_gravity(g.into())).map(PyModel::wrap)
     }

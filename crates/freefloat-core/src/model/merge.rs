@@ -1,5 +1,6 @@
-//! Welded leaves merged into their parents: the same rigid-body dynamics with fewer bodies, for algorithms that
-//! take only moving joints (the DDP robot model of Valverde 2018 ch. 8, say).
+//! Smaller models with the same dynamics: welded leaves merged into their parents, for algorithms that take only
+//! moving joints (the DDP robot model of Valverde 2018 ch. 8, say), and a model cut to its leading bodies (a
+//! massless tail, such as that model's rate-driven wrist, dropped).
 
 use super::{Frame, JointType, Model};
 use crate::error::{FfError, Result};
@@ -75,6 +76,35 @@ impl Model {
         m.id = super::next_model_id();
         Ok(m)
     }
+    /// The model of its first `n` bodies: the last `nbodies − n` bodies (a subtree closed under descendants, since
+    /// every parent precedes its children) and the frames on them are dropped, the rest keeps its layout (q and v
+    /// of the kept joints are the leading entries of the full model's). The dynamics of the rest equal the full
+    /// model's when the dropped bodies are massless: what the DDP robot of Valverde 2018 ch. 8 needs for its
+    /// massless wrist driven by Euler-angle rates (§8.4, eq. (8.51)). A new layout identity.
+    pub fn leading_bodies(&self, n: usize) -> Result<Model> {
+        if n == 0 || n > self.nbodies() {
+            return Err(FfError::arg("n", format!("keep between 1 and {} bodies, got {n}", self.nbodies())));
+        }
+        if n == self.nbodies() {
+            return Ok(self.clone());
+        }
+        let mut m = self.clone();
+        m.body_names.truncate(n);
+        m.joint_names.truncate(n);
+        m.parents.truncate(n);
+        m.joint_types.truncate(n);
+        m.axes.truncate(n);
+        m.axes2.truncate(n);
+        m.placements.truncate(n);
+        m.inertias.truncate(n);
+        m.limits.truncate(n);
+        m.tags.truncate(n);
+        m.allow_nonphysical.truncate(n);
+        m.frames.retain(|f| f.body < n);
+        m.finalize()?;
+        m.id = super::next_model_id();
+        Ok(m)
+    }
 }
 
 #[cfg(test)]
@@ -114,5 +144,41 @@ mod tests {
         let placed = dm.o_mi[fb].compose(&fp);
         assert!((placed.trans - d.o_mi[t].trans).norm() < 1e-12);
         assert!((placed.rot - d.o_mi[t].rot).abs().max() < 1e-12);
+    }
+
+    #[test]
+    fn leading_bodies_have_the_dynamics_of_the_full_model_with_a_vanishing_tail() {
+        // the ch. 8 arm with its wrist made nearly massless (1e-9 kg): the base and arm accelerate as the model of
+        // the leading bodies says, whatever the wrist does
+        let m = builtin::load("valverde_ch8_arm").unwrap();
+        let mut p = m.parameters();
+        for row in p.iter_mut().skip(4) {
+            for x in row.iter_mut() {
+                *x *= 1e-8;
+            }
+        }
+        let light = m.with_parameters(&p.concat()).unwrap();
+        let lead = m.leading_bodies(4).unwrap();
+        assert_eq!((lead.nbodies(), lead.nq, lead.nv), (4, m.nq - 3, m.nv - 3));
+        assert!(lead.frame_or_body("ee").is_err(), "the frame on a dropped body goes with it");
+        let mut q = m.neutral();
+        for (k, x) in q.iter_mut().enumerate().skip(7) {
+            *x = 0.4 * (k as f64).sin();
+        }
+        let v: Vec<f64> = (0..m.nv).map(|k| 0.1 * (k as f64 - 5.0)).collect();
+        let mut tau: Vec<f64> = (0..m.nv).map(|k| 0.7 * (k as f64).cos()).collect();
+        tau[m.nv - 3..].fill(0.0);
+        let (mut d, mut dl) = (Data::new(&light), Data::new(&lead));
+        aba(&light, &mut d, &q, &v, &tau, None).unwrap();
+        aba(&lead, &mut dl, &q[..lead.nq], &v[..lead.nv], &tau[..lead.nv], None).unwrap();
+        for i in 0..lead.nv {
+            assert!(
+                (d.ddq[i] - dl.ddq[i]).abs() < 1e-6 * (1.0 + dl.ddq[i].abs()),
+                "dof {i}: {} vs {}",
+                d.ddq[i],
+                dl.ddq[i]
+            );
+        }
+        assert!(m.leading_bodies(0).is_err() && m.leading_bodies(8).is_err());
     }
 }

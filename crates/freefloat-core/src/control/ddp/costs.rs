@@ -144,6 +144,10 @@ pub enum Residual {
         placement: Se3,
         /// References (thesis layout).
         refs: Vec<[f64; 8]>,
+        /// Compare with whichever of ±q_D is nearer (`q_G − s q_D`, s = sign(q_G,r · q_D,r)), so that the cost
+        /// measures the pose and not the quaternion's sheet; false: the thesis' literal `q_G − q_D`, which is
+        /// maximal (4 w) at the exact pose on the other sheet (a reference that turns by 2π ends at −q).
+        nearest_sign: bool,
     },
     /// `x ⊖ x_ref` (ndx); one reference or one per node.
     State {
@@ -270,6 +274,18 @@ pub fn frame_dual_quat(m: &Model, q: &[f64], body: usize, placement: &Se3, o_mf:
 pub fn placement_residual(o_mf: &Se3, reference: &Se3) -> (V6, nalgebra::Matrix6<f64>) {
     let r = log6(&reference.inv_compose(o_mf));
     (r, se3_right_jacobian_inv(&r))
+}
+
+/// The sign s ∈ {1, −1} with which the reference enters the dual-quaternion residual `q_G − s q_D`: +1 for the
+/// thesis' literal cost, else the sign of `q_G,r · q_D,r` (the nearer of ±q_D; +1 on a tie). s is constant wherever
+/// the dot product does not vanish, i.e. for orientation errors below 180°, so the residual's Jacobian is ∂q_G/∂δ.
+pub fn reference_sign(g: &[f64; 8], reference: &[f64; 8], nearest: bool) -> f64 {
+    let dot = g[0] * reference[0] + g[1] * reference[1] + g[2] * reference[2] + g[3] * reference[3];
+    if nearest && dot < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
 }
 
 /// Columns of `∂q_G/∂δ` (8 × nv) from the frame's local Jacobian (6 × nv): with a local twist (v, ω),

@@ -6,8 +6,16 @@
 //!
 //! Step Jacobians are analytic (`step_jacobians`, from the engine's forward-dynamics derivatives), as are
 //! the cost derivatives (`costs`); `fd_step` keeps the central-difference Jacobians as the test oracle.
+//!
+//! Rate-driven joints (`set_rate_driven`): the thesis' end effector is massless and its spherical wrist is driven
+//! kinematically, the Euler-angle rates being controls (Valverde 2018, §8.4, eqs. (8.50)-(8.51)). Here the last k
+//! bodies of the model may be such a tail: their inertia is ignored, the dynamics are those of the leading bodies
+//! (`Model::leading_bodies`), and their controls are the joint rates, `v⁺_w = u_w`, `q⁺_w = q_w + Δt u_w`. The state
+//! keeps its layout (v_w is the rate last applied, which nothing else reads).
 
-use super::costs::{dual_quat_jacobian, frame_dual_quat, keep_out, placement_residual, CostTerm, KeepOut, Residual};
+use super::costs::{
+    dual_quat_jacobian, frame_dual_quat, keep_out, placement_residual, reference_sign, CostTerm, KeepOut, Residual,
+};
 use super::lie::{ff_difference, ff_integrate, se3_right_jacobian_inv};
 use super::problem::{ActionModel, NodeDiff};
 use crate::data::Data;
@@ -51,6 +59,20 @@ pub struct FloatingRobot {
     pub(crate) offset: usize,
     /// Scratch of the full-DDP step Hessian (`step_hessian`), made on first use.
     pub(crate) hess: Option<super::step_hessian::HessianWork>,
+    /// The rate-driven tail, if any (see the module notes).
+    pub(crate) rate: Option<RateDriven>,
+}
+
+/// The dynamics of a robot whose last `k` joints are driven by their rates (a massless tail): the model of the
+/// leading bodies, with its own workspaces.
+#[derive(Clone)]
+pub(crate) struct RateDriven {
+    /// Number of rate-driven joints (the last k bodies, one coordinate each).
+    pub(crate) k: usize,
+    /// The leading bodies' model (nq − k, nv − k).
+    pub(crate) model: Model,
+    pub(crate) data: Data,
+    pub(crate) deriv: Derivatives,
 }
 
 impl FloatingRobot {
@@ -117,6 +139,7 @@ impl FloatingRobot {
         FloatingRobot {
             offset: 0,
             hess: None,
+            rate: None,
             data,
             deriv: Derivatives::new(&model),
             dt,
@@ -158,14 +181,53 @@ impl FloatingRobot {
                 })
                 .collect()
         };
-        Ok(Self::build(
+        let mut w = Self::build(
             self.model.clone(),
             self.dt,
             horizon,
             freeze(&self.running),
             freeze(&self.terminal),
             self.keep_out.clone(),
-        ))
+        );
+        w.rate = self.rate.clone();
+        Ok(w)
+    }
+
+    /// Drive the last `k` joints by their rates (0: none, the default): their bodies count as massless, their
+    /// controls are the joint rates instead of torques (Valverde 2018, eq. (8.51): the wrist's Euler-angle rates).
+    /// Each must be a one-coordinate (revolute or prismatic) joint after the base.
+    pub fn set_rate_driven(&mut self, k: usize) -> Result<()> {
+        if k == 0 {
+            self.rate = None;
+            return Ok(());
+        }
+        let n = self.model.nbodies();
+        if k >= n {
+            return Err(FfError::arg(
+                "rate_joints",
+                format!("{k} rate-driven joints leave no body to carry the dynamics ({n} bodies)"),
+            ));
+        }
+        for i in n - k..n {
+            if !matches!(self.model.joint_types[i], JointType::Revolute | JointType::Prismatic) {
+                return Err(FfError::arg(
+                    "rate_joints",
+                    format!(
+                        "joint '{}' is not revolute or prismatic: only those can be rate-driven",
+                        self.model.joint_names[i]
+                    ),
+                ));
+            }
+        }
+        let model = self.model.leading_bodies(n - k)?;
+        let (data, deriv) = (Data::new(&model), Derivatives::new(&model));
+        self.rate = Some(RateDriven { k, model, data, deriv });
+        Ok(())
+    }
+
+    /// Number of rate-driven joints (the last ones of the model; 0 if none).
+    pub fn rate_driven(&self) -> usize {
+        self.rate.as_ref().map_or(0, |r| r.k)
     }
 
     /// Reference offset of node 0 (see `window`).
@@ -183,6 +245,9 @@ impl FloatingRobot {
     /// of the plant (e.g. an online identification) without being rebuilt.
     pub fn set_parameters(&mut self, params: &[f64]) -> Result<()> {
         self.model = self.model.with_parameters(params)?;
+        if let Some(r) = self.rate.as_mut() {
+            r.model = r.model.with_parameters(&params[..10 * r.model.nbodies()])?;
+        }
         Ok(())
     }
 
@@ -230,10 +295,21 @@ impl FloatingRobot {
     pub(crate) fn step(&mut self, x: &[f64], u: &[f64], xnext: &mut [f64]) -> Result<()> {
         let (nq, nv) = (self.model.nq, self.model.nv);
         let (q, v) = x.split_at(nq);
-        aba(&self.model, &mut self.data, q, v, u, None)?;
-        for i in 0..nv {
-            self.vnext[i] = v[i] + self.dt * self.data.ddq[i];
-            self.dq[i] = self.dt * self.vnext[i];
+        if let Some(r) = self.rate.as_mut() {
+            // the leading bodies' dynamics; the massless tail follows its rate controls
+            let (nqd, nvd) = (r.model.nq, r.model.nv);
+            aba(&r.model, &mut r.data, &q[..nqd], &v[..nvd], &u[..nvd], None)?;
+            for i in 0..nv {
+                self.vnext[i] = if i < nvd { v[i] + self.dt * r.data.ddq[i] } else { u[i] };
+                self.dq[i] = self.dt * self.vnext[i];
+            }
+            crate::kinematics::forward_kinematics(&self.model, &mut self.data, q)?;
+        } else {
+            aba(&self.model, &mut self.data, q, v, u, None)?;
+            for i in 0..nv {
+                self.vnext[i] = v[i] + self.dt * self.data.ddq[i];
+                self.dq[i] = self.dt * self.vnext[i];
+            }
         }
         let (qn, vn) = xnext.split_at_mut(nq);
         Self::integrate_q(&self.model, q, &self.dq, qn);
@@ -256,11 +332,12 @@ impl FloatingRobot {
                     let r = super::lie::log6(&refs[(k + self.offset).min(refs.len() - 1)].inv_compose(&o_mf));
                     total += (0..6).map(|i| w[i] * r[i] * r[i]).sum::<f64>();
                 }
-                Residual::FrameDualQuat { body, placement, refs } => {
+                Residual::FrameDualQuat { body, placement, refs, nearest_sign } => {
                     let o_mf = self.data.o_mi[*body].compose(placement);
                     let g = frame_dual_quat(&self.model, q, *body, placement, &o_mf)?.to_array();
                     let rf = &refs[(k + self.offset).min(refs.len() - 1)];
-                    total += (0..8).map(|i| w[i] * (g[i] - rf[i]).powi(2)).sum::<f64>();
+                    let s = reference_sign(&g, rf, *nearest_sign);
+                    total += (0..8).map(|i| w[i] * (g[i] - s * rf[i]).powi(2)).sum::<f64>();
                 }
                 Residual::State { refs } => {
                     let xr = &refs[(k + self.offset).min(refs.len() - 1)];
@@ -313,15 +390,16 @@ impl FloatingRobot {
                     }
                     add_gauss_newton(&self.jres, 6, &self.res, w, d, nv);
                 }
-                Residual::FrameDualQuat { body, placement, refs } => {
+                Residual::FrameDualQuat { body, placement, refs, nearest_sign } => {
                     jacobian_from_data(&self.model, &self.data, *body, placement, Reference::Local, &mut self.jac);
                     let o_mf = self.data.o_mi[*body].compose(placement);
                     let g = frame_dual_quat(&self.model, q, *body, placement, &o_mf)?;
                     dual_quat_jacobian(&g, &o_mf, &self.jac, &mut self.jres);
                     let ga = g.to_array();
                     let rf = &refs[(k + self.offset).min(refs.len() - 1)];
+                    let s = reference_sign(&ga, rf, *nearest_sign);
                     for i in 0..8 {
-                        self.res[i] = ga[i] - rf[i];
+                        self.res[i] = ga[i] - s * rf[i];
                     }
                     add_gauss_newton(&self.jres, 8, &self.res, w, d, nv);
                 }

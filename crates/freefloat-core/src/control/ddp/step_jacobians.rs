@@ -29,18 +29,42 @@ impl FloatingRobot {
         let (nq, nv) = (self.model.nq, self.model.nv);
         let dt = self.dt;
         let (q, v) = x.split_at(nq);
-        aba_derivatives(&self.model, &mut self.data, &mut self.deriv, q, v, u, None)?;
-        let w = &self.deriv;
-        // velocity rows: fx[nv.., ..] = [Δt ∂a/∂q, I + Δt ∂a/∂v], fu[nv.., ..] = Δt M⁻¹
-        for c in 0..nv {
-            for r in 0..nv {
-                fx[(nv + r, c)] = dt * w.da_dq[(r, c)];
-                fx[(nv + r, nv + c)] = dt * w.da_dv[(r, c)] + if r == c { 1.0 } else { 0.0 };
-                fu[(nv + r, c)] = dt * w.minv[(r, c)];
+        if let Some(rd) = self.rate.as_mut() {
+            // Rate-driven tail (massless, `set_rate_driven`): the leading bodies' derivatives, which the tail does
+            // not affect; the tail's velocity rows are v⁺_w = u_w.
+            let nd = rd.model.nv;
+            aba_derivatives(&rd.model, &mut rd.data, &mut rd.deriv, &q[..rd.model.nq], &v[..nd], &u[..nd], None)?;
+            let w = &rd.deriv;
+            for c in 0..nv {
+                for r in 0..nv {
+                    let (a, b, m) = if r < nd && c < nd {
+                        (dt * w.da_dq[(r, c)], dt * w.da_dv[(r, c)], dt * w.minv[(r, c)])
+                    } else {
+                        (0.0, 0.0, if r == c { 1.0 } else { 0.0 })
+                    };
+                    fx[(nv + r, c)] = a;
+                    fx[(nv + r, nv + c)] = b + if r == c && r < nd { 1.0 } else { 0.0 };
+                    fu[(nv + r, c)] = m;
+                }
             }
-        }
-        for i in 0..nv {
-            self.dq[i] = dt * (v[i] + dt * w.ddq[i]);
+            for i in 0..nv {
+                self.dq[i] = dt * if i < nd { v[i] + dt * w.ddq[i] } else { u[i] };
+            }
+            crate::kinematics::forward_kinematics(&self.model, &mut self.data, q)?;
+        } else {
+            aba_derivatives(&self.model, &mut self.data, &mut self.deriv, q, v, u, None)?;
+            let w = &self.deriv;
+            // velocity rows: fx[nv.., ..] = [Δt ∂a/∂q, I + Δt ∂a/∂v], fu[nv.., ..] = Δt M⁻¹
+            for c in 0..nv {
+                for r in 0..nv {
+                    fx[(nv + r, c)] = dt * w.da_dq[(r, c)];
+                    fx[(nv + r, nv + c)] = dt * w.da_dv[(r, c)] + if r == c { 1.0 } else { 0.0 };
+                    fu[(nv + r, c)] = dt * w.minv[(r, c)];
+                }
+            }
+            for i in 0..nv {
+                self.dq[i] = dt * (v[i] + dt * w.ddq[i]);
+            }
         }
         // configuration rows, joint by joint: fx[q_i, ..] = J_q,i [I 0]_i + Δt J_δ,i fx[v_i, ..]
         for b in 0..self.model.nbodies() {
@@ -99,7 +123,8 @@ impl FloatingRobot {
                 }
             }
         }
-        // `aba_derivatives` ran forward kinematics at q: the cost derivatives read them from `data`.
+        // `aba_derivatives` (or, with a rate-driven tail, `forward_kinematics`) left the kinematics of q in `data`:
+        // the cost derivatives read them.
         Ok(())
     }
 }
@@ -137,5 +162,26 @@ mod tests {
         let ex = (&fx - &gx).amax() / gx.amax();
         let eu = (&fu - &gu).amax() / gu.amax();
         assert!(ex < 1e-6 && eu < 1e-6, "analytic vs central differences: Fx {ex:.2e}, Fu {eu:.2e}");
+
+        // the thesis' massless wrist driven by its Euler-angle rates (the last three joints)
+        robot.set_rate_driven(3).unwrap();
+        robot.step_jacobians(&x, &u, &mut fx, &mut fu).unwrap();
+        robot.fd_step_jacobians(&x, &u, &mut gx, &mut gu).unwrap();
+        let ex = (&fx - &gx).amax() / gx.amax();
+        let eu = (&fu - &gu).amax() / gu.amax();
+        assert!(ex < 1e-6 && eu < 1e-6, "rate-driven wrist: Fx {ex:.2e}, Fu {eu:.2e}");
+        // the wrist's rate controls move only the wrist's own angles and rates: q⁺_w = q_w + Δt u_w, v⁺_w = u_w
+        for c in nv - 3..nv {
+            for r in 0..ndx {
+                let expect = if r == c {
+                    robot.dt()
+                } else if r == nv + c {
+                    1.0
+                } else {
+                    0.0
+                };
+                assert!((gu[(r, c)] - expect).abs() < 1e-7, "Fu[{r}, {c}] = {} (expected {expect})", gu[(r, c)]);
+            }
+        }
     }
 }
