@@ -21,6 +21,28 @@ from .._core import InputError
     help="End-effector pose cost: 'dq' = the thesis' component-wise dual-quaternion difference (eq. 8.56), "
     "'log' = log-SE(3) as Crocoddyl uses. Default: the scenario's.",
 )
+@click.option(
+    "--dq-sign",
+    type=click.Choice(["nearest", "literal"]),
+    default=None,
+    help="How the 'dq' pose cost meets the reference's sign: 'nearest' compares with whichever of +q_D and -q_D is "
+    "nearer (a pose metric); 'literal' is the thesis' q_G - q_D, which is largest at the exact pose once the "
+    "quaternion has changed sign (a reference turning by 360 degrees does). Default: the scenario's.",
+)
+@click.option(
+    "--wrist",
+    type=click.Choice(["rate", "torque"]),
+    default=None,
+    help="'rate': the thesis' massless wrist, its Euler-angle rates being controls (eq. 8.51); 'torque': the "
+    "model's wrist bodies (0.1 kg each) driven by joint torques. Default: the scenario's.",
+)
+@click.option(
+    "--robot",
+    default=None,
+    help="Robot instead of the scenario's: a built-in name or a model file with the same joint and frame names, "
+    "e.g. valverde_ch8_arm (the same arm on a 50 kg base; the built-in scenarios use valverde_ch8_servicer, "
+    "1500 kg).",
+)
 @click.option("--max-iter", type=int, default=None, help="Maximum DDP iterations (default: the scenario's).")
 @click.option("--no-schedule", is_flag=True, help="Constant End-column weights instead of the Table 8.2 schedule.")
 @click.option("--no-keep-out", is_flag=True, help="Drop the soft keep-out term on the joints.")
@@ -80,7 +102,12 @@ from .._core import InputError
     help="Relative mass (and inertia) error of the simulated plant's --error-body against the model the "
     "controller was optimised on, e.g. 0.1 for +10 %.",
 )
-@click.option("--error-body", default=None, help="Body whose mass is wrong in the plant (default: the last body).")
+@click.option(
+    "--error-body",
+    default=None,
+    help="Body whose mass is wrong in the plant (default: the last body with mass, the arm's last link with a "
+    "rate-driven wrist).",
+)
 @click.option(
     "--substeps", type=int, default=5, show_default=True, help="Simulator RK4 steps per DDP step (closed loop)."
 )
@@ -88,6 +115,9 @@ def ddp_cmd(
     scenario,
     out,
     cost,
+    dq_sign,
+    wrist,
+    robot,
     max_iter,
     no_schedule,
     no_keep_out,
@@ -130,6 +160,9 @@ def ddp_cmd(
             schedule=False if no_schedule else None,
             keep_out=False if no_keep_out else None,
             initial_controls=initial_controls,
+            wrist=wrist,
+            dq_sign=dq_sign,
+            robot=robot,
         )
     except InputError as e:
         raise click.UsageError(str(e)) from None
@@ -153,7 +186,7 @@ def ddp_cmd(
         opts["second_order"] = True
     warm = None
     if warm_start:
-        guide = ddp.load_scenario(scenario, cost="log", schedule=False, keep_out=False)
+        guide = ddp.load_scenario(scenario, cost="log", schedule=False, keep_out=False, wrist=wrist, robot=robot)
         click.echo("warm start: solving the companion problem (log-SE(3) cost, End weights, no keep-out) ...")
         prob, gsol = ddp.warm_started(prob, guide)
         warm = {
@@ -237,11 +270,12 @@ def ddp_cmd(
 def _closed_loop(prob, sol, mpc, horizon, replan, mpc_iter, model_error, error_body, substeps):
     from ..control import ddp_closed_loop as cl
 
+    # the default error body is the last one with mass (a rate-driven wrist is massless)
+    body = error_body or prob.model.body_names[-1 - len(prob.rate_joints)]
     try:
-        plant = cl.perturbed_model(prob.model, model_error, error_body) if model_error else prob.model
+        plant = cl.perturbed_model(prob.model, model_error, body) if model_error else prob.model
     except InputError as e:
         raise click.UsageError(str(e)) from None
-    body = error_body or prob.model.body_names[-1]
     click.echo(
         f"\nclosed loop: plant = {prob.model.name}"
         + (f" with {body} {100 * model_error:+g} % mass" if model_error else " (no model error)")

@@ -59,6 +59,9 @@ class Problem:
     reference_dq: np.ndarray | None = None
     name: str = ""
     cost_kind: str = "log"
+    #: the model's last joints driven by their rates (the thesis' massless wrist, eq. 8.51): their controls are joint
+    #: rates in rad/s, their bodies' inertia is ignored; empty: every joint torque-driven
+    rate_joints: list[str] = field(default_factory=list)
 
 
 def _weights(w, n: int, what: str) -> dict:
@@ -76,21 +79,28 @@ def _weights(w, n: int, what: str) -> dict:
     return {"weights": w}
 
 
-def frame_cost(name: str, frame: str, reference, weights, kind: str = "log") -> dict:
+def frame_cost(name: str, frame: str, reference, weights, kind: str = "log", sign: str = "nearest") -> dict:
     """End-effector pose cost. `kind="log"`: residual log6(M_ref⁻¹ M) (6: translation then rotation), reference
-    (M, 7) [p, quat xyzw]; `kind="dq"`: thesis component-wise dual-quaternion difference q_G − q_D (8),
-    reference (M, 8) [real w x y z, dual w x y z]. M = 1 or one per node."""
+    (M, 7) [p, quat xyzw]; `kind="dq"`: thesis component-wise dual-quaternion difference (8), reference (M, 8)
+    [real w x y z, dual w x y z]. M = 1 or one per node. `sign` (dq only): 'nearest' compares with whichever of
+    ±q_D is nearer to q_G (a pose metric), 'literal' is the thesis' q_G − q_D, which is largest at the exact pose
+    on the quaternion's other sheet."""
     if kind not in ("log", "dq"):
         raise InputError(f"cost {name!r}: pose cost kind must be 'log' or 'dq', got {kind!r}")
+    if sign not in DQ_SIGNS:
+        raise InputError(f"cost {name!r}: sign must be one of {', '.join(DQ_SIGNS)}, got {sign!r}")
     n = 6 if kind == "log" else 8
     ref = np.atleast_2d(np.asarray(reference, dtype=float))
-    return {
+    d = {
         "name": name,
         "kind": "frame_placement" if kind == "log" else "frame_dq",
         "frame": frame,
         "reference": ref,
         **_weights(weights, n, f"cost {name!r}"),
     }
+    if kind == "dq":
+        d["sign"] = sign
+    return d
 
 
 def state_cost(name: str, model: Model, weights, reference=None) -> dict:
@@ -222,6 +232,12 @@ def _concat(parts: list):
     return out
 
 
+#: how the dual-quaternion pose cost meets the reference's sign (`frame_cost`)
+DQ_SIGNS = ("nearest", "literal")
+#: how the scenario's wrist is driven: 'rate' = the thesis' massless wrist with Euler-angle-rate controls
+#: (eq. 8.51); 'torque' = the model's wrist bodies with their inertia, driven by joint torques
+WRIST_MODES = ("rate", "torque")
+
 #: the `weights` keys of a control_ddp scenario, each [Start, Medium, End] (Valverde 2018, Tables 8.1-8.2)
 _WEIGHT_KEYS = [
     "pose_terminal_real",
@@ -246,12 +262,17 @@ def load_scenario(
     schedule: bool | None = None,
     keep_out: bool | None = None,
     initial_controls: str | None = None,
+    wrist: str | None = None,
+    dq_sign: str | None = None,
+    robot: str | None = None,
 ) -> Problem:
     """Read a `control_ddp` scenario (built-in name or YAML path) and build its problem. The keyword arguments
     override the file: pose cost 'dq' or 'log', iteration count, weight schedule on/off (off: the End column),
-    keep-out on/off, initial controls 'zero' or 'gaussian'."""
+    keep-out on/off, initial controls 'zero' or 'gaussian', wrist 'rate' or 'torque' (`WRIST_MODES`), the dq
+    cost's sign 'nearest' or 'literal' (`DQ_SIGNS`), the robot (a built-in name or model file with the scenario's
+    joint and frame names)."""
     d, source = scenario_files.read(spec, kind="control_ddp")
-    model = load_model(_key(d, "robot", source, str))
+    model = load_model(robot or _key(d, "robot", source, str))
     frame = _key(d, "frame", source, str, "ee")
     dt = float(_key(d, "dt", source, (int, float)))
     n = _key(d, "horizon", source, int)
@@ -306,6 +327,10 @@ def load_scenario(
     cost = cost or _key(d, "cost", source, str, "dq")
     if cost not in ("dq", "log"):
         raise InputError(f"--cost / key 'cost': expected 'dq' or 'log', got {cost!r}")
+    dq_sign = dq_sign or _key(d, "dq_sign", source, str, "nearest")
+    if dq_sign not in DQ_SIGNS:
+        raise InputError(f"{source}: key 'dq_sign' / --dq-sign: expected one of {', '.join(DQ_SIGNS)}, got {dq_sign!r}")
+    rate_joints = _rate_joints(d, source, model, wrist)
 
     def sched(key):
         return _sched(w, key, wsrc, sched_bp)
@@ -339,7 +364,9 @@ def load_scenario(
         return _concat([zeros(nv), _expand(lin, 3), _expand(both, 3), zeros(nv - 6)])
 
     running = [
-        frame_cost("pose", frame, pose_ref, pose_weights(sched("pose_running_real"), sched("pose_running_dual")), cost),
+        frame_cost(
+            "pose", frame, pose_ref, pose_weights(sched("pose_running_real"), sched("pose_running_dual")), cost, dq_sign
+        ),
         state_cost("base_velocity", model, base_velocity("running")),
         control_cost(
             "control",
@@ -356,7 +383,12 @@ def load_scenario(
     ]
     terminal = [
         frame_cost(
-            "pose", frame, pose_ref, pose_weights(sched("pose_terminal_real"), sched("pose_terminal_dual")), cost
+            "pose",
+            frame,
+            pose_ref,
+            pose_weights(sched("pose_terminal_real"), sched("pose_terminal_dual")),
+            cost,
+            dq_sign,
         ),
         state_cost("base_velocity", model, base_velocity("terminal")),
     ]
@@ -405,7 +437,30 @@ def load_scenario(
         reference_dq=ref_dq,
         name=Path(str(spec)).stem,
         cost_kind=cost,
+        rate_joints=rate_joints,
     )
+
+
+def _rate_joints(d: dict, source: str, model: Model, wrist: str | None) -> list[str]:
+    """The scenario's `wrist` ('rate': the joints of `wrist_joints`, the model's last ones, are driven by their
+    rates as the thesis' massless wrist is; 'torque': by torques, with the model's wrist inertia) → rate joints."""
+    wrist = wrist or _key(d, "wrist", source, str, "torque")
+    if wrist not in WRIST_MODES:
+        raise InputError(f"{source}: key 'wrist' / --wrist: expected one of {', '.join(WRIST_MODES)}, got {wrist!r}")
+    if wrist == "torque":
+        return []
+    names = _key(d, "wrist_joints", source, list, None)
+    if names is None:
+        raise InputError(
+            f"{source}: key 'wrist_joints': 'wrist: rate' needs the wrist's joint names (the model's last joints)"
+        )
+    names = [str(j) for j in names]
+    tail = list(model.joint_names[len(model.joint_names) - len(names) :])
+    if not names or names != tail:
+        raise InputError(
+            f"{source}: key 'wrist_joints': {names} must be the last joints of {model.name}, in order ({tail})"
+        )
+    return names
 
 
 def solve(problem: Problem, progress=None, **options) -> dict:
@@ -428,6 +483,7 @@ def solve(problem: Problem, progress=None, **options) -> dict:
         xs0=problem.xs0,
         options=opts,
         callback=progress,
+        rate_joints=problem.rate_joints or None,
     )
     sol["solve_time_s"] = time.perf_counter() - t0
     return sol
@@ -452,6 +508,7 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
     hold = final_hold_s if final_hold_s is not None else min(5.0, t_end)
     sel = t >= t_end - hold - 1e-9
     f, tau = us[:, :3], us[:, 3:6]
+    nt = us.shape[1] - len(problem.rate_joints)  # torque-driven entries (rate-driven ones last)
     it = int(sol["iterations"])
     # base twist in base axes (linear, angular) is the first block of the velocities
     vb = xs[:, nq : nq + 6] if m.joint_types and m.joint_types[0] == "free" else np.zeros((len(xs), 6))
@@ -480,7 +537,9 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
         "ee_position_error_rms_m": float(np.sqrt(np.mean(pos**2))),
         "base_force_peak_N": float(np.linalg.norm(f, axis=1).max()),
         "base_torque_peak_Nm": float(np.linalg.norm(tau, axis=1).max()),
-        "joint_torque_peak_Nm": float(np.abs(us[:, 6:]).max()) if us.shape[1] > 6 else 0.0,
+        "joint_torque_peak_Nm": float(np.abs(us[:, 6:nt]).max()) if nt > 6 else 0.0,
+        "rate_joints": list(problem.rate_joints),
+        "rate_control_peak_rad_s": float(np.abs(us[:, nt:]).max()) if nt < us.shape[1] else 0.0,
         "base_speed_peak_m_s": float(np.linalg.norm(vb[:, :3], axis=1).max()),
         "base_rate_peak_rad_s": float(np.linalg.norm(vb[:, 3:], axis=1).max()),
         "base_force_sum_sq": float(np.sum(f**2)),

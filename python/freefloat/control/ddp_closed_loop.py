@@ -91,6 +91,17 @@ def run(
     if plant.nq != m.nq or plant.nv != m.nv:
         raise InputError("argument `plant`: its sizes (nq, nv) differ from the problem's model")
     n, dt, nq = problem.horizon, problem.dt, m.nq
+    # A rate-driven tail (the thesis' massless wrist): the simulator integrates the leading bodies' dynamics, and the
+    # tail's angles follow the held rate controls exactly, q_w(t_k+1) = q_w(t_k) + dt u_w,k.
+    nr = len(problem.rate_joints)
+    if nr and observer is not None:
+        raise InputError("argument `observer`: not available with rate-driven joints (problem.rate_joints)")
+    sim_plant = plant.leading_bodies(len(plant.body_names) - nr) if nr else plant
+    nqd, nvd = sim_plant.nq, sim_plant.nv
+    wq = np.zeros((n + 1, nr))
+    wv = np.zeros((n + 1, nr))
+    if nr:
+        wq[0], wv[0] = problem.x0[nqd:nq], problem.x0[nq + nvd :]
     if mode == "mpc":
         opts = {"variant": "fddp", "max_iter": 5, "alphas": [0.5**k for k in range(10)], "reg_init": 1e-6}
         opts.update(mpc_options or {})
@@ -109,6 +120,7 @@ def run(
             options=opts,
             first_max_iter=int(first_max_iter),
             shrink=bool(shrink),
+            rate_joints=problem.rate_joints or None,
             **guess,
         )
 
@@ -132,21 +144,24 @@ def run(
     def controller(t, q, v):
         k = int(round(t / dt))
         if k >= n or stopped[0]:
-            return np.zeros(m.nv)
+            return np.zeros(nvd)
         if progress is not None and progress(k, n) is False:
             stopped[0] = True
-            return np.zeros(m.nv)
-        u = law(k, np.r_[q, v])
+            return np.zeros(nvd)
+        u = law(k, np.r_[q, wq[k], v, wv[k]])
         applied[k] = u
-        return u
+        if nr:
+            wq[k + 1] = wq[k] + dt * u[nvd:]
+            wv[k + 1] = u[nvd:]
+        return u[:nvd]
 
     x0 = np.asarray(problem.x0, float)
     t0 = time.perf_counter()
     if observer is None:
         tr = simulate(
-            plant,
-            x0[:nq],
-            x0[nq:],
+            sim_plant,
+            x0[:nqd],
+            x0[nq : nq + nvd],
             n * dt,
             dt / substeps,
             method="rk4",
@@ -158,9 +173,11 @@ def run(
     else:
         tq, tv, t = _observed(plant, x0, n, dt, substeps, controller, applied, stopped, observer, observe_every, ctrl)
     wall = time.perf_counter() - t0
+    kk = np.clip(np.rint(t / dt).astype(int), 0, n)
+    if nr:
+        tq, tv = np.c_[tq, wq[kk]], np.c_[tv, wv[kk]]
     xs = np.c_[tq, tv]
     g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(tq), problem.frame)
-    kk = np.clip(np.rint(t / dt).astype(int), 0, n)
     err = pose_errors(g, problem.reference_dq[kk])
     out = {
         "mode": mode,

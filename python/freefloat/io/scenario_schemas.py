@@ -303,6 +303,12 @@ class ControlDdp(_Scenario):
     dt: Positive
     horizon: integer(lo=1)
     cost: literal("dq", "log") = "dq"
+    # the dq cost against the reference's sign: 'nearest' (±q_D, a pose metric) or 'literal' (the thesis' q_G − q_D)
+    dq_sign: literal("nearest", "literal") = "nearest"
+    # 'rate': the thesis' massless wrist, its joints (wrist_joints, the model's last) driven by Euler-angle rates;
+    # 'torque': the model's wrist bodies driven by joint torques
+    wrist: literal("rate", "torque") = "torque"
+    wrist_joints: list[Text] | None = None
     initial_state: dict | None = None
     reference: dict
     schedule: Anything = None
