@@ -129,6 +129,64 @@ def test_identify_minimal_full_urdf_and_weights(tmp_path):
 
 
 @pytest.mark.slow
+def test_identify_minimal_case1_like_for_like(tmp_path):
+    """`identify minimal --case1`: Naveen, Shah, Misra's Case 1 under the paper's conditions, then one improvement a
+    row. The paper's figures (Table 5: median 2.08 %, max 174.02 %; κ(G_m) = 248.8, Sec. VI.B) are printed beside
+    ours. Our rows are held to figures measured by other paths: the 67 spread intervals at 1 kHz in
+    docs/identification.md ("Cases 1-3": κ 1931, LS median 0.036-0.052 % over seeds 0-3 through
+    `excitation_data(m, 67)` with its own noise, bias removal 0.0015-0.0083 %, max 0.06-0.30 %) and the designed
+    trajectory in docs/excitation.md (κ 1405 on the true robot); `demo --case1` gives the same rows."""
+    r = run("identify", "minimal", "naveen_dual_arm", "--case1", "--out", str(tmp_path))
+    for printed in ("2.08 %", "174 %", "248.8"):
+        assert printed in r.stdout, (printed, r.stdout)
+    res = json.loads((tmp_path / "results.json").read_text())
+    assert (tmp_path / "table.txt").read_text().count("\n") == 6 and "248.8" in (tmp_path / "table.txt").read_text()
+    assert res["paper"] == {"median_pct": 2.08, "max_pct": 174.02, "condition_number": 248.8}
+    paper, cond, more, eiv, designed = res["rows"]
+    assert (paper["median_pct"], paper["max_pct"], paper["condition_number"]) == (2.08, 174.02, 248.8)
+    # the paper's conditions: 67 s at 20 Hz, both ends included; a median of the paper's order (its 2.08 %)
+    assert cond["samples"] == 67 * 20 + 1 and res["sample_rate_hz"] == 20.0
+    assert 2.08 / 3 < cond["median_pct"] < 2.08 * 3, cond
+    assert cond["max_pct"] > 5 * cond["median_pct"]  # a few poorly seen parameters, as in the paper
+    # 1 kHz, plain LS: docs/identification.md's 67 spread intervals
+    assert more["samples"] == 67 * 1000 + 1
+    assert more["condition_number"] == pytest.approx(1931, rel=0.01)
+    assert 0.02 < more["median_pct"] < 0.06 and more["max_pct"] < 0.5, more
+    assert more["median_pct"] < cond["median_pct"] / 10
+    # bias removal: the median falls several times, the maximum (variance, not bias) stays of the same size
+    assert eiv["median_pct"] < 0.3 * more["median_pct"] and eiv["max_pct"] < 0.5, eiv
+    assert designed["condition_number"] == pytest.approx(1405, rel=0.01)
+    assert designed["median_pct"] < 0.3 * more["median_pct"] and designed["max_pct"] < 1.0, designed
+    # the same function behind `freefloat demo --case1`
+    d = run("demo", "--case1", "--out", str(tmp_path / "demo"))
+    assert "2.08 %" in d.stdout and "174 %" in d.stdout
+    rows = json.loads((tmp_path / "demo" / "case1.json").read_text())["rows"]
+    assert [x["median_pct"] for x in rows] == [x["median_pct"] for x in res["rows"]]
+
+
+@pytest.mark.parametrize(
+    "args, expect",
+    [
+        (["--case1", "--simulate", "16"], "drop --data, --simulate and --trajectory"),
+        (["--case1", "--full"], "do not apply to it: --full"),
+        (["--case1", "--rate-noise", "none"], "--rate-noise"),
+        (["--simulate", "16", "--case1-rate", "10"], "--case1-rate only go with --case1"),
+        (["--case1", "--case1-rate", "0"], "sampling rate must be above 0 and at most 1000 Hz"),
+        (["--case1", "--case1-rate", "5000"], "at most 1000 Hz"),
+        (["--case1", "--case1-draws", "0"], "--case1-draws"),
+    ],
+)
+def test_identify_minimal_case1_bad_input(args, expect):
+    r = run("identify", "minimal", "naveen_dual_arm", *args, ok=False)
+    assert r.returncode != 0 and expect in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+def test_identify_minimal_case1_needs_the_naveen_robot():
+    r = run("identify", "minimal", "valverde_ch5_single_arm", "--case1", ok=False)
+    assert r.returncode != 0 and "Naveen, Shah, Misra robot" in r.stderr and "Traceback" not in r.stderr, r.stderr
+
+
+@pytest.mark.slow
 def test_excite_writes_a_trajectory_that_identify_consumes(tmp_path):
     r = run("excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--maxiter", "3", "--out", str(tmp_path))
     assert "pruning kept" in r.stdout and "Table 3" in r.stdout

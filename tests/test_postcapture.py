@@ -193,6 +193,76 @@ def test_noise_free_3d(spatial):
 
 
 @pytest.mark.slow
+def test_3d_force_form_sees_the_base_inertia_only_while_the_base_turns(spatial):
+    """Why ours reverses Table 6's finding on the base inertia at the paper's prior (docs/postcapture.md): the
+    force form's angular rows (eq. 31) carry the base's principal moments through its angular acceleration and
+    gyroscopic terms, which vanish once eq. (39) has stopped the base, so their information stops growing within
+    ~10 s; the momentum form's rows (eq. 16) are cumulative differences from t0, which keep the initial rate, so
+    theirs grows with every sample. x, the slowest mode with the smallest initial rate, gets the least."""
+    sc = spatial.scenario
+    m = ff.models.load(sc.model)
+    meas = pc.measure(m, spatial.simulation, sc, None)
+    tgt = pc.target_index(m)
+    cols = [0, 3, 5]  # I'1xx, I'1yy, I'1zz in θ = [I'1#, I'n#], I# = [I11, I12, I13, I22, I23, I33] (eq. 21)
+
+    def info(rows, t_end):  # Σ over samples up to t_end of the squared I'1 columns of Φ
+        keep = rows.t <= t_end + 1e-9
+        return (rows.Phi[keep][:, :, cols] ** 2).sum(axis=(0, 1))
+
+    force = eq.paper_force_rows(m, meas, 0, tgt)
+    mom = eq.paper_momentum_rows(m, meas, 0, tgt)
+    f10, f100 = info(force, 10.0), info(force, 100.0)
+    m10, m100 = info(mom, 10.0), info(mom, 100.0)
+    print("force info at 10 / 100 s", f10, f100, "momentum", m10, m100)
+    assert (f100 < 1.02 * f10).all(), (f10, f100)  # frozen once the base is still
+    assert (m100 > 5 * m10).all(), (m10, m100)  # grows ~linearly with time
+    assert f100[0] < f100[1] < f100[2], f100  # x is the least excited axis
+    assert (f100 < m100).all()
+
+
+@pytest.mark.slow
+def test_3d_force_form_is_faster_on_the_base_inertia_once_the_prior_is_weak(spatial):
+    """Zhang, Yue, Yuan 2020, Table 6: the force form reaches the 1 % band on the base's principal moments in
+    1.0-2.3 s, faster than the momentum form. With the paper's prior P0 = 1e6 (its eqs. 34-38 initial
+    covariances) ours does not (docs/postcapture.md: I'1xx 12.2 s against 7.7 s): the prior's ridge, weighed
+    against the little information the force form gets (previous test), leaves the modified RLS 0.5 % off, most
+    of it through D(μ) from the guesses of m and m b'. Pinned here: (1) with a weaker prior the paper's ordering
+    holds for each moment and for both solvers, at the paper's speed; (2) at P0 = 1e6 guessing m and m b' right
+    removes most of the force form's I'1xx bias."""
+    import dataclasses
+
+    sc = spatial.scenario
+    m = ff.models.load(sc.model)
+    meas = pc.measure(m, spatial.simulation, sc, None)
+    names = spatial.names
+    for P0 in (1e8, 1e10):
+        res = pc.identify(m, meas, dataclasses.replace(sc, P0=P0))
+        for solver in pc.SOLVERS:
+            tf, tm = res.transits("force", solver), res.transits("momentum", solver)
+            for p in ("I1xx", "I1yy", "I1zz"):
+                j = names.index(p)
+                assert tf[j][1] is not None and tm[j][1] is not None, (P0, solver, p)
+                assert tf[j][1] < tm[j][1], (P0, solver, p, tf[j][1], tm[j][1])
+                assert tf[j][1] <= 2.5, (P0, solver, p, tf[j][1])  # the paper: 2.3, 1.1, 1.0 s
+    j = names.index("I1xx")
+    err_paper = spatial.rel_error("force", "modified_rls")[j]
+    tr = yaml_truth("zhang2020_3d")  # the guesses of m and b' set to the model file's values
+    guess = {k: dict(v) for k, v in sc.guess.items()}
+    for key in ("base", "target"):
+        guess[key]["mass"], guess[key]["com"] = float(tr[key][0]), tr[key][1].tolist()
+    res = pc.identify(m, meas, dataclasses.replace(sc, guess=guess))
+    err_mu_right = res.rel_error("force", "modified_rls")[j]
+    print(f"force-form I'1xx error at P0 = 1e6: {err_paper:.2e}, with m and m b' guessed right {err_mu_right:.2e}")
+    assert err_paper > 3e-3 and err_mu_right < 0.4 * err_paper, (err_paper, err_mu_right)
+
+
+def test_cli_p0_is_checked():
+    for bad in ("0", "-1", "nan", "inf"):
+        r = CliRunner().invoke(main, ["identify", "postcapture", "zhang2020_2d_small", "--p0", bad])
+        assert r.exit_code != 0 and "--p0" in r.output and "positive finite" in r.output, (bad, r.output)
+
+
+@pytest.mark.slow
 def test_mass_and_com_do_not_depend_on_the_solver(medium):
     """Both solvers see the same physics: m and b' agree to the accuracy of the estimates."""
     a = medium.final("momentum", "modified_rls")

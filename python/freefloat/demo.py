@@ -117,12 +117,21 @@ def run(out="freefloat-demo", t_final: float = 20.0, echo=print, progress: bool 
 
 #: Naveen, Shah, Misra's Case 1 (Table 5): median and max relative error of the 52 minimal parameters [%]
 PAPER_CASE1 = (2.08, 174.02)
+#: Case 1's condition number κ(G_m) of the regressor after pruning, the paper's Sec. VI.B
+PAPER_CASE1_KAPPA = 248.8
 #: Case 1's trajectory length: the 67 intervals its pruning kept (1 s each; the kept combinations are not listed)
 CASE1_INTERVALS = 67
+#: the simulation step of the Case 1 data [s] (its 1 kHz is the fastest sampling rate row 1 can take)
+CASE1_DT = 1e-3
 
 
 def case1_table(
-    sample_rate: float = 20.0, seeds=(0, 1, 2), echo=print, progress: bool = True, designed: str = TRAJECTORY
+    sample_rate: float = 20.0,
+    seeds=(0, 1, 2),
+    echo=print,
+    progress: bool = True,
+    designed: str = TRAJECTORY,
+    model=MODEL,
 ) -> dict:
     """Naveen, Shah, Misra's Case 1 like for like, then each of freefloat's improvements as its own row.
 
@@ -134,37 +143,52 @@ def case1_table(
     median of 1.3 %, near the paper's 2.08 %; 10 Hz gives 20 %, 50 Hz 0.02 %; the paper's 174 % maximum is not
     reached at any rate we tried: 14 % at 20 Hz). Then one change per row: more samples
     (1 kHz), errors-in-variables bias removal, and the designed exciting trajectory (`freefloat excite`).
-    Each row is the median over `seeds` of the noise draws. Returns the rows; prints the table."""
+    Each row is the median over `seeds` of the noise draws (error figures and the regressor's condition number κ).
+    `model`: the robot (a name or a Model; Naveen, Shah, Misra's, `naveen_dual_arm`, by default).
+    Returns the rows, the settings and the printed table (`table`); prints the table through `echo`."""
     import dataclasses
     import warnings
 
+    from ._core import InputError
     from .identification import identify as idf
     from .io.telemetry import add_noise
 
-    m = models.load(MODEL)
+    if not (np.isfinite(sample_rate) and 0 < sample_rate <= 1.0 / CASE1_DT):
+        raise InputError(
+            f"the Case 1 sampling rate must be above 0 and at most {1.0 / CASE1_DT:g} Hz (the simulation's), "
+            f"got {sample_rate:g}"
+        )
+    seeds = [int(x) for x in seeds]
+    if not seeds:
+        raise InputError("Case 1 needs at least one noise seed")
+    m = models.load(model) if isinstance(model, str) else model
     echo(
         f"Naveen, Shah, Misra Case 1, like for like ({CASE1_INTERVALS} intervals, paper's noise), then one change a row"
+        f" ({m.name}; median over {len(seeds)} noise draw{'s' if len(seeds) > 1 else ''})"
     )
-    clean, _ = idf.excitation_data(m, n_intervals=CASE1_INTERVALS, noise=False, progress=progress)
+    clean, _ = idf.excitation_data(m, n_intervals=CASE1_INTERVALS, dt=CASE1_DT, noise=False, progress=progress)
     step = max(1, int(round(1.0 / (sample_rate * np.median(np.diff(clean.t))))))
+    rate = 1.0 / (step * CASE1_DT)  # the rate row 1 runs at (a whole number of simulation steps)
 
     def run(telem, rate_noise):
-        meds, maxs = [], []
+        meds, maxs, kappas = [], [], []
         for seed in seeds:
             noisy = add_noise(telem, m, np.random.default_rng(seed))
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                e = idf.identify_minimal(m, noisy, rate_noise=rate_noise, check="off").errors(m)
+                res = idf.identify_minimal(m, noisy, rate_noise=rate_noise, check="off")
+            e = res.errors(m)
             meds.append(e["median_rel_error_pct"])
             maxs.append(e["max_rel_error_pct"])
-        return float(np.median(meds)), float(np.median(maxs)), len(telem.t)
+            kappas.append(res.fit.condition_number)
+        return float(np.median(meds)), float(np.median(maxs)), float(np.median(kappas)), len(telem.t)
 
     def sub(t, k):
         return dataclasses.replace(t, t=t.t[::k], q=t.q[::k], v=t.v[::k], momentum=None)
 
-    rows = [("Naveen, Shah, Misra Table 5, Case 1 (printed)", *PAPER_CASE1, None)]
+    rows = [("Naveen, Shah, Misra Table 5, Case 1 (printed)", *PAPER_CASE1, PAPER_CASE1_KAPPA, None)]
     rows.append(
-        (f"paper's conditions: {CASE1_INTERVALS} Table 3 intervals, {sample_rate:g} Hz, plain LS",)
+        (f"paper's conditions: {CASE1_INTERVALS} Table 3 intervals, {rate:g} Hz, plain LS",)
         + run(sub(clean, step), "none")
     )
     rows.append(("+ more samples (1 kHz)",) + run(sub(clean, 1), "none"))
@@ -173,7 +197,19 @@ def case1_table(
     dclean, _ = idf.trajectory_data(m, trajectory, joints, noise=False, progress=progress)
     rows.append((f"+ designed excitation ({designed}, {trajectory.duration:g} s)",) + run(dclean, "data"))
     w = max(len(r[0]) for r in rows)
-    echo(f"  {'run':{w}s}  {'median':>9s}  {'max':>9s}  samples")
-    for name, med, mx, n in rows:
-        echo(f"  {name:{w}s}  {med:8.3g} %  {mx:8.3g} %  {'' if n is None else n}")
-    return {"rows": [{"run": r[0], "median_pct": r[1], "max_pct": r[2], "samples": r[3]} for r in rows]}
+    lines = [f"  {'run':{w}s}  {'median':>9s}  {'max':>9s}  {'κ':>8s}  samples"]
+    for name, med, mx, kappa, n in rows:
+        lines.append(f"  {name:{w}s}  {med:8.3g} %  {mx:8.3g} %  {kappa:8.4g}  {'' if n is None else n}")
+    for ln in lines:
+        echo(ln)
+    return {
+        "model": m.name,
+        "intervals": CASE1_INTERVALS,
+        "sample_rate_hz": rate,
+        "seeds": seeds,
+        "designed_trajectory": designed,
+        "rows": [
+            {"run": r[0], "median_pct": r[1], "max_pct": r[2], "condition_number": r[3], "samples": r[4]} for r in rows
+        ],
+        "table": "\n".join(lines),
+    }

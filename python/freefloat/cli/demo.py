@@ -36,6 +36,7 @@ def demo_cmd(out, t_final, case1, case1_rate):
         from pathlib import Path
 
         res = demo.case1_table(case1_rate, echo=click.echo, progress=True)
+        res.pop("table")  # printed above; the numbers are in the rows
         p = Path(out)
         p.mkdir(parents=True, exist_ok=True)
         (p / "case1.json").write_text(json.dumps(res, indent=2))

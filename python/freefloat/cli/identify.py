@@ -51,6 +51,32 @@ def identify_group():
     "naveen_exciting_trajectory) with the paper's rate noise, and identify from that.",
 )
 @click.option(
+    "--case1",
+    is_flag=True,
+    help="Instead of --data: reproduce Naveen, Shah, Misra's Case 1 (their Table 5: median 2.08 %, max 174 % "
+    "relative error of the 52 minimal parameters, condition number 248.8) under the paper's own conditions, on MODEL "
+    "= naveen_dual_arm: 67 one-second excitation intervals from the paper's Table 3 seeds, the paper's rate noise, "
+    "plain least squares, sampled at --case1-rate. Then one of freefloat's improvements per row (1 kHz samples, "
+    "errors-in-variables bias removal, the designed exciting trajectory), so each one's gain can be read. Prints "
+    "the table; --out writes results.json and table.txt. About 10-30 s. The other options do not apply.",
+)
+@click.option(
+    "--case1-rate",
+    type=float,
+    default=20.0,
+    show_default=True,
+    help="With --case1: sampling rate [Hz] of the paper-conditions row (the paper does not give its rate; 20 Hz "
+    "gives errors near the paper's median). At most 1000 Hz, the simulation's rate; rounded to a whole number of "
+    "its 1 ms steps.",
+)
+@click.option(
+    "--case1-draws",
+    type=click.IntRange(min=1),
+    default=3,
+    show_default=True,
+    help="With --case1: number of noise draws (seeds 0, 1, ...); each row shows the median over them.",
+)
+@click.option(
     "--method",
     type=click.Choice(["auto", "closed-form", "numeric"]),
     default="auto",
@@ -124,13 +150,18 @@ def identify_group():
     "explains the data and names it; 'warn' only warns; 'off' skips the check.",
 )
 @click.option(
-    "--out", help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf)."
+    "--out",
+    help="Directory for results.json and the figures (and the simulated telemetry, identified.urdf; with --case1: "
+    "results.json and table.txt).",
 )
 def identify_minimal_cmd(
     model,
     data,
     n_sim,
     traj_file,
+    case1,
+    case1_rate,
+    case1_draws,
     method,
     known,
     h0,
@@ -152,13 +183,31 @@ def identify_minimal_cmd(
     Prints the estimate with standard deviations (and the true value and relative error with --truth) and the
     paper's error figures; --full gives a complete URDF back, --validate checks it by prediction.
 
-    Example: freefloat identify minimal naveen_dual_arm_consistent --simulate 64 --validate
-    --prior naveen_dual_arm_offset --out ident/"""
+    \b
+    Examples:
+      freefloat identify minimal naveen_dual_arm_consistent --simulate 64 --validate \\
+          --prior naveen_dual_arm_offset --out ident/
+      freefloat identify minimal naveen_dual_arm --case1 --out case1/   # Naveen, Shah, Misra's Case 1"""
     from ..identification import identify as idf
 
+    ctx = click.get_current_context()
+    given = [p for p in _CASE1_ONLY if _given(ctx, p)]
+    if case1:
+        if data is not None or n_sim is not None or traj_file is not None:
+            raise click.UsageError("--case1 simulates its own data: drop --data, --simulate and --trajectory")
+        other = [p for p in _NOT_WITH_CASE1 if _given(ctx, p)]
+        if other:
+            raise click.UsageError(
+                "--case1 runs the paper's Case 1 with fixed settings; these options do not apply to it: "
+                + ", ".join("--" + p.replace("_", "-") for p in other)
+            )
+        _case1(model, case1_rate, case1_draws, out)
+        return
+    if given:
+        raise click.UsageError(", ".join("--" + p.replace("_", "-") for p in given) + " only go with --case1")
     m = load_model(model)
     if sum(x is not None for x in (data, n_sim, traj_file)) != 1:
-        raise click.UsageError("give exactly one of --data FILE, --simulate N and --trajectory FILE")
+        raise click.UsageError("give exactly one of --data FILE, --simulate N, --trajectory FILE and --case1")
     known_list = None if known is None else [k for k in known.split(",") if k]
     h = None if h0 is None else parse_vector(h0, 6, "--h0", np.zeros(6))
     w = (
@@ -214,6 +263,53 @@ def identify_minimal_cmd(
         summary.update(_full_and_validate(m, res, prior, validate, out))
         if out:
             Path(out, "results.json").write_text(json.dumps(summary, indent=2))
+
+
+#: options that only `--case1` takes, and the options of `identify minimal` that do not apply to it
+_CASE1_ONLY = ("case1_rate", "case1_draws")
+_NOT_WITH_CASE1 = (
+    "method",
+    "known",
+    "h0",
+    "weights",
+    "rate_noise",
+    "full",
+    "prior",
+    "validate",
+    "truth",
+    "truth_model",
+    "check",
+)
+
+
+def _given(ctx, name: str) -> bool:
+    """Whether the user gave the option (on the command line or by environment), not its default."""
+    src = ctx.get_parameter_source(name)
+    return src is not None and src not in (
+        click.core.ParameterSource.DEFAULT,
+        click.core.ParameterSource.DEFAULT_MAP,
+    )
+
+
+def _case1(model, rate, draws, out) -> None:
+    """--case1 of `identify minimal`: Naveen, Shah, Misra's Case 1 like for like (`freefloat.demo.case1_table`,
+    shared with `freefloat demo --case1`), the table printed and, with --out, results.json and table.txt."""
+    from .. import demo
+
+    m = load_model(model)
+    res = demo.case1_table(rate, seeds=range(draws), echo=click.echo, progress=True, model=m)
+    table = res.pop("table")
+    res["paper"] = {
+        "median_pct": demo.PAPER_CASE1[0],
+        "max_pct": demo.PAPER_CASE1[1],
+        "condition_number": demo.PAPER_CASE1_KAPPA,
+    }
+    if out:
+        o = Path(out)
+        o.mkdir(parents=True, exist_ok=True)
+        (o / "results.json").write_text(json.dumps(res, indent=2))
+        (o / "table.txt").write_text(table + "\n")
+        click.echo(f"wrote {o / 'results.json'} and {o / 'table.txt'}")
 
 
 def _full_and_validate(m, res, prior, validate, out) -> dict:

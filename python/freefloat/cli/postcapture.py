@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -38,6 +39,13 @@ from .._core import Interrupted
     help="Forgetting factor of the standard-parameter RLS (default: the scenario's, 1 = none).",
 )
 @click.option(
+    "--p0",
+    type=float,
+    help="Prior covariance P0 (times the identity) of all four estimators, i.e. how little the initial guesses are "
+    "trusted: a ridge of weight 1/P0 pulls the estimate toward them (default: the scenario's, 1e6 as in the paper). "
+    "Larger values (1e8-1e14) remove the guesses' bias from noise-free runs; docs/postcapture.md, Table 6.",
+)
+@click.option(
     "--project/--no-project",
     default=None,
     help="Report the standard-parameter estimate projected onto physically consistent parameters.",
@@ -62,7 +70,7 @@ from .._core import Interrupted
     "system drifts and the attitude is integrated from a gyro) or the inertial origin (the paper's eqs. 9-10).",
 )
 def identify_postcapture_cmd(
-    scenario, out, noise, seed, sweep, forgetting, project, accelerations, impulses, momentum_point
+    scenario, out, noise, seed, sweep, forgetting, p0, project, accelerations, impulses, momentum_point
 ):
     """Zhang, Yue, Yuan 2020: identify base and captured target online, in one step (momentum- and force-based).
 
@@ -86,6 +94,10 @@ def identify_postcapture_cmd(
         if not 0 < forgetting <= 1:
             raise click.BadParameter("must be in (0, 1]", param_hint="--forgetting")
         sc.forgetting = forgetting
+    if p0 is not None:
+        if not (math.isfinite(p0) and p0 > 0):
+            raise click.BadParameter(f"must be a positive finite number, got {p0}", param_hint="--p0")
+        sc.P0 = p0
     if project is not None:
         sc.project = project
     if accelerations:

@@ -157,7 +157,8 @@ class PostcaptureResult:
             (f"INTERRUPTED ({self.interrupted}): " if self.interrupted else "")
             + f"{self.scenario.name}: final estimates at t = "
             + f"{self.scenario.duration if self.t_end is None else self.t_end:g} s, "
-            f"(transit time to {tol * 100:g} %, after which the estimate stays within)"
+            f"(transit time to {tol * 100:g} %, after which the estimate stays within; prior covariance "
+            f"P0 = {self.scenario.P0:g})"
         ]
         if self.truth_history is not None:
             lines.append(
