@@ -82,6 +82,11 @@ def build_crocoddyl_problem(problem):
 
     if problem.keep_out:
         raise ValueError("Crocoddyl has no keep-out activation: build the problem with keep_out=False")
+    if problem.model.name != "valverde_ch8_arm" or problem.rate_joints:
+        raise ValueError(
+            "the Pinocchio model is valverde_ch8_arm with a torque-driven wrist: load the scenario with "
+            "robot='valverde_ch8_arm', wrist='torque'"
+        )
     model = build_pinocchio_model()
     state = crocoddyl.StateMultibody(model)
     act = crocoddyl.ActuationModelFull(state)
@@ -207,8 +212,15 @@ def main(argv=None) -> int:
     ap.add_argument("--repeats", type=int, default=None)
     a = ap.parse_args(argv)
     reps = a.repeats or (1 if a.quick else 3)
+    # the problem Crocoddyl's baseline solves: the 50 kg base of valverde_ch8_arm, torque-driven wrist
     prob = ddp.load_scenario(
-        "valverde_ch8_tracking", cost="log", schedule=False, keep_out=False, initial_controls="zero"
+        "valverde_ch8_tracking",
+        cost="log",
+        schedule=False,
+        keep_out=False,
+        initial_controls="zero",
+        robot="valverde_ch8_arm",
+        wrist="torque",
     )
     prob = truncate(prob, 80 if a.quick else prob.horizon)
     n = prob.horizon

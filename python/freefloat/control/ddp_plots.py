@@ -87,14 +87,15 @@ def plot_all(problem: Problem, sol: dict, out: Path, prefix: str = "") -> list[P
     axs[1].legend(ncol=3, fontsize=8)
     save(fig, "base_wrench")
 
-    # Fig. 8.5 / 8.11: joint torques and wrist.
+    # Fig. 8.5 / 8.11: joint torques and the wrist's Euler-angle rates (or torques, with a torque-driven wrist).
     names = m.joint_names[1:]
+    rate = set(problem.rate_joints)
     fig, axs = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
     for j, name in enumerate(names):
-        a = axs[1] if name.startswith("wrist") else axs[0]
+        a = axs[1] if name.startswith("wrist") or name in rate else axs[0]
         a.plot(tu, us[:, 6 + j], label=name)
     axs[0].set_ylabel("arm joint torques [N m]")
-    axs[1].set_ylabel("wrist torques [N m]")
+    axs[1].set_ylabel("wrist rates [rad/s]" if rate else "wrist torques [N m]")
     axs[1].set_xlabel("t [s]")
     axs[0].legend(fontsize=8)
     axs[1].legend(fontsize=8)
