@@ -213,22 +213,33 @@ class PeerStack:
                 return
 
 
-def peer_example_b(sc, alpha, t_final, dt):
+def peer_example_b(sc, alpha, t_final, dt, alpha_off_after=None, info=None):
+    """Example B's closed loop in numpy. `alpha_off_after` (Remark 6): α = 0 from the first step start at least that
+    long after numpy's `matrix_rank` of the stack's Σ R_kᵀR_k first reads 7; `info` (a dict) receives
+    `rank7_time` and `alpha_off_time`."""
     peer = Peer(sc, alpha)
     st = PeerStack(sc.n_s, sc.sigma_stop, sc.seed)
     n = int(round(t_final / dt))
     x = np.concatenate([sc.q0, sc.w0, sc.estimate0])
     hist = np.empty((n + 1, 7))
+    info = {} if info is None else info
+    info.update(rank7_time=None, alpha_off_time=None)
+    a = [alpha]
 
     def f(t, x):
         p = peer.plant(t, x[:8], x[8:16], x[16:23])
-        cl = alpha * (st.RR @ x[16:23] - st.Rf) if len(st.rtr) else 0.0
+        cl = a[0] * (st.RR @ x[16:23] - st.Rf) if len(st.rtr) else 0.0
         return np.concatenate([p["qdot"], p["wdot"], peer.ki * (p["adapt"] - cl)]), p
 
     for k in range(n + 1):
         t = k * dt
         p = peer.plant(t, x[:8], x[8:16], x[16:23])
         st.offer(peer.regressor(p), p["f"])
+        if info["rank7_time"] is None and np.linalg.matrix_rank(st.RR) == 7:
+            info["rank7_time"] = t
+        if alpha_off_after is not None and info["rank7_time"] is not None and info["alpha_off_time"] is None:
+            if k >= round((info["rank7_time"] + alpha_off_after) / dt):
+                info["alpha_off_time"], a[0] = t, 0.0
         hist[k] = x[16:23]
         if k == n:
             break

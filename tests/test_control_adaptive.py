@@ -110,6 +110,7 @@ def _write(tmp_path, edit):
         (lambda d: d["learning"].__setitem__("n_s", 1), "learning.n_s"),
         (lambda d: d["learning"].__setitem__("sigma_stop", 0), "learning.sigma_stop"),
         (lambda d: d["learning"].__setitem__("alpha", [-0.1]), "learning.alpha"),
+        (lambda d: d["learning"].__setitem__("alpha_off_after", -1.0), "learning.alpha_off_after"),
         (lambda d: d["simulation"].__setitem__("rtol", 2.0), "simulation.rtol"),
         (lambda d: d["reference"].__setitem__("angular", {"amplitud": [1, 0, 0]}), "reference.angular"),
         (lambda d: d.pop("truth"), "truth"),
@@ -288,6 +289,80 @@ def test_example_b_baseline_converges_only_i12_and_i13(example_b):
     assert np.linalg.norm(example_b.runs["baseline"].position_error[-1]) < 0.02
 
 
+# ---- Remark 6: α switched off once the rank condition holds ---------------------------------------------------
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.5])
+def test_remark6_switch_matches_the_numpy_peer(delay):
+    # the numpy closed loop (benches/adaptive_bench.py) builds its own stack and switches α off `delay` after
+    # numpy's matrix_rank of Σ R_kᵀR_k first reads 7; the engine must switch at the same step and follow it
+    peer = _peer()
+    sc = _short("valverde_ch4_example_b", 2.0)
+    info = {}
+    t, est = peer.peer_example_b(sc, 0.005, 2.0, sc.dt, alpha_off_after=delay, info=info)
+    run = ad.simulate(sc, 0.005, alpha_off_after=delay)
+    assert info["rank7_time"] == pytest.approx(0.01)  # the 2nd sample: one sample has rank ≤ 6 (C1)
+    assert run.rank7_time == pytest.approx(info["rank7_time"])
+    assert run.alpha_off_time == pytest.approx(info["alpha_off_time"]) == pytest.approx(0.01 + delay)
+    assert np.max(np.abs(run.estimate - est)) < 1e-9
+    # the weight in effect over each step: α before the switch, 0 from it on
+    before = run.t < run.alpha_off_time - 1e-9
+    assert np.all(run.alpha_in_effect[before] == 0.005) and np.all(run.alpha_in_effect[~before] == 0.0)
+    # and the switch matters: without it the same peer run differs by more than 1
+    assert np.max(np.abs(ad.simulate(sc, 0.005, alpha_off_after=None).estimate - est)) > 1
+
+
+def test_remark6_at_rank_7_leaves_the_baseline_s_unconverged_parameters():
+    # Switching α off as soon as the rank condition holds (0.002 s in A, 0.01 s in B) leaves the estimate to the
+    # baseline's law, which lacks persistent excitation: the parameters the PE argument says the baseline cannot
+    # identify (A: I11, I13, I33; B: all but I12, I13) stay wrong, as in B5/C4, while α kept converges them
+    for name, alpha, bad, good in (
+        ("valverde_ch4_example_a", 1.0, [0, 2, 5], [3]),
+        ("valverde_ch4_example_b", 0.005, [0, 3, 4, 5, 6], [1, 2]),
+    ):
+        sc = ad.load_scenario(name)
+        kept = ad.simulate(sc, alpha)
+        off = ad.simulate(sc, alpha, alpha_off_after=0.0)
+        assert kept.alpha_off_time is None and np.all(kept.alpha_in_effect == alpha)
+        assert off.alpha_off_time == off.rank7_time <= 0.01
+        assert np.max(np.abs(kept.final_estimate - TRUTH)) < 0.01
+        rel = np.abs(off.final_estimate - TRUTH) / TRUTH
+        assert np.all(rel[bad] > 0.05), (name, rel)
+        assert np.all(rel[good] < 0.05), (name, rel)
+
+
+def test_remark6_later_switch_keeps_tracking_but_the_estimate_drifts():
+    # α off 3 s after rank 7 in example A (the thesis' estimates have converged "in under 3 s"): tracking is as with
+    # α kept, the estimate no longer converges to the truth: the baseline's adaptation moves it while s ≠ 0
+    sc = ad.load_scenario("valverde_ch4_example_a")
+    kept, off = ad.simulate(sc, 1.0), ad.simulate(sc, 1.0, alpha_off_after=3.0)
+    assert 3.0 <= off.alpha_off_time - off.rank7_time < 3.05
+    at = np.argmin(np.abs(off.t - off.alpha_off_time))
+    assert np.max(np.abs(off.estimate[at] - TRUTH) / TRUTH) < 0.01  # converged when α went to 0
+    e_kept = np.max(np.abs(kept.final_estimate - TRUTH))
+    e_off = np.max(np.abs(off.final_estimate - TRUTH))
+    assert e_kept < 1e-4 and 1e-3 < e_off < 0.05, (e_kept, e_off)
+    assert np.linalg.norm(off.position_error[-1]) < 0.01 and np.degrees(off.attitude_error[-1]) < 3.0
+    assert np.all(np.diff(off.lyapunov) <= 1e-9 * off.lyapunov[:-1])  # (4.21) with α = 0 still holds
+
+
+def test_remark6_avoids_the_numerical_problem_of_an_unbounded_p():
+    # Remark 6's reason: P = ∫RᵀR grows without bound, so the CL term's rate α K_i σ_max(P) does too; with a fixed
+    # step it leaves RK4's stability interval (|λ dt| ≤ 2.785: σ_max > 27.8 at α = 1, K_i = 10, dt = 0.01, reached
+    # at about 26 s in example A) and the loop diverges. α = 0 after the rank condition removes the term.
+    import dataclasses
+
+    from freefloat._core import NumericalError
+
+    sc = dataclasses.replace(ad.load_scenario("valverde_ch4_example_a"), method="rk4", dt=0.01, duration=40.0)
+    with pytest.raises(NumericalError, match="diverged"):
+        ad.simulate(sc, 1.0)
+    off = ad.simulate(sc, 1.0, alpha_off_after=10.0)
+    assert off.singular_values[-1, 0] * 10.0 * 0.01 > 2.785  # P kept growing past the limit, harmlessly
+    assert np.max(np.abs(off.final_estimate - TRUTH)) < 0.05
+    assert np.linalg.norm(off.position_error[-1]) < 0.05
+
+
 @pytest.mark.slow
 def test_cli_writes_results_and_figures(tmp_path):
     res = CliRunner().invoke(cli_main, ["control", "adaptive", "valverde_ch4_example_b", "--out", str(tmp_path)])
@@ -310,3 +385,18 @@ def test_cli_help_and_baseline_flag(tmp_path):
     assert bad.exit_code != 0 and "--alpha" in bad.output
     missing = CliRunner().invoke(cli_main, ["control", "adaptive", "no_such_scenario"])
     assert missing.exit_code != 0 and "not found" in missing.output
+    bad = CliRunner().invoke(cli_main, ["control", "adaptive", "valverde_ch4_example_b", "--alpha-off-after", "-1"])
+    assert bad.exit_code != 0 and "--alpha-off-after" in bad.output
+
+
+def test_cli_alpha_off_after(tmp_path):
+    res = CliRunner().invoke(
+        cli_main,
+        ["control", "adaptive", "valverde_ch4_example_b", "--alpha", "0.005", "--no-compare"]
+        + ["--alpha-off-after", "10", "--out", str(tmp_path)],
+    )
+    assert res.exit_code == 0, res.output
+    d = json.loads((tmp_path / "results.json").read_text())
+    assert d["learning"]["alpha_off_after_s"] == 10.0
+    assert d["runs"]["alpha=0.005"]["alpha_off_time_s"] == pytest.approx(10.01)
+    assert "alpha = 0 from" in res.output and "10.0100 s" in res.output

@@ -251,6 +251,54 @@ def test_D6_D7_accuracy_flat_in_ns_run_time_grows(scenario):
     assert t[300] > 1.3 * t[10], t
 
 
+def _slowest_plain_rate(sv, sigma_th2):
+    """(9.27) leaves every direction with σ_i ≥ σ_th,2 at its plain rate σ_i (9.25): the slowest of them."""
+    return sv[sv >= sigma_th2].min()
+
+
+def test_fig_9_5_accuracy_against_ns_under_the_thesis_rule(model, scenario):
+    # Fig. 9.5 at the thesis' σ_th,2 = 0.5. At N_s = 10 no singular value of ΣRᵀR lies in [0.5, 3.4): every direction
+    # is either accelerated to σ_new = 100 or already fast, and the error is at its floor. At N_s ≥ 50 values of
+    # 0.54-0.68 sit just above σ_th,2; (9.27) leaves them at their own rate (σ̄_i = 1), so once the stack is frozen the
+    # error decays as exp(−σ_i t) with σ_i the slowest of them (9.25), and at 9.7-10 s it is still 6-9e-3.
+    truth = _truth(model).ravel()
+    scales = cl.parameter_scales(truth)
+    sups = {}
+    for ns in (10, 50, 100, 300):
+        r = cl.run(scenario, ns=ns)
+        err = np.max(np.abs(r.estimates - truth) / scales, axis=1)
+        sups[ns] = err[r.t >= 9.7 - 1e-9].max()
+        assert sups[ns] == pytest.approx(r.sup_error(9.7), rel=1e-12)
+        sv = r.singular_values[-1]
+        if ns == 10:
+            assert not np.any((sv >= 0.5) & (sv < 3.0)), sv
+            assert sups[ns] < 1e-9
+            continue
+        slow = _slowest_plain_rate(sv, 0.5)
+        assert 0.5 < slow < 0.7, slow
+        # the error's decay over 7-10 s, measured against the truth, is that singular value's rate
+        i7 = np.argmin(np.abs(r.t - 7.0))
+        measured = np.log(err[i7] / err[-1]) / (r.t[-1] - r.t[i7])
+        assert measured == pytest.approx(slow, rel=1e-3), (ns, measured, slow)
+        assert r.error_decay_rate(3.0) == pytest.approx(measured, rel=1e-9)
+        assert 3e-3 < sups[ns] < 1.5e-2, (ns, sups[ns])
+    assert sups[50] > 1e6 * sups[10]
+
+
+def test_fig_9_5_is_flat_with_sigma_th2_at_sigma_new(model, scenario):
+    # (9.27) with σ_th,2 = σ_new (a setting, not the thesis' 0.5): every direction converges at max(σ_i, σ_new), and
+    # the error at 9.7-10 s is at or below the N_s = 10 floor for every N_s
+    sc = cl.with_settings(scenario, sigma_th2=100.0)
+    truth = _truth(model).ravel()
+    for ns in (10, 50, 100, 300):
+        r = cl.run(sc, ns=ns)
+        assert r.singular_values[-1].max() < 100.0  # so every nonzero direction is accelerated
+        err = np.max(np.abs(r.estimates - truth) / cl.parameter_scales(truth), axis=1)
+        assert err[r.t >= 9.7 - 1e-9].max() < 1e-9, ns
+    # the thesis' σ_th,2 = 0.5 stays the scenario's, and the CLI option overrides it
+    assert scenario.estimator["sigma_th2"] == 0.5
+
+
 def test_user_loop_reaches_the_same_accuracy(model, scenario):
     # drive the estimator from our own loop on the engine's ABA simulation (the Python API of the issue)
     def tau(t, q, v):
@@ -374,6 +422,20 @@ def test_cli_help_and_run(tmp_path):
     assert time.time() - t0 < 60
     bad = subprocess.run([*exe, "identify", "cl", MODEL, "--ns", "1"], capture_output=True, text=True)
     assert bad.returncode != 0 and "--ns" in bad.stderr
+    # --sigma-th2 reaches the run and the sweep: N_s = 50 at σ_th,2 = σ_new has no slow direction left
+    r = subprocess.run(
+        [*exe, "identify", "cl", MODEL, "--out", str(out), "--ns", "50", "--sigma-th2", "100", "--no-noise"]
+        + ["--repeats", "1"],
+        capture_output=True,
+        text=True,
+    )
+    assert r.returncode == 0, r.stderr
+    d = json.loads((out / "results.json").read_text())
+    assert d["settings"]["sigma_th2"] == 100.0 and d["sup_error_9p7_to_10s"] < 1e-9
+    assert all(row["sup_error_9p7_to_10s"] < 1e-9 for row in d["ns_sweep"])
+    assert "error decay rate" in r.stdout
+    bad = subprocess.run([*exe, "identify", "cl", MODEL, "--sigma-th2", "nan"], capture_output=True, text=True)
+    assert bad.returncode != 0 and "--sigma-th2" in bad.stderr
 
 
 def test_scenario_is_listed():

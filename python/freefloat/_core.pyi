@@ -405,12 +405,14 @@ def actuator_fields() -> Any:
 (`Wheel::new`; `None`: no limit). The one source the Python classes and the scenario schema read.
     """
 
-def adaptive_simulate(truth: ArrayLike, q0: ArrayLike, w0: ArrayLike, estimate0: ArrayLike, k_r: ArrayLike, k_q: ArrayLike, k_v: ArrayLike, k_w: ArrayLike, k_i: ArrayLike, alpha: float, t_final: float, learning: ArrayLike = 'continuous', n_s: ArrayLike = 50, sigma_stop: ArrayLike = Ellipsis, selection: ArrayLike = 'elementwise', seed: ArrayLike = 0, law_form: ArrayLike = 'corrected', reference_angular: ArrayLike | None = None, reference_linear: ArrayLike | None = None, reference_times: ArrayLike | None = None, reference_twists: ArrayLike | None = None, method: str = 'dopri5', dt: float = 0.01, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = Ellipsis, output_dt: ArrayLike = 0.01, max_steps: int = 50000000, rank_tol: ArrayLike = 1e-08, progress: Callable[[float], Any] | None = None) -> Any:
+def adaptive_simulate(truth: ArrayLike, q0: ArrayLike, w0: ArrayLike, estimate0: ArrayLike, k_r: ArrayLike, k_q: ArrayLike, k_v: ArrayLike, k_w: ArrayLike, k_i: ArrayLike, alpha: float, t_final: float, learning: ArrayLike = 'continuous', n_s: ArrayLike = 50, sigma_stop: ArrayLike = Ellipsis, selection: ArrayLike = 'elementwise', seed: ArrayLike = 0, law_form: ArrayLike = 'corrected', reference_angular: ArrayLike | None = None, reference_linear: ArrayLike | None = None, reference_times: ArrayLike | None = None, reference_twists: ArrayLike | None = None, method: str = 'dopri5', dt: float = 0.01, rtol: float = 1e-10, atol: float = 1e-10, max_step: float | None = Ellipsis, output_dt: ArrayLike = 0.01, max_steps: int = 50000000, rank_tol: ArrayLike = 1e-08, alpha_off_after: ArrayLike | None = None, progress: Callable[[float], Any] | None = None) -> Any:
     """Simulate the closed loop of Valverde 2018 ch. 4 (relative pose-error dynamics (2.58) of a spacecraft with
 mass properties `truth`, adaptive law (4.9) corrected, update law (4.13) or (4.29)) in the engine, and
 return the recorded histories: `t`, `q`, `w`, `estimate`, `force`, `singular_values`, `lyapunov`,
-`position_error`, `attitude_error`, `stack_len`, plus `steps`, `rejected`, `evaluations`, `rank7_time`,
-`stack_changes`, `left_admissible_at`, `admissible_since`, `interrupted`. `progress(t)` is called with the
+`position_error`, `attitude_error`, `stack_len`, `alpha_in_effect` (the CL weight in effect over the step from each
+recorded time), plus `steps`, `rejected`, `evaluations`, `rank7_time`, `alpha_off_time`, `stack_changes`,
+`left_admissible_at`, `admissible_since`, `interrupted`. `alpha_off_after` (seconds, ≥ 0; None = never):
+Valverde 2018 Remark 6, α is set to 0 that long after the CL matrix first has rank 7 (σ_min > `rank_tol`). `progress(t)` is called with the
 simulated time every 200 steps; returning False (or Ctrl-C) stops the run and keeps what was done.
     """
 

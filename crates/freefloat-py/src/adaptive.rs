@@ -169,8 +169,10 @@ pub fn inertia_realisability<'py>(py: Python<'py>, v: &Bound<'_, PyAny>) -> PyRe
 /// Simulate the closed loop of Valverde 2018 ch. 4 (relative pose-error dynamics (2.58) of a spacecraft with
 /// mass properties `truth`, adaptive law (4.9) corrected, update law (4.13) or (4.29)) in the engine, and
 /// return the recorded histories: `t`, `q`, `w`, `estimate`, `force`, `singular_values`, `lyapunov`,
-/// `position_error`, `attitude_error`, `stack_len`, plus `steps`, `rejected`, `evaluations`, `rank7_time`,
-/// `stack_changes`, `left_admissible_at`, `admissible_since`, `interrupted`. `progress(t)` is called with the
+/// `position_error`, `attitude_error`, `stack_len`, `alpha_in_effect` (the CL weight in effect over the step from each
+/// recorded time), plus `steps`, `rejected`, `evaluations`, `rank7_time`, `alpha_off_time`, `stack_changes`,
+/// `left_admissible_at`, `admissible_since`, `interrupted`. `alpha_off_after` (seconds, ≥ 0; None = never):
+/// Valverde 2018 Remark 6, α is set to 0 that long after the CL matrix first has rank 7 (σ_min > `rank_tol`). `progress(t)` is called with the
 /// simulated time every 200 steps; returning False (or Ctrl-C) stops the run and keeps what was done.
 #[pyfunction]
 #[pyo3(signature = (
@@ -178,7 +180,7 @@ pub fn inertia_realisability<'py>(py: Python<'py>, v: &Bound<'_, PyAny>) -> PyRe
     sigma_stop = f64::INFINITY, selection = "elementwise", seed = 0, law_form = "corrected",
     reference_angular = None, reference_linear = None, reference_times = None, reference_twists = None,
     method = "dopri5", dt = 0.01, rtol = 1e-10, atol = 1e-10, max_step = f64::INFINITY, output_dt = 0.01,
-    max_steps = 50_000_000, rank_tol = 1e-8, progress = None
+    max_steps = 50_000_000, rank_tol = 1e-8, alpha_off_after = None, progress = None
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn adaptive_simulate<'py>(
@@ -212,6 +214,7 @@ pub fn adaptive_simulate<'py>(
     output_dt: f64,
     max_steps: usize,
     rank_tol: f64,
+    alpha_off_after: Option<f64>,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let harmonic = match (&reference_angular, &reference_linear) {
@@ -228,6 +231,7 @@ pub fn adaptive_simulate<'py>(
         truth: v7_arg(truth, "truth")?,
         gains: gains(k_r, k_q, k_v, k_w, k_i)?,
         alpha,
+        alpha_off_after,
         law: law(law_form)?,
         learning: self::learning(learning, n_s, sigma_stop, selection, seed)?,
         q0: dq_arg(q0, "q0")?,
@@ -293,6 +297,8 @@ pub fn adaptive_simulate<'py>(
     d.set_item("rejected", r.rejected)?;
     d.set_item("evaluations", r.evaluations)?;
     d.set_item("rank7_time", r.rank7_time)?;
+    d.set_item("alpha_in_effect", PyArray1::from_slice(py, &r.alpha_in_effect))?;
+    d.set_item("alpha_off_time", r.alpha_off_time)?;
     d.set_item("stack_changes", r.stack_changes)?;
     d.set_item("left_admissible_at", r.left_admissible_at)?;
     d.set_item("admissible_since", r.admissible_since)?;

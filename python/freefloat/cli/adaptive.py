@@ -18,7 +18,15 @@ import click
     help="Concurrent-learning weight(s) instead of the scenario's (repeat for several runs); the baseline runs beside.",
 )
 @click.option("--no-compare", is_flag=True, help="Do not run the baseline beside the concurrent-learning runs.")
-def adaptive_cmd(scenario, out, baseline, alpha, no_compare):
+@click.option(
+    "--alpha-off-after",
+    type=float,
+    metavar="SECONDS",
+    help="Valverde 2018 Remark 6: set alpha to 0 this many seconds after the concurrent-learning matrix first has "
+    "rank 7 (overrides the scenario's learning.alpha_off_after; default: never). 0 switches it off at rank 7; "
+    "the estimate then keeps only the baseline's adaptation (docs/architecture.md, 'Remark 6').",
+)
+def adaptive_cmd(scenario, out, baseline, alpha, no_compare, alpha_off_after):
     """Valverde 2018 ch. 4: a spacecraft tracks a moving reference frame while it learns its own mass and inertia.
 
     SCENARIO is a built-in name (`freefloat scenarios`: valverde_ch4_example_a, valverde_ch4_example_b) or a
@@ -28,6 +36,7 @@ def adaptive_cmd(scenario, out, baseline, alpha, no_compare):
     estimates against the truth [I11, I12, I13, I22, I23, I33, m], the time after which all stay within 1 %,
     and the final tracking errors; --out writes results.json and Figs. 4.1-4.7 (tracking errors, estimates,
     singular values, control effort). Ctrl-C stops a run and keeps what was simulated."""
+    import dataclasses
     import math
 
     from tqdm import tqdm
@@ -36,7 +45,11 @@ def adaptive_cmd(scenario, out, baseline, alpha, no_compare):
 
     if any(not (a >= 0 and math.isfinite(a)) for a in alpha):
         raise click.BadParameter("must be finite and >= 0", param_hint="--alpha")
+    if alpha_off_after is not None and not (alpha_off_after >= 0 and math.isfinite(alpha_off_after)):
+        raise click.BadParameter(f"must be finite and >= 0, got {alpha_off_after}", param_hint="--alpha-off-after")
     sc = ad.load_scenario(scenario)
+    if alpha_off_after is not None:
+        sc = dataclasses.replace(sc, alpha_off_after=float(alpha_off_after))
     labels = ["baseline"] if baseline else [f"alpha={a:g}" for a in (alpha or sc.alphas) if a != 0]
     if not baseline and not no_compare:
         labels.append("baseline")

@@ -61,6 +61,7 @@ class Scenario:
     selection: str = "elementwise"
     seed: int = 0
     law: str = "corrected"
+    alpha_off_after: float | None = None  # Remark 6: alpha = 0 this long after rank 7 (None: never)
     reference: dict = field(default_factory=dict)
     duration: float = 50.0
     method: str = "dopri5"
@@ -231,6 +232,9 @@ def load_scenario(spec: str | Path) -> Scenario:
         selection=selection,
         seed=int(le.get("seed", 0)),
         law=str(le.get("law", "corrected")),
+        alpha_off_after=(
+            None if le.get("alpha_off_after") is None else _num(le, "alpha_off_after", source, "learning.", lo=0.0)
+        ),
         reference=_reference(ref, source),
         duration=_num(sim, "duration", source, "simulation.", lo=0.0, lo_open=True),
         method=method,
@@ -314,6 +318,7 @@ class AdaptiveRun:
             "final_singular_values": sv[-1].tolist(),
             "sigma_min_first_reaches_0p1_s": float(t[reach[0]]) if len(reach) else None,
             "rank7_time_s": d["rank7_time"],
+            "alpha_off_time_s": d["alpha_off_time"],
             "lyapunov_initial": float(V[0]),
             "lyapunov_final": float(V[-1]),
             "lyapunov_max_increase": float(max(0.0, np.max(np.diff(V)))) if len(V) > 1 else 0.0,
@@ -330,17 +335,25 @@ class AdaptiveRun:
         }
 
 
-def simulate(sc: Scenario | str | Path, alpha: float, progress=None, law: str | None = None) -> AdaptiveRun:
+_KEEP = object()
+
+
+def simulate(
+    sc: Scenario | str | Path, alpha: float, progress=None, law: str | None = None, alpha_off_after=_KEEP
+) -> AdaptiveRun:
     """One closed-loop run of a scenario with the CL weight `alpha` (0: the baseline), in the engine.
-    `progress(t)` gets the simulated time; returning False or Ctrl-C stops the run, keeping what was done."""
+    `progress(t)` gets the simulated time; returning False or Ctrl-C stops the run, keeping what was done.
+    `alpha_off_after` (s, ≥ 0, or None for never; default the scenario's `learning.alpha_off_after`): Valverde 2018
+    Remark 6, α is set to 0 that long after the CL matrix first has rank 7 (`rank7_time_s`)."""
     sc = _scenario(sc)
+    off = sc.alpha_off_after if alpha_off_after is _KEEP else alpha_off_after
     g = sc.gains
     t0 = time.perf_counter()
     data = _core.adaptive_simulate(
         sc.truth, sc.q0, sc.w0, sc.estimate0, g["K_r"], g["K_q"], g["K_v"], g["K_w"], g["K_i"], alpha,
         sc.duration, learning=sc.mode, n_s=sc.n_s, sigma_stop=sc.sigma_stop, selection=sc.selection,
         seed=sc.seed, law_form=law or sc.law, method=sc.method, dt=sc.dt, rtol=sc.rtol, atol=sc.atol,
-        max_step=sc.max_step, output_dt=sc.output_dt, progress=progress, **sc.reference,
+        max_step=sc.max_step, output_dt=sc.output_dt, alpha_off_after=off, progress=progress, **sc.reference,
     )  # fmt: skip
     wall = time.perf_counter() - t0
     label = "baseline" if alpha == 0 else f"alpha={alpha:g}"
@@ -388,6 +401,7 @@ class AdaptiveResult:
                     if sc.mode == "discrete"
                     else {}
                 ),
+                "alpha_off_after_s": sc.alpha_off_after,
             },
             "integration": {
                 "method": sc.method,
@@ -411,16 +425,21 @@ class AdaptiveResult:
         lines.append("")
         hdr = f"  {'run':<14}{'within 1 % from':>17}{'pos. err [m]':>14}{'att. err [deg]':>16}"
         hdr += f"{'rank 7 at':>11}{'sv_min>=0.1':>13}{'steps':>8}{'wall [s]':>10}"
+        off = self.scenario.alpha_off_after is not None
+        if off:
+            hdr += f"{'alpha = 0 from':>16}"
         lines.append(hdr)
         for k, r in self.runs.items():
             s = r.summary(tr)
             w = s["time_within_1pct_s"]
             sm = s["sigma_min_first_reaches_0p1_s"]
             r7 = s["rank7_time_s"]
+            ao = s["alpha_off_time_s"]
             lines.append(
                 f"  {k:<14}{('never' if w is None else f'{w:.2f} s'):>17}{s['final_position_error_m']:>14.3e}"
                 f"{s['final_attitude_error_deg']:>16.3f}{('-' if r7 is None else f'{r7:.4f} s'):>11}"
                 f"{('-' if sm is None else f'{sm:.2f} s'):>13}{s['steps']:>8}{s['wall_time_s']:>10.3f}"
+                + (f"{('-' if ao is None else f'{ao:.4f} s'):>16}" if off else "")
             )
         rz = realisability(tr)
         if not rz["realisable"]:

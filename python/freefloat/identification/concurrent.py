@@ -442,6 +442,17 @@ class ClResult:
         sel = self.t >= t_from - 1e-9
         return float(np.max(np.abs(self.errors[sel]))) if np.any(sel) else float("nan")
 
+    def error_decay_rate(self, window: float = 3.0) -> float:
+        """How fast the largest relative error fell over the last `window` seconds, ln(e(T − window)/e(T)) / window
+        (1/s). Once the stack is frozen the law is linear with constant coefficients, so this is the rate of the
+        slowest direction still carrying error: the smallest σ_i ≥ σ_th,2 of the stacked sum under (9.27) with the
+        thesis' σ_th,2 (docs/identification.md, "Accuracy against N_s"); near 0 once the error is at its floor."""
+        e = np.max(np.abs(self.errors), axis=1)
+        ia = int(np.argmin(np.abs(self.t - (self.t[-1] - window))))
+        if self.t[-1] - self.t[ia] <= 0 or not (e[ia] > 0 and e[-1] > 0):
+            return float("nan")
+        return float(np.log(e[ia] / e[-1]) / (self.t[-1] - self.t[ia]))
+
     def to_dict(self) -> dict:
         fe = self.final_estimate
         rel = np.abs(fe - self.truth) / parameter_scales(self.truth)
@@ -464,6 +475,7 @@ class ClResult:
             "first_nonzero_singular_value_s": self.first_nonzero_sv_s,
             "singular_values_constant_after_s": self.last_stack_change_s,
             "sup_error_9p7_to_10s": self.sup_error(9.7),
+            "error_decay_rate_last_3s": self.error_decay_rate(3.0),
             "max_residual_RM_minus_F": None if not np.isfinite(self.max_residual) else self.max_residual,
             "noise_sigma_final": [float(x) if np.isfinite(x) else None for x in self.noise_sigma],
             "gain_withheld": [int(x) for x in self.gain_withheld],

@@ -40,6 +40,7 @@ def ns_sweep(scenario, ns_values=(10, 50, 100, 200, 300), repeats: int = 3, prog
             {
                 "ns": ns,
                 "sup_error_9p7_to_10s": d["sup_error_9p7_to_10s"],
+                "tail_decay_rate_per_s": d["error_decay_rate_last_3s"],
                 "max_final_relative_error": d["max_final_relative_error"],
                 "time_within_1pct_s": d["time_within_1pct_s"],
                 "rank_final": d["rank_final"],

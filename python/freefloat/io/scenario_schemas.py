@@ -218,6 +218,7 @@ class AdLearning(Block):
     selection: literal("elementwise", "max_min_sv") = "elementwise"
     seed: integer(lo=0) = 0
     law: Text = "corrected"
+    alpha_off_after: NonNegative | None = None
 
 
 class AdReference(Block):

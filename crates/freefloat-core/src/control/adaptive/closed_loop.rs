@@ -53,6 +53,11 @@ pub struct Setup {
     pub gains: Gains,
     /// Concurrent-learning weight α ≥ 0 (0 = the baseline of [47]).
     pub alpha: f64,
+    /// Remark 6 (Valverde 2018 §4.2): "once the rank condition (4.16) is satisfied, α can eventually be set to
+    /// α = 0". `Some(d)`: α is switched to 0 at the first step start at least `d` ≥ 0 seconds after the CL matrix
+    /// (P in continuous CL, Σ R_kᵀR_k in discrete CL) first has rank 7 (σ_min > `RunOptions::rank_tol`, the
+    /// `Run::rank7_time`); `None`: α is kept throughout (the thesis' examples).
+    pub alpha_off_after: Option<f64>,
     /// Corrected or printed control law.
     pub law: LawForm,
     /// Continuous or discrete CL.
@@ -125,13 +130,15 @@ pub(crate) fn regressor_of(ev: &Eval, x: &[f64; NX]) -> M87 {
     relative_regressor(&ev.w_dot, &dq_at(x, IW), &ev.reference.1, &ev.reference.0, &dq_at(x, IQ))
 }
 
-/// The state rate at (t, x) into `dx`. `stack` holds the discrete-CL sums (ignored in continuous CL).
+/// The state rate at (t, x) into `dx` with the CL weight `alpha` in effect (`s.alpha`, or 0 after Remark 6's
+/// switch). `stack` holds the discrete-CL sums (ignored in continuous CL).
 pub(crate) fn rhs(
     s: &Setup,
     m: &DualInertia,
     t: f64,
     x: &[f64; NX],
     stack: Option<&DataStack>,
+    alpha: f64,
     dx: &mut [f64; NX],
 ) -> Eval {
     let ev = plant_eval(s, m, t, x);
@@ -147,11 +154,11 @@ pub(crate) fn rhs(
             dx[IP..IP + 49].copy_from_slice(rtr.as_slice());
             dx[IQQ..IQQ + 7].copy_from_slice(rtf.as_slice());
             let (p, qq) = (m7_at(x, IP), v7_at(x, IQQ));
-            estimate_rate(&s.gains, s.alpha, &v_hat, &ev.err, Some((&p, &qq)))
+            estimate_rate(&s.gains, alpha, &v_hat, &ev.err, Some((&p, &qq)))
         }
         Learning::Discrete { .. } => {
             let cl = stack.filter(|st| !st.is_empty()).map(|st| (st.rr(), st.rf()));
-            estimate_rate(&s.gains, s.alpha, &v_hat, &ev.err, cl)
+            estimate_rate(&s.gains, alpha, &v_hat, &ev.err, cl)
         }
     };
     dx[IV..IV + 7].copy_from_slice(rate.as_slice());

@@ -82,6 +82,10 @@ pub struct Run {
     pub evaluations: usize,
     /// First step time at which σ_min of the CL matrix exceeds `rank_tol`.
     pub rank7_time: Option<f64>,
+    /// The CL weight in effect over the step from each recorded time (`Setup::alpha`, 0 after Remark 6's switch).
+    pub alpha_in_effect: Vec<f64>,
+    /// The step start from which α = 0 (Remark 6, `Setup::alpha_off_after`); None if it was never switched off.
+    pub alpha_off_time: Option<f64>,
     /// Times the stack changed (discrete CL).
     pub stack_changes: usize,
     /// First recorded time at which an admissible estimate (m > 0, Ī > 0) became inadmissible.
@@ -107,6 +111,14 @@ fn check_setup(s: &Setup, o: &RunOptions) -> Result<DualInertia> {
             "alpha",
             format!("must be finite and ≥ 0 (0 = no concurrent learning), got {}", s.alpha),
         ));
+    }
+    if let Some(d) = s.alpha_off_after {
+        if !(d >= 0.0) || !d.is_finite() {
+            return Err(FfError::arg(
+                "alpha_off_after",
+                format!("must be finite and ≥ 0 (seconds after the CL matrix reaches rank 7), got {d}"),
+            ));
+        }
     }
     if !(o.t_final > 0.0) || !o.t_final.is_finite() {
         return Err(FfError::arg("t_final", format!("must be positive and finite, got {}", o.t_final)));
@@ -146,12 +158,31 @@ struct Driver<'a> {
     rank_tol: f64,
     evals: usize,
     was_admissible: bool,
+    /// the CL weight in effect (Remark 6 sets it to 0)
+    alpha: f64,
 }
 
 impl Driver<'_> {
     fn f(&mut self, t: f64, x: &[f64; NX], dx: &mut [f64; NX]) -> Eval {
         self.evals += 1;
-        rhs(self.s, &self.m, t, x, self.stack.as_ref(), dx)
+        rhs(self.s, &self.m, t, x, self.stack.as_ref(), self.alpha, dx)
+    }
+
+    /// Remark 6 (Valverde 2018 §4.2): at a step start t, switch α off once t is `alpha_off_after` past the time the
+    /// rank condition (4.16)/(4.30) first held. Returns whether α changed (the integrator's stored first stage is
+    /// then stale).
+    fn switch_alpha(&mut self, t: f64) -> bool {
+        let (Some(delay), Some(t7)) = (self.s.alpha_off_after, self.run.rank7_time) else {
+            return false;
+        };
+        // half a microstep of slack: a delay that is a multiple of the RK4 step lands on that step
+        if self.run.alpha_off_time.is_none() && t >= t7 + delay - 1e-9 * delay.max(1.0) {
+            self.run.alpha_off_time = Some(t);
+            let changed = self.alpha != 0.0;
+            self.alpha = 0.0;
+            return changed;
+        }
+        false
     }
 
     /// At an accepted step start: offer the candidate of this state to the stack.
@@ -204,6 +235,7 @@ impl Driver<'_> {
         r.position_error.extend_from_slice(pos.as_slice());
         r.attitude_error.push(ang);
         r.stack_len.push(self.stack.as_ref().map_or(0, |s| s.len()));
+        r.alpha_in_effect.push(self.alpha);
         let ok = realisability(&v_hat).is_admissible();
         if ok && r.admissible_since.is_none() {
             r.admissible_since = Some(t);
@@ -234,8 +266,16 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
         Learning::Discrete { n_s, sigma_stop, rule, seed } => Some(DataStack::new(n_s, sigma_stop, rule, seed)?),
         Learning::Continuous => None,
     };
-    let mut d =
-        Driver { s: setup, m, stack, run: Run::default(), rank_tol: opts.rank_tol, evals: 0, was_admissible: false };
+    let mut d = Driver {
+        s: setup,
+        m,
+        stack,
+        run: Run::default(),
+        rank_tol: opts.rank_tol,
+        evals: 0,
+        was_admissible: false,
+        alpha: setup.alpha,
+    };
     // the histories are sized once (bounded by the recording grid), so the stepping loop does not reallocate
     let n_out = ((opts.t_final / opts.output_dt).ceil() as usize).saturating_add(2).min(50_000_000);
     let r = &mut d.run;
@@ -249,6 +289,7 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
     r.position_error.reserve(3 * n_out);
     r.attitude_error.reserve(n_out);
     r.stack_len.reserve(n_out);
+    r.alpha_in_effect.reserve(n_out);
     let n_active = if matches!(setup.learning, Learning::Continuous) { NX } else { N_CORE };
     let x0 = initial_state(setup);
     let mut stop = false;
@@ -269,6 +310,7 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
                 let t = step as f64 * dt;
                 d.offer(t, &x);
                 d.check_rank_continuous(t, &x);
+                d.switch_alpha(t);
                 if step % every == 0 || step == n {
                     d.record(t, &x)?;
                 }
@@ -347,6 +389,7 @@ fn dopri5(
     let mut t = 0.0;
     let mut k = [[0.0; NX]; 7];
     d.offer(t, &x);
+    d.switch_alpha(t);
     d.record(t, &x)?;
     let mut out_k = 1usize;
     {
@@ -443,6 +486,7 @@ fn dopri5(
         k[0] = k[6];
         d.run.steps += 1;
         d.check_rank_continuous(t, &x);
+        let mut switched = d.switch_alpha(t);
         let factor = if err == 0.0 { 10.0 } else { (0.9 * err.powf(-0.2)).min(10.0) };
         h = if rejected_last { h * factor.min(1.0) } else { h * factor }.min(max_step);
         rejected_last = false;
@@ -451,8 +495,12 @@ fn dopri5(
             return Ok(false);
         }
         if d.stack.is_some() {
-            // the new candidate may change the CL sums: the first stage must see them
+            // the new candidate may change the CL sums (and bring rank 7, Remark 6's trigger)
             d.offer(t, &x);
+            switched |= d.switch_alpha(t);
+        }
+        if d.stack.is_some() || switched {
+            // the first stage must see the new sums or the new α
             let mut k0 = [0.0; NX];
             d.f(t, &x, &mut k0);
             k[0] = k0;

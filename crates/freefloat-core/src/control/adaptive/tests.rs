@@ -39,6 +39,7 @@ fn example_a_setup(alpha: f64, law: LawForm) -> Setup {
         truth: truth(),
         gains: thesis_gains(),
         alpha,
+        alpha_off_after: None,
         law,
         learning: Learning::Continuous,
         q0: from_rotation_body_translation(&qr, &V3::new(1.0, 2.0, 0.5)),
@@ -112,7 +113,7 @@ fn lyapunov_check(law: LawForm, seed: u64) -> (f64, f64) {
     x[IQQ..IQQ + 7].copy_from_slice((p * truth()).as_slice());
     let t = 0.3;
     let mut dx = [0.0; NX];
-    let ev = rhs(&s, &m, t, &x, None, &mut dx);
+    let ev = rhs(&s, &m, t, &x, None, s.alpha, &mut dx);
     let v_of = |x: &[f64; NX]| {
         let q = dq_at(x, IQ);
         let err = error_state(&s.gains, &q, &dq_at(x, IW), &DualQuat::ZERO, &DualQuat::ZERO);
@@ -159,7 +160,7 @@ fn regression_holds_along_the_simulated_motion() {
         x[8..16].copy_from_slice(&run.w[8 * k..8 * k + 8]);
         x[16..23].copy_from_slice(&run.estimate[7 * k..7 * k + 7]);
         let mut dx = [0.0; NX];
-        let ev = rhs(&s, &m, run.t[k], &x, None, &mut dx);
+        let ev = rhs(&s, &m, run.t[k], &x, None, s.alpha, &mut dx);
         let r = relative_regressor(&ev.w_dot, &dq_at(&x, IW), &ev.reference.1, &ev.reference.0, &dq_at(&x, IQ));
         let res = (r * s.truth - ev.force.to_vec8()).amax();
         assert!(res < 1e-9 * ev.force.to_vec8().amax().max(1.0), "t = {}: {res}", run.t[k]);
@@ -286,4 +287,45 @@ fn bad_input_is_named() {
     assert!(simulate(&s, &bad, None).unwrap_err().to_string().contains("rtol"));
     let long = RunOptions { max_steps: 10, ..o };
     assert!(simulate(&s, &long, None).unwrap_err().to_string().contains("max_steps"));
+}
+
+#[test]
+fn remark_6_switches_alpha_off_after_the_rank_condition() {
+    // Valverde 2018 Remark 6: α = 0 from the first step start `delay` after rank 7; before it the run is the one
+    // with α kept (to the bit), after it the stack no longer enters: two stacks of different capacity, which hold
+    // different samples once the smaller is full (0.5 s), give the same run.
+    let mut s = example_a_setup(0.005, LawForm::Corrected);
+    s.reference = Reference::constant(V3::new(1.0, 0.0, 0.0), V3::new(1.0, 0.0, 0.0));
+    s.learning = Learning::Discrete { n_s: 50, sigma_stop: 20.0, rule: Selection::Elementwise, seed: 0 };
+    let o = RunOptions {
+        t_final: 2.0,
+        integrator: Integrator::Rk4 { dt: 0.01 },
+        output_dt: 0.01,
+        max_steps: 1_000_000,
+        rank_tol: 1e-8,
+    };
+    let kept = simulate(&s, &o, None).unwrap();
+    assert!(kept.alpha_off_time.is_none() && kept.alpha_in_effect.iter().all(|&a| a == 0.005));
+    s.alpha_off_after = Some(0.3);
+    let off = simulate(&s, &o, None).unwrap();
+    let t_off = off.alpha_off_time.unwrap();
+    assert!((t_off - (off.rank7_time.unwrap() + 0.3)).abs() < 1e-12, "{t_off}");
+    let k_off = (t_off / 0.01).round() as usize;
+    assert_eq!(off.estimate[..7 * (k_off + 1)], kept.estimate[..7 * (k_off + 1)]);
+    assert!(off.alpha_in_effect[..k_off].iter().all(|&a| a == 0.005));
+    assert!(off.alpha_in_effect[k_off..].iter().all(|&a| a == 0.0));
+    let mut bigger = s.clone();
+    bigger.learning = Learning::Discrete { n_s: 80, sigma_stop: 20.0, rule: Selection::Elementwise, seed: 0 };
+    let other = simulate(&bigger, &o, None).unwrap();
+    assert_eq!(other.estimate, off.estimate);
+    bigger.alpha_off_after = None;
+    let other_kept = simulate(&bigger, &o, None).unwrap();
+    // the stacks differ, and matter while α is on
+    assert_ne!(other_kept.estimate, kept.estimate);
+
+    // bad input is named
+    s.alpha_off_after = Some(-1.0);
+    assert!(simulate(&s, &o, None).unwrap_err().to_string().contains("alpha_off_after"));
+    s.alpha_off_after = Some(f64::NAN);
+    assert!(simulate(&s, &o, None).unwrap_err().to_string().contains("alpha_off_after"));
 }
