@@ -240,19 +240,26 @@ fn stack_fills_then_only_improves_every_singular_value() {
     assert!(DataStack::new(50, -1.0, Selection::Elementwise, 0).is_err());
 }
 
-#[test]
-fn example_b_reaches_rank_7_at_the_second_sample() {
-    // C1: the second stored sample (t = 0.01 s) gives rank 7
+/// Example B's setting (constant reference w = v = [1, 0, 0], discrete learning with a stack of `n_s`, stop at
+/// σ_min 20, α = 0.005), RK4 at 0.01 s for `t_final` seconds.
+fn example_b_setup(n_s: usize, t_final: f64) -> (Setup, RunOptions) {
     let mut s = example_a_setup(0.005, LawForm::Corrected);
     s.reference = Reference::constant(V3::new(1.0, 0.0, 0.0), V3::new(1.0, 0.0, 0.0));
-    s.learning = Learning::Discrete { n_s: 50, sigma_stop: 20.0, rule: Selection::Elementwise, seed: 0 };
+    s.learning = Learning::Discrete { n_s, sigma_stop: 20.0, rule: Selection::Elementwise, seed: 0 };
     let o = RunOptions {
-        t_final: 1.0,
+        t_final,
         integrator: Integrator::Rk4 { dt: 0.01 },
         output_dt: 0.01,
         max_steps: 1_000_000,
         rank_tol: 1e-8,
     };
+    (s, o)
+}
+
+#[test]
+fn example_b_reaches_rank_7_at_the_second_sample() {
+    // C1: the second stored sample (t = 0.01 s) gives rank 7
+    let (s, o) = example_b_setup(50, 1.0);
     let run = simulate(&s, &o, None).unwrap();
     let t7 = run.rank7_time.unwrap();
     assert!(t7 <= 0.02 + 1e-12 && t7 > 0.0, "{t7}");
@@ -294,16 +301,7 @@ fn remark_6_switches_alpha_off_after_the_rank_condition() {
     // Valverde 2018 Remark 6: α = 0 from the first step start `delay` after rank 7; before it the run is the one
     // with α kept (to the bit), after it the stack no longer enters: two stacks of different capacity, which hold
     // different samples once the smaller is full (0.5 s), give the same run.
-    let mut s = example_a_setup(0.005, LawForm::Corrected);
-    s.reference = Reference::constant(V3::new(1.0, 0.0, 0.0), V3::new(1.0, 0.0, 0.0));
-    s.learning = Learning::Discrete { n_s: 50, sigma_stop: 20.0, rule: Selection::Elementwise, seed: 0 };
-    let o = RunOptions {
-        t_final: 2.0,
-        integrator: Integrator::Rk4 { dt: 0.01 },
-        output_dt: 0.01,
-        max_steps: 1_000_000,
-        rank_tol: 1e-8,
-    };
+    let (mut s, o) = example_b_setup(50, 2.0);
     let kept = simulate(&s, &o, None).unwrap();
     assert!(kept.alpha_off_time.is_none() && kept.alpha_in_effect.iter().all(|&a| a == 0.005));
     s.alpha_off_after = Some(0.3);
@@ -315,7 +313,7 @@ fn remark_6_switches_alpha_off_after_the_rank_condition() {
     assert!(off.alpha_in_effect[..k_off].iter().all(|&a| a == 0.005));
     assert!(off.alpha_in_effect[k_off..].iter().all(|&a| a == 0.0));
     let mut bigger = s.clone();
-    bigger.learning = Learning::Discrete { n_s: 80, sigma_stop: 20.0, rule: Selection::Elementwise, seed: 0 };
+    bigger.learning = example_b_setup(80, 2.0).0.learning;
     let other = simulate(&bigger, &o, None).unwrap();
     assert_eq!(other.estimate, off.estimate);
     bigger.alpha_off_after = None;
