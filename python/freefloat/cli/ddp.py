@@ -139,7 +139,10 @@ def ddp_cmd(
     """Solve a DDP end-effector problem (Valverde 2018, ch. 8) on a built-in scenario or your own YAML file.
 
     Built-in: valverde_ch8_tracking (three-phase helicoidal reference, 640 steps of 0.05 s) and
-    valverde_ch8_stabilisation (fixed pose of eq. 8.53, 1000 steps of 0.015 s). Progress is printed per iteration
+    valverde_ch8_stabilisation (fixed pose of eq. 8.53, 1000 steps of 0.015 s), both with the thesis' settings and
+    its massless wrist driven by Euler-angle rates, on a 1500 kg base; their defaults meet the thesis' acceptance
+    figures (docs/ddp.md). --dq-sign literal, --wrist torque and --robot valverde_ch8_arm undo one choice each.
+    Progress is printed per iteration
     (cost, step length, regularisation); Ctrl-C stops and keeps the best iterate. With --out, results.json and the
     figures (poses in 3D, pose errors, base wrench, joint torques, cost per iteration) go to DIR.
 
