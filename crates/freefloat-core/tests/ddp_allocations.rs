@@ -124,3 +124,28 @@ fn which_block_allocates() {
     });
     assert_eq!((a, b, c, e), (0, 0, 0, 0));
 }
+
+#[test]
+fn the_rate_driven_wrist_and_the_nearest_sign_allocate_nothing() {
+    // the chapter 8 defaults: the thesis' wrist driven by its rates (the leading bodies' dynamics and derivatives,
+    // then the full model's kinematics for the costs) and the nearest-sign dual-quaternion cost
+    let (mut rob, x0) = robot(6);
+    for t in rob.running.iter_mut().chain(rob.terminal.iter_mut()) {
+        if let Residual::FrameDualQuat { nearest_sign, .. } = &mut t.residual {
+            *nearest_sign = true;
+        }
+    }
+    rob.set_rate_driven(3).unwrap();
+    let mut xn = vec![0.0; 25];
+    let u = vec![0.1; 12];
+    let mut d = freefloat_core::control::ddp::NodeDiff::zeros(24, 12);
+    rob.calc(0, &x0, &u, &mut xn).unwrap();
+    rob.calc_diff(0, &x0, &u, &mut d).unwrap();
+    let a = count(|| {
+        rob.calc(0, &x0, &u, &mut xn).unwrap();
+    });
+    let b = count(|| {
+        rob.calc_diff(0, &x0, &u, &mut d).unwrap();
+    });
+    assert_eq!((a, b), (0, 0));
+}
