@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Run every benchmark in benches/ and regenerate BENCHMARKS.md's tables and the README's speed paragraph.
+"""Run every benchmark in benches/ and regenerate BENCHMARKS.md's tables and the README's speed table.
 
 Each script is run once, in its full mode (or with --fast: its --quick mode, or fewer repeats, and the tables
 say so), writing its results with --json FILE; the Rust estimator benchmark (cargo bench --bench rls_cpu) is
@@ -10,7 +10,7 @@ machine load (os.getloadavg() before and after the script) and the git hash the 
 What is written:
   BENCHMARKS.md   the part between `<!-- run_all:begin -->` and `<!-- run_all:end -->` (added at the top if
                   absent): the summary table and each script's own markdown table; text outside is kept.
-  README.md       the part between `<!-- speed:begin -->` and `<!-- speed:end -->`: a paragraph quoting only
+  README.md       the part between `<!-- speed:begin -->` and `<!-- speed:end -->`: a table quoting only
                   rows of this run (left alone if the markers are absent).
   benches/results/run_all/  every script's JSON and markdown.
 
@@ -587,19 +587,19 @@ def _faster(r: Row) -> str:
 
 
 def speed_paragraph(sections: list[Section], git: str, fast: bool) -> str:
-    """The README's speed paragraph: one sentence per capability, each number a row of this run's summary
-    table (never a number from an older run), each with its target when the issue set one."""
+    """The README's speed table: one row per capability, each number a row of this run's summary table (never a
+    number from an older run), each with its target when the issue set one."""
     rows = {s.name: s.rows for s in sections}
-    parts = []
+    parts: list[tuple[str, str, str]] = []  # (what, result, target)
 
     def add(r: Row, label: str) -> None:
         if r.ratio is None:
             return
         if r.note.startswith("freefloat / reference") or "lower is better" in r.note:
-            text = f"{label}: {r.ratio:.2f}× the time of {r.peer}"
+            text = f"{r.ratio:.2f}× the time of {r.peer}"
         else:
-            text = f"{label}: {_faster(r)}"
-        parts.append(text + (f" (target {r.target})" if r.target else ""))
+            text = _faster(r)
+        parts.append((label, text, r.target))
 
     seed = [r for r in rows.get("kernels", []) if "naveen" in r.what or "seed001" in r.what]
     # one row per kernel: the core-to-core loop against the C++ peer where it ran, else the batched call
@@ -618,18 +618,18 @@ def speed_paragraph(sections: list[Section], git: str, fast: bool) -> str:
         add(r, "identification " + r.what.split(" (")[0])
     for r in rows.get("rls", []):
         if r.what.startswith("modified_rls_3d") or "modified" in r.what:
-            tgt = f" (target {r.target})" if r.target else ""
-            parts.append(f"online 3D post-capture estimator: {r.freefloat} in wall / CPU time{tgt}")
+            parts.append(("online 3D post-capture estimator", f"{r.freefloat} in wall / CPU time", r.target))
     for r in rows.get("ddp", []):
         add(r, "DDP on the ch. 8 tracking problem")
     for r in rows.get("basilisk", [])[:1]:
         add(r, "hub with three reaction wheels")
     mode = " in fast mode (quick problem sizes, indicative only)" if fast else ""
-    body = "; ".join(parts) if parts else "no rows"
+    table = ["| what | freefloat against the peer | target |", "|---|---|---|"]
+    table += [f"| {what} | {text} | {target or '—'} |" for what, text, target in parts] or ["| no rows | | |"]
     return (
-        f"{SPEED_BEGIN}\nSpeed, measured by `python benches/run_all.py`{mode} at git `{git}` against the strongest "
-        f"peer in the same run (every number is a row of [BENCHMARKS.md](BENCHMARKS.md), with its spread and the "
-        f"machine load there): {body}.\n{SPEED_END}"
+        f"{SPEED_BEGIN}\nMeasured by `python benches/run_all.py`{mode} at git `{git}` against the strongest peer in "
+        f"the same run; every number is a row of [BENCHMARKS.md](BENCHMARKS.md), with its spread and the machine "
+        f"load there.\n\n" + "\n".join(table) + f"\n{SPEED_END}"
     )
 
 
