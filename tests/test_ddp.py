@@ -461,3 +461,20 @@ def test_rate_and_sign_options_are_checked(tmp_path):
         )
     r = CliRunner().invoke(main, ["control", "ddp", "valverde_ch8_tracking", "--dq-sign", "sometimes"])
     assert r.exit_code != 0 and "--dq-sign" in r.output
+
+
+def test_results_of_a_hand_built_problem_read_the_reference_from_its_pose_cost():
+    """A problem built with the cost helpers has no `reference_dq`: `results` takes the reference from its pose cost
+    (log-SE(3) poses converted to dual quaternions), and agrees with the scenario's own table."""
+    from dataclasses import replace
+
+    prob = short(ddp.load_scenario("valverde_ch8_tracking", cost="log"), 20)
+    sol = ddp.solve(prob, max_iter=2)
+    want = ddp.results(prob, sol)
+    got = ddp.results(replace(prob, reference_dq=None), sol)
+    for k in ("ee_position_error_final_hold_max_m", "ee_angle_error_final_hold_max_deg", "ee_position_error_rms_m"):
+        assert got[k] == pytest.approx(want[k], rel=1e-9, abs=1e-12), k
+    bare = replace(prob, reference_dq=None, running=[t for t in prob.running if t["kind"] != "frame_placement"])
+    bare = replace(bare, terminal=[t for t in prob.terminal if t["kind"] != "frame_placement"])
+    with pytest.raises(InputError, match="reference_dq"):
+        ddp.results(bare, sol)

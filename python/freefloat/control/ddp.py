@@ -499,7 +499,7 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
     xs, us = np.asarray(sol["xs"]), np.asarray(sol["us"])
     nq = m.nq
     g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(xs[:, :nq]), problem.frame)
-    ref = problem.reference_dq
+    ref = problem.reference_dq if problem.reference_dq is not None else _reference_from_costs(problem)
     err = pose_errors(g, ref)
     t = np.arange(problem.horizon + 1) * problem.dt
     pos = np.linalg.norm(err["position"], axis=1)
@@ -548,6 +548,25 @@ def results(problem: Problem, sol: dict, final_hold_s: float | None = None) -> d
         "gap": float(sol["gap"]),
         "cost_history": [float(h["cost"]) for h in sol["history"]],
     }
+
+
+def _reference_from_costs(problem: Problem) -> np.ndarray:
+    """The reference poses of `problem.frame` as thesis-layout dual quaternions (horizon + 1, 8), read from its first
+    pose cost on that frame (running, else terminal), for a problem built by hand without `reference_dq`."""
+    for t in problem.running + problem.terminal:
+        if t["kind"] in ("frame_placement", "frame_dq") and t["frame"] == problem.frame:
+            r = np.atleast_2d(np.asarray(t["reference"], dtype=float))
+            if t["kind"] == "frame_placement":  # [p, quat xyzw] -> [real w x y z, dual w x y z]
+                r = np.array([_pose_dq(np.r_[row[6], row[3:6]] / np.linalg.norm(row[3:7]), row[:3]) for row in r])
+            if len(r) == 1:
+                return np.tile(r, (problem.horizon + 1, 1))
+            if len(r) == problem.horizon + 1:
+                return r
+            return np.vstack([r, np.tile(r[-1], (problem.horizon + 1 - len(r), 1))])
+    raise InputError(
+        f"argument `problem`: no `reference_dq` and no pose cost on its frame {problem.frame!r} to read the reference"
+        " from: set Problem.reference_dq ((horizon + 1, 8) dual quaternions) or add a frame cost"
+    )
 
 
 def unwind_joint_turns(model: Model, xs, us) -> tuple[np.ndarray, np.ndarray, list]:
