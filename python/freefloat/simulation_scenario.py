@@ -206,7 +206,7 @@ def load(spec) -> SimulationScenario:
     by the engine, against its robot (joint names, tank masses, sensor joints): every error names the file,
     line and key."""
     from .io import scenario_files
-    from .postcapture.scenario import scenario_blocks
+    from .io.scenario_blocks import scenario_blocks
 
     d, source = scenario_files.read(spec, kind="simulate")
     p = Path(spec)
