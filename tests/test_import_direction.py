@@ -61,9 +61,6 @@ LAYERS: list[tuple[str, list[str]]] = [
         "simulation",
         [
             "freefloat.simulation",
-            "freefloat.actuators",
-            "freefloat.environment",
-            "freefloat.batch_simulation",
             "freefloat.io",
             "freefloat.io.telemetry",
             "freefloat.io.mujoco",
@@ -76,7 +73,7 @@ LAYERS: list[tuple[str, list[str]]] = [
             "freefloat.io.scenario_blocks",
             "freefloat.io.scenario_schemas",
             "freefloat.io.scenario_files",
-            "freefloat.simulation_scenario",
+            "freefloat.simulation.scenario",
         ],
     ),
     (

@@ -9,8 +9,8 @@ import numpy as np
 from .. import _core
 from .. import sensors as sn
 from .._core import InputError
-from ..actuators import Actuators
-from ..environment import environment_from_dict
+from ..simulation.actuators import Actuators
+from ..simulation.environment import environment_from_dict
 from . import scenario_files, schema
 
 

@@ -13,7 +13,7 @@ from typing import Annotated, Any
 
 from pydantic import BeforeValidator, Field, PlainValidator, model_validator
 
-from ..actuators import WHEEL_DEFAULTS
+from ..simulation.actuators import WHEEL_DEFAULTS
 from .schema import (
     _TYPES_ONLY,
     Anything,

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
 
-from ._core import InputError, actuator_fields
+from .._core import InputError, actuator_fields
 
 # The keys the engine reads and its wheel defaults (`Wheel::new`): one copy, in the engine; the classes below and
 # the scenario schema (`io/scenario_schemas.py`) take theirs from here.

@@ -30,7 +30,7 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from ._core import Environment, InputError
+from .._core import Environment, InputError
 
 __all__ = ["Environment", "environment_from_dict", "load_environment"]
 
