@@ -6,13 +6,11 @@ from __future__ import annotations
 
 import json
 import os
-import re
 import shutil
 import signal
 import socket
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
@@ -26,6 +24,8 @@ from freefloat import campaign as cp
 from freefloat._core import InputError
 from freefloat.campaign import dataset, runner
 from freefloat.campaign.spec import get_path, run_key, set_path
+
+from _helpers import sigint_when, start_cli
 
 #: the medium post-capture scenario, shortened so one run takes about a second, with measurement noise so the
 #: Monte Carlo seeds matter; 2 grid points x 8 noise draws (the issue's 2 x 8)
@@ -406,39 +406,16 @@ def test_ctrl_c_keeps_the_finished_runs_and_the_same_command_continues(tmp_path)
     spec["set"]["duration"] = 40.0
     spec_file = tmp_path / "spec.yaml"
     spec_file.write_text(yaml.safe_dump(spec))
-    cmd = [
-        sys.executable,
-        "-m",
-        "freefloat",
-        "campaign",
-        str(spec_file),
-        "--out",
-        str(tmp_path / "o"),
-        "--workers",
-        "1",
-    ]
-    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    err_chunks: list[bytes] = []
-    reader = threading.Thread(target=lambda: err_chunks.extend(iter(lambda: os.read(p.stderr.fileno(), 4096), b"")))
-    reader.start()
-    deadline = time.monotonic() + 120
-    while not re.search(rb"done [1-9]", b"".join(err_chunks)):  # the progress bar's postfix: "done 1, failed 0"
-        assert time.monotonic() < deadline and p.poll() is None, ("no run finished", b"".join(err_chunks)[-2000:])
-        time.sleep(0.05)
-    assert p.poll() is None, "the campaign finished before it could be interrupted (make its runs longer)"
-    p.send_signal(signal.SIGINT)
-    t_sig = time.monotonic()
-    p.wait(timeout=60)
-    stopped_after = time.monotonic() - t_sig
-    reader.join(timeout=10)
-    err = b"".join(err_chunks).decode(errors="replace")
-    assert p.returncode == 130 and "run the same command again to continue" in err, (p.returncode, err[-2000:])
+    args = ["campaign", str(spec_file), "--out", str(tmp_path / "o"), "--workers", "1"]
+    # once a run is done (the progress bar's postfix: "done 1, failed 0")
+    r = sigint_when(start_cli(args), r"done [1-9]", regex=True)
+    assert r.code == 130 and "run the same command again to continue" in r.err, (r.code, r.err[-2000:])
     # within a second: the local worker is killed, not waited for (a graceful shutdown took about 5 s)
-    assert stopped_after < 1.0, f"the campaign exited {stopped_after:.2f} s after Ctrl-C"
+    assert r.took < 1.0, f"the campaign exited {r.took:.2f} s after Ctrl-C"
     res = json.loads((tmp_path / "o" / "results.json").read_text())
     assert res["interrupted"] is True and 1 <= res["runs_done"] < 16
     kept = res["runs_done"]
-    r = subprocess.run(cmd, capture_output=True, text=True, timeout=300)
+    r = subprocess.run([sys.executable, "-m", "freefloat.cli", *args], capture_output=True, text=True, timeout=300)
     assert r.returncode == 0, r.stderr[-2000:]
     res = json.loads((tmp_path / "o" / "results.json").read_text())
     assert res["runs_done"] == 16 and res["runs_new"] == 16 - kept and len(_rows(tmp_path / "o")) == 16

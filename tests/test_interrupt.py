@@ -5,8 +5,6 @@ running `freefloat simulate ... --out DIR`, which writes the part simulated so f
 import json
 import os
 import signal
-import subprocess
-import sys
 import threading
 import time
 
@@ -14,6 +12,8 @@ import numpy as np
 import pytest
 
 import freefloat as ff
+
+from _helpers import sigint_when, start_cli
 
 #: the stop must come within this many seconds of the signal (the engine polls every 20 ms)
 STOP_WITHIN = 1.0
@@ -24,15 +24,19 @@ def robot():
     return ff.models.load("naveen_dual_arm")
 
 
-def _interrupt_after(delay: float, sent: list):
-    """SIGINT to this process after `delay` seconds, from a timer thread (Python runs the handler in the main
-    thread, which is inside the engine call); the time it was sent goes into `sent`."""
+def _interrupt_after(delay: float, sent: list, after: threading.Event | None = None):
+    """SIGINT to this process after `delay` seconds (counted from `after` when given, waited for up to 120 s), from
+    a thread (Python runs the handler in the main thread, which is inside the engine call); the time it was sent goes
+    into `sent`. Returns the thread (a `threading.Timer`: `cancel()` stops it before it fires)."""
 
     def fire():
-        sent.append(time.monotonic())
-        os.kill(os.getpid(), signal.SIGINT)
+        if after is None or after.wait(120):
+            time.sleep(0.0 if after is None else delay)
+            sent.append(time.monotonic())
+            os.kill(os.getpid(), signal.SIGINT)
 
-    t = threading.Timer(delay, fire)
+    t = threading.Timer(0.0 if after is not None else delay, fire)
+    t.daemon = True
     t.start()
     return t
 
@@ -146,66 +150,15 @@ def test_an_exception_in_a_callback_is_still_that_exception(robot):
         ff.simulate(m, m.neutral(), np.zeros(m.nv), 1.0, 1e-3, torques=torques)
 
 
-def _start_cli(args, cwd, merged=False):
-    """The CLI as a child process; `merged` sends its stdout into the stderr pipe (for commands whose progress is
-    printed on stdout)."""
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
-    return subprocess.Popen(
-        [sys.executable, "-m", "freefloat.cli", *args],
-        cwd=cwd,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT if merged else subprocess.PIPE,
-        text=True,
-        env=env,
-    )
-
-
-def _wait_for(p, marker, seconds=120):
-    """Wait until `marker` appears on the command's stderr (its progress bar: the work is under way)."""
-    buf = []
-    done = threading.Event()
-
-    def reader():
-        stream = p.stderr if p.stderr is not None else p.stdout
-        for line in iter(lambda: stream.read(1), ""):
-            buf.append(line)
-            if marker in "".join(buf[-400:]):
-                done.set()
-        done.set()
-
-    th = threading.Thread(target=reader, daemon=True)
-    th.start()
-    assert done.wait(seconds), "the simulation did not start"
-    assert p.poll() is None, "".join(buf)
-    return buf, th
-
-
-def _sigint_after(p, marker, delay):
-    """Wait (generously: a loaded machine imports slowly) until `marker` shows on the command's stderr (its work is
-    under way), wait `delay` seconds more, send SIGINT and time the exit. Returns (exit code, seconds from the
-    signal to the exit, everything the command wrote to stderr); the process is killed if it outlives this."""
-    try:
-        buf, th = _wait_for(p, marker)
-        time.sleep(delay)
-        sent = time.monotonic()
-        p.send_signal(signal.SIGINT)
-        p.wait(timeout=60)
-        took = time.monotonic() - sent
-        th.join(5)
-    finally:
-        if p.poll() is None:
-            p.kill()
-    return p.returncode, took, "".join(buf)
-
-
 def test_sigint_to_the_cli_stops_it_within_a_second_and_saves_the_partial_run(tmp_path):
     out = tmp_path / "run"
     # 1e6 s at dt = 1e-3 is 1e9 steps (hours); recording every 100 000th step keeps it within the memory check
-    p = _start_cli(
+    p = start_cli(
         ["simulate", "naveen_dual_arm", "--t-final", "1e6", "--record-every", "100000", "--out", str(out)], tmp_path
     )
     # well into the run
-    code, took, err = _sigint_after(p, "simulated", 1.0)
+    r = sigint_when(p, "simulated", 1.0)
+    code, took, err = r.code, r.took, r.err
     assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     assert "interrupted" in err and "t = " in err, err[-2000:]
@@ -292,15 +245,7 @@ def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
             del d.evaluate
 
     sent = []
-
-    def fire():
-        if first.wait(120):
-            time.sleep(0.3)
-            sent.append(time.monotonic())
-            os.kill(os.getpid(), signal.SIGINT)
-
-    th = threading.Thread(target=fire, daemon=True)
-    th.start()
+    _interrupt_after(0.3, sent, after=first)
     with pytest.raises(KeyboardInterrupt) as info:
         run()
     latency = time.monotonic() - sent[0]
@@ -326,9 +271,10 @@ def test_ctrl_c_in_the_excitation_design_keeps_the_best_design_so_far(design):
 
 def test_sigint_to_freefloat_excite_keeps_the_best_trajectory(tmp_path):
     out = tmp_path / "ex"
-    p = _start_cli(["excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--out", str(out)], tmp_path)
+    p = start_cli(["excite", "naveen_dual_arm", "--guess", "naveen_dual_arm_offset", "--out", str(out)], tmp_path)
     # the first SQP iteration is done: there is a design to keep
-    code, took, err = _sigint_after(p, "C=", 0.5)
+    r = sigint_when(p, "C=", 0.5)
+    code, took, err = r.code, r.took, r.err
     assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     res = json.loads((out / "results.json").read_text())
@@ -342,8 +288,9 @@ def test_sigint_to_freefloat_excite_keeps_the_best_trajectory(tmp_path):
 def test_sigint_to_freefloat_control_ddp_keeps_the_best_iterate_and_exits_130(tmp_path):
     out = tmp_path / "ddp"
     args = ["control", "ddp", "valverde_ch8_tracking", "--max-iter", "100000", "--out", str(out)]
-    p = _start_cli(args, tmp_path, merged=True)
-    code, took, err = _sigint_after(p, "\n    2 ", 0.3)  # iteration 2's progress line: there is an iterate to keep
+    p = start_cli(args, tmp_path, merged=True)
+    r = sigint_when(p, "\n    2 ", 0.3)  # iteration 2's progress line: there is an iterate to keep
+    code, took, err = r.code, r.took, r.err
     assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     res = json.loads((out / "results.json").read_text())
@@ -438,8 +385,9 @@ def test_sigint_to_freefloat_identify_postcapture_writes_the_partial_run(tmp_pat
     path = tmp_path / "long.yaml"
     path.write_text(yaml.safe_dump(spec))
     out = tmp_path / "pc"
-    p = _start_cli(["identify", "postcapture", str(path), "--out", str(out), "--no-sweep"], tmp_path)
-    code, took, err = _sigint_after(p, "stage", 1.0)
+    p = start_cli(["identify", "postcapture", str(path), "--out", str(out), "--no-sweep"], tmp_path)
+    r = sigint_when(p, "stage", 1.0)
+    code, took, err = r.code, r.took, r.err
     assert code == 130, (code, err[-2000:])
     assert took < STOP_WITHIN, f"exited {took:.2f} s after SIGINT"
     res = json.loads((out / "results.json").read_text())

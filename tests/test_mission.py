@@ -16,6 +16,8 @@ from freefloat import algorithms as alg
 from freefloat import mission as fm
 from freefloat.mission import phases
 
+from _helpers import sigint_when, start_cli
+
 TARGET_YAML = """
 name: free_target
 base: free
@@ -226,21 +228,10 @@ def test_mission_campaign_kind_and_report(tmp_path):
 def test_ctrl_c_keeps_the_phases_done(tmp_path):
     """SIGINT once the grasp is reported (the detumble simulation has started): exit 130, and results.json holds the
     capture phase and says where the mission stopped."""
-    import signal
-
     out = tmp_path / "m"
-    p = subprocess.Popen(
-        [sys.executable, "-m", "freefloat", "mission", "zhang2020_3d_capture_heavy", "--out", str(out)],
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    for line in p.stderr:
-        if line.startswith("capture:"):
-            break
-    p.send_signal(signal.SIGINT)
-    rest = p.stderr.read()
-    assert p.wait(timeout=60) == 130, rest
+    p = start_cli(["mission", "zhang2020_3d_capture_heavy", "--out", str(out)])
+    r = sigint_when(p, r"(^|\n)capture:", regex=True)
+    assert r.code == 130, r.err[-2000:]
     d = json.loads((out / "results.json").read_text())
     assert d["phases_done"][0] == "capture" and "berth" not in d["phases_done"]
     assert d["interrupted"].startswith("stopped after capture")

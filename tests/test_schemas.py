@@ -4,6 +4,7 @@ valid key; a block shared by several kinds is one declaration."""
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import yaml
 
@@ -133,3 +134,74 @@ def test_campaign_files_are_checked_with_lines(tmp_path):
     # a value out of range is left to its run (recorded as that run's error), not refused up front
     f.write_text("name: c\nkind: postcapture\nscenario: zhang2020_2d_medium\ngrid:\n  duration: [1.0, -1.0]\n")
     assert campaign_spec.load(f).runs_total == 2
+
+
+# -- one declaration: the schema's blocks are made from the classes that run them (issue 35) -------------------
+def test_actuator_blocks_are_the_actuator_classes():
+    """Each list of an `actuators:` block has exactly the fields of its class (freefloat.Wheel, ...), in the
+    engine's key order, with the class's defaults: the schema is made from the class, so a field exists once."""
+    import dataclasses
+
+    from freefloat.io import scenario_schemas as ss
+    from freefloat.simulation import actuators as act
+
+    for lst, cls, block in (
+        ("limits", act.JointLimit, ss.ActLimit),
+        ("wheels", act.Wheel, ss.ActWheel),
+        ("thrusters", act.Thruster, ss.ActThruster),
+        ("tanks", act.Tank, ss.ActTank),
+    ):
+        fields = {f.name: f for f in dataclasses.fields(cls)}
+        assert list(block.model_fields) == act.FIELDS[lst]["keys"], lst
+        assert set(block.model_fields) == set(fields), lst
+        for name, f in fields.items():
+            mf = block.model_fields[name]
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                assert mf.is_required(), (lst, name)
+            else:
+                want = f.default if f.default is not dataclasses.MISSING else f.default_factory()
+                assert mf.default == want, (lst, name)
+
+
+def test_a_field_added_to_the_declaration_shows_up_in_the_schema():
+    import dataclasses
+
+    from freefloat.io import schema
+    from freefloat.simulation import actuators as act
+
+    @dataclasses.dataclass
+    class Tank2(act.Tank):
+        pressure: float = schema.key(schema.Positive, 2e6)
+
+    block = schema.block_of(Tank2)
+    assert "pressure" in block.model_fields and block.model_fields["pressure"].default == 2e6
+    with pytest.raises(ValueError):
+        block.model_validate({"name": "t", "mass": 1.0, "pressure": -1.0})
+
+
+def test_environment_blocks_are_the_environment_reader_keys():
+    from freefloat import _core
+    from freefloat.io import scenario_schemas as ss
+    from freefloat.simulation import environment as env
+
+    assert list(ss.EnvCentralBody.model_fields) == list(env.CENTRAL_BODY_KEYS)
+    assert list(ss.EnvOrbit.model_fields) == list(env.ORBIT_KEYS)
+    assert list(ss.EnvDisturbance.model_fields) == list(env.DISTURBANCE_KEYS)
+    assert list(ss.EnvironmentBlock.model_fields) == list(env.TOP_KEYS)
+    cb = ss.EnvCentralBody.model_fields
+    assert {k: cb[k].default for k in cb} == env.EARTH
+    # the Earth of the one Python declaration is the engine's (μ and the radius are observable)
+    e = _core.Environment(altitude=500e3)
+    assert e.mu == env.EARTH["mu"]
+    assert np.linalg.norm(e.orbit_state[0]) == pytest.approx(env.EARTH["radius"] + 500e3, rel=1e-15)
+
+
+def test_one_registry_of_scenario_kinds():
+    """The readers (`scenario_files.KINDS`), `freefloat scenarios` and the schemas use the kinds declared with
+    `schema.register_kind`."""
+    from freefloat.io import scenario_files, schema
+
+    assert scenario_files.KINDS == schema.commands()
+    assert list(scenario_files.KINDS) == [k for k in schema.kinds() if k != "campaign"]
+    for s in scenario_files.listing():
+        assert s.kind in scenario_files.KINDS

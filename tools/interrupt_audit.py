@@ -13,16 +13,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import signal
 import subprocess
 import sys
 import tempfile
-import threading
 import time
 from pathlib import Path
 
 import yaml
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+from _helpers import sigint_when, start_cli  # noqa: E402  (the tests' Ctrl-C helper, one copy)
 
 LIMIT = 1.0
 
@@ -121,63 +121,26 @@ def commands(tmp: Path) -> list[tuple[str, list[str]]]:
 
 
 def audit_one(name: str, argv: list[str], cwd: Path, delay: float, fallback: float) -> dict:
-    env = dict(os.environ, PYTHONUNBUFFERED="1")
     t_start = time.monotonic()
-    p = subprocess.Popen(
-        [sys.executable, "-m", "freefloat.cli", *argv],
-        cwd=cwd,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-        env=env,
-        # a command started from a background job inherits an ignored SIGINT (and Python then keeps it
-        # ignored): give it the default disposition, as an interactive shell does
-        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-    )
-    err: list[str] = []
-    started = threading.Event()
-
-    def read(stream, sink, mark):
-        for ch in iter(lambda: stream.read(1), ""):
-            sink.append(ch)
-            if mark:
-                started.set()
-
-    out: list[str] = []
-    te = threading.Thread(target=read, args=(p.stderr, err, True), daemon=True)
-    to = threading.Thread(target=read, args=(p.stdout, out, False), daemon=True)
-    te.start()
-    to.start()
-    started.wait(fallback)
-    time.sleep(delay)
-    if p.poll() is not None:
-        te.join(2)
+    # the first progress output on stderr, or `fallback` seconds, then `delay` more
+    r = sigint_when(start_cli(argv, cwd), None, delay, wait=fallback, exit_within=30, strict=False)
+    if r.took is None:
         return {
             "command": name,
-            "result": f"ended before the signal (exit {p.returncode})",
+            "result": f"ended before the signal (exit {r.code})",
             "ok": None,
-            "stderr": "".join(err)[-800:],
+            "stderr": r.err[-800:],
         }
-    sent = time.monotonic()
-    p.send_signal(signal.SIGINT)
-    try:
-        p.wait(timeout=30)
-        took = time.monotonic() - sent
-    except subprocess.TimeoutExpired:
-        p.kill()
-        p.wait()
-        took = float("inf")
-    te.join(2)
-    to.join(2)
+    took, sent = r.took, t_start + r.sent_after
     outs = sorted(
         str(f.relative_to(cwd)) for d in cwd.glob("out_*") for f in (d.rglob("*") if d.is_dir() else [d]) if f.is_file()
     )
-    tail = [ln for ln in "".join(err).replace("\r", "\n").splitlines() if ln.strip()][-3:]
+    tail = [ln for ln in r.err.replace("\r", "\n").splitlines() if ln.strip()][-3:]
     return {
         "command": name,
         "signal_after_s": round(sent - t_start, 2),
         "exit_after_signal_s": round(took, 3),
-        "exit_code": p.returncode,
+        "exit_code": r.code,
         "ok": took < LIMIT,
         "kept": outs,
         "last_lines": tail,

@@ -12,13 +12,14 @@ parameters, excitation design, least squares, consistent parameters, validation,
 `postcapture` (Zhang, Yue, Yuan 2020), `dq` (Valverde 2018's dual quaternions and reaction wrenches), `control`,
 `viz` (plotting helpers) and `cli` (the `freefloat` command). Every number is computed by the Rust engine."""
 
+import sys as _sys
+
 from . import _cpu
 
 _cpu.check()  # before anything loads the engine: a clear ImportError on too old a processor, not SIGILL
 
-from . import constants, control, derivatives, dq, identification, io, models, trajectories, viz
+from . import constants, control, derivatives, dq, identification, io, models, simulation, trajectories, viz
 from ._core import InputError, Interrupted, ModelError, NumericalError
-from .actuators import Actuators, JointLimit, Tank, Thruster, Wheel
 from .algorithms import (
     aba,
     base_twist_for_momentum,
@@ -43,10 +44,8 @@ from .algorithms import (
     rnea,
     skew,
 )
-from .batch_simulation import Trajectories, simulate_many, torque_table
 from .derivatives import aba_derivatives, rnea_derivatives, step_derivatives
 from .dq import reactions
-from .environment import Environment, load_environment
 from .identification import (
     IdentificationResult,
     MinimalParameters,
@@ -60,9 +59,37 @@ from .identification import (
 )
 from .io import Telemetry, telemetry
 from .model import Model
-from .simulation import Trajectory, simulate
-from .simulation_scenario import load as load_simulation_scenario
-from .simulation_scenario import run as run_simulation_scenario
+from .simulation import (
+    Actuators,
+    Environment,
+    JointLimit,
+    Tank,
+    Thruster,
+    Trajectories,
+    Trajectory,
+    Wheel,
+    actuators,
+    environment,
+    load_environment,
+    simulate,
+    simulate_many,
+    torque_table,
+)
+from .simulation import scenario as simulation_scenario
+from .simulation.scenario import load as load_simulation_scenario
+from .simulation.scenario import run as run_simulation_scenario
+
+# The simulation stage's modules moved into `freefloat/simulation/`; their former paths still import them
+# (`from freefloat.actuators import add_wheels`, `freefloat.environment.environment_from_dict`, ...).
+batch_simulation = simulation.batch
+for _old, _new in (
+    ("actuators", actuators),
+    ("environment", environment),
+    ("batch_simulation", batch_simulation),
+    ("simulation_scenario", simulation_scenario),
+):
+    _sys.modules[f"{__name__}.{_old}"] = _new
+del _old, _new, _sys
 
 __version__ = "0.1.0"
 

@@ -70,9 +70,11 @@ class Model:
         hinges -> universal. Tendons, equality constraints, contact-enabled geoms, armature and joint types
         freefloat lacks are refused with the element's name (and line when it has one). Tags written by
         `to_mjcf` come back. `path` may also be MJCF text."""
-        from .io.mujoco import model_from_mjcf
+        import yaml
 
-        return model_from_mjcf(path, name)
+        from .io.mjcf import mjcf_spec
+
+        return cls.from_yaml_string(yaml.safe_dump(mjcf_spec(path, name), sort_keys=False))
 
     def to_mjcf(self, path=None, gravity: bool = False) -> str:
         """Write the model as MuJoCo MJCF (to `path` if given) and return the text: a free joint on the base,

@@ -18,11 +18,11 @@ import numpy as np
 import yaml
 
 from .._core import InputError
+from .kind import Kind, json_roundtrip, leaf_paths
 
 
 def _load(ref, kind: str) -> dict:
     from ..io import scenario_files
-    from .registry import _json_roundtrip
 
     if isinstance(ref, dict):
         d = copy.deepcopy(ref)
@@ -30,7 +30,7 @@ def _load(ref, kind: str) -> dict:
         d.setdefault("name", "inline")
         if d["kind"] != kind:
             raise InputError(f"scenario mapping: kind '{d['kind']}' given to a campaign of kind '{kind}'")
-        return _json_roundtrip(d)
+        return json_roundtrip(d)
     d, source = scenario_files.read(ref, kind=kind)
     src = Path(source)
     for key in ("model", "robot", "servicer"):
@@ -38,13 +38,11 @@ def _load(ref, kind: str) -> dict:
         if isinstance(p, str) and Path(p).suffix in (".yaml", ".yml", ".urdf", ".xml") and src.is_file():
             if not Path(p).is_absolute():
                 d[key] = str((src.parent / p).resolve())
-    return _json_roundtrip(d)
+    return json_roundtrip(d)
 
 
 def _normalize(d: dict) -> dict:
-    from .registry import _json_roundtrip
-
-    d = _json_roundtrip(d)
+    d = json_roundtrip(d)
     d.pop("description", None)  # not an input of a run
     return d
 
@@ -155,11 +153,12 @@ def run_mission(scenario: dict, seed: int) -> dict:
     return out
 
 
-def register_all() -> None:
-    from .registry import Kind, leaf_paths, register
+def kinds() -> list[Kind]:
+    """The kinds of this module, in the order the registry lists them."""
+    out = []
 
     def kind(name, description, run, headline, extra=(), campaign_keys=()):
-        register(
+        out.append(
             Kind(
                 name=name,
                 description=description,
@@ -209,3 +208,4 @@ def register_all() -> None:
             "berth.identified.position_error_final_m",
         ),
     )
+    return out

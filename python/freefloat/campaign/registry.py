@@ -21,38 +21,13 @@ from __future__ import annotations
 import copy
 import difflib
 import functools
-import json
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._core import InputError
-from .spec import leaf_paths
-
-
-def _identity(d: dict) -> dict:
-    return d
-
-
-@dataclass(frozen=True)
-class Kind:
-    """One scenario kind: load its scenario, list its parameter paths, run it, name its summary numbers."""
-
-    name: str
-    description: str
-    load: Callable[[object], dict]
-    parameters: Callable[[dict], list]
-    run: Callable[[dict, int], dict]
-    #: the canonical JSON-able form of a scenario mapping (what the run key hashes)
-    normalize: Callable[[dict], dict] = _identity
-    #: summary names a report shows first
-    headline: tuple = field(default_factory=tuple)
-    #: top-level sections a campaign may add that the kind's `run` consumes itself (not keys of its scenario
-    #: files, so the scenario schema does not check them; `run` does)
-    campaign_keys: tuple = field(default_factory=tuple)
-
+from . import file_kinds
+from .kind import Kind, json_roundtrip, leaf_paths
 
 KINDS: dict[str, Kind] = {}
 
@@ -73,13 +48,6 @@ def get(name: str, where: str = "kind") -> Kind:
         + (f" (did you mean {' or '.join(close)}?)" if close else "")
         + f"; campaign kinds: {', '.join(KINDS)}"
     )
-
-
-def _json_roundtrip(d: dict) -> dict:
-    """Plain JSON types (tuples -> lists, numpy scalars -> numbers), so the run key is stable."""
-    from .spec import _canonical
-
-    return json.loads(_canonical(d))
 
 
 # -- post-capture identification (Zhang, Yue, Yuan 2020) ---------------------------------------------------
@@ -109,9 +77,9 @@ def _pc_load(ref) -> dict:
     if isinstance(ref, dict):
         d = copy.deepcopy(ref)
         d.setdefault("name", "inline")
-        return _json_roundtrip(d)
+        return json_roundtrip(d)
     d, _ = scenario_files.read(ref, kind="postcapture")
-    return _json_roundtrip(d)
+    return json_roundtrip(d)
 
 
 def _pc_parameters(base: dict) -> list:
@@ -120,7 +88,7 @@ def _pc_parameters(base: dict) -> list:
 
 
 def _pc_normalize(d: dict) -> dict:
-    d = _json_roundtrip(d)
+    d = json_roundtrip(d)
     # not inputs of one run: the scenario's own sweep list, the paper's printed values, the description (editing
     # them must not make finished runs look new)
     for k in ("sweep", "paper_sweep", "paper", "description"):
@@ -132,10 +100,10 @@ def run_postcapture(scenario: dict, seed: int) -> dict:
     """One post-capture identification (simulate, measure, four estimators) -> final relative errors, estimates
     and transit times of every parameter for each method/solver."""
     from ..postcapture import pipeline
-    from ..postcapture.scenario import _parse
+    from ..postcapture.scenario import parse_scenario
 
     t0 = time.perf_counter()
-    sc = _parse(copy.deepcopy(scenario), f"campaign run of '{scenario.get('name', '?')}'")
+    sc = parse_scenario(copy.deepcopy(scenario), f"campaign run of '{scenario.get('name', '?')}'")
     res = pipeline.run(sc, seed=seed)
     out = {"wall_s": time.perf_counter() - t0, "simulation_s": float(res.timings.get("simulation", np.nan))}
     for (method, solver), (_t, h) in res.histories.items():
@@ -188,7 +156,7 @@ def _min_load(ref) -> dict:
 
     models.load(d["model"])  # InputError naming the built-in robots when unknown
     load_trajectory(d["trajectory"])
-    return _json_roundtrip(d)
+    return json_roundtrip(d)
 
 
 def _min_parameters(base: dict) -> list:
@@ -276,7 +244,7 @@ def _scl_load(ref) -> dict:
     if unknown:
         raise InputError(f"sensor_classes scenario: unknown key '{unknown[0]}'; keys: {', '.join(d)}")
     d.update({k: v for k, v in ref.items() if k != "name"})
-    return _json_roundtrip(d)
+    return json_roundtrip(d)
 
 
 def run_sensor_classes(scenario: dict, seed: int) -> dict:
@@ -311,7 +279,7 @@ def _builtin_kinds() -> None:
             load=_min_load,
             parameters=_min_parameters,
             run=run_minimal,
-            normalize=_json_roundtrip,
+            normalize=json_roundtrip,
             headline=("ls.median_rel_error_pct", "eiv.median_rel_error_pct", "ls.max_rel_error_pct"),
         )
     )
@@ -324,13 +292,12 @@ def _builtin_kinds() -> None:
             load=_scl_load,
             parameters=lambda base: ["estimator", "sensor_class", "horizons"],
             run=run_sensor_classes,
-            normalize=_json_roundtrip,
+            normalize=json_roundtrip,
             headline=("zhang_momentum.inertia.100", "zhang_force.inertia.100", "naveen_eiv.inertia.100"),
         )
     )
-    from .file_kinds import register_all
-
-    register_all()
+    for kind in file_kinds.kinds():
+        register(kind)
 
 
 _builtin_kinds()

@@ -26,7 +26,6 @@ import copy
 import difflib
 import hashlib
 import itertools
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,6 +33,9 @@ import numpy as np
 import yaml
 
 from .._core import InputError
+from . import registry
+from .kind import canonical as _canonical
+from .kind import leaf_paths  # noqa: F401  (re-exported: `freefloat.campaign.spec.leaf_paths`)
 
 #: distributions a Monte Carlo parameter can be drawn from, with their required keys
 DISTRIBUTIONS = {
@@ -93,8 +95,6 @@ class CampaignSpec:
     def fingerprint(self) -> str:
         """A hash of what the campaign runs (kind, base scenario, overrides, grid, draws), not its description:
         two specs with the same fingerprint produce the same runs."""
-        from . import registry
-
         what = {
             "kind": self.kind,
             "base": registry.get(self.kind).normalize(copy.deepcopy(self.base)),
@@ -107,18 +107,6 @@ class CampaignSpec:
     def runs(self, limit: int | None = None) -> list[Run]:
         """The campaign's runs in order (grid points outer, Monte Carlo draws inner); the first `limit` only."""
         return expand(self, limit)
-
-
-def _canonical(obj) -> str:
-    return json.dumps(obj, sort_keys=True, separators=(",", ":"), default=_jsonable)
-
-
-def _jsonable(o):
-    if isinstance(o, np.generic):
-        return o.item()
-    if isinstance(o, np.ndarray):
-        return o.tolist()
-    raise TypeError(f"not JSON serialisable: {type(o).__name__}")
 
 
 def _hash(obj) -> str:
@@ -165,22 +153,6 @@ def set_path(d: dict, path: str, value) -> None:
         cur[last] = value
 
 
-def leaf_paths(d, prefix: str = "") -> list[str]:
-    """Every dotted path of a nested mapping: mappings and lists (themselves and their items) and scalars."""
-    out = []
-    if isinstance(d, dict):
-        for k, v in d.items():
-            p = f"{prefix}{k}"
-            out.append(p)
-            out += leaf_paths(v, p + ".")
-    elif isinstance(d, list):
-        for i, v in enumerate(d):
-            p = f"{prefix}{i}"
-            out.append(p)
-            out += leaf_paths(v, p + ".")
-    return out
-
-
 def check_path(path: str, valid: list[str], kind: str, where: str) -> None:
     """InputError naming `path` and the closest valid names when it is not one of `valid`."""
     _split(path)
@@ -197,8 +169,6 @@ def check_path(path: str, valid: list[str], kind: str, where: str) -> None:
 # -- reading ----------------------------------------------------------------------------------------------
 def parse(d: dict, source: str, base_dir: Path | None = None) -> CampaignSpec:
     """A CampaignSpec from a parsed YAML mapping; InputError naming the key at fault."""
-    from . import registry
-
     if not isinstance(d, dict):
         raise InputError(f"{source}: a campaign spec must be a YAML mapping, got {type(d).__name__}")
     unknown = [k for k in d if k not in SPEC_KEYS]
@@ -372,8 +342,6 @@ def _draw(dist: dict, rng: np.random.Generator):
 def expand(spec: CampaignSpec, limit: int | None = None) -> list[Run]:
     """The runs of `spec` in order; the run seeds and draws derive from the master seed and the draw index, so a
     run's inputs do not depend on `limit` or on which other runs exist."""
-    from . import registry
-
     kind = registry.get(spec.kind)
     base = copy.deepcopy(spec.base)
     for p, v in spec.fixed.items():

@@ -11,8 +11,8 @@ import click
 import numpy as np
 
 from .._core import InputError, Interrupted
-from ..environment import load_environment
 from ..simulation import simulate
+from ..simulation.environment import load_environment
 from ._common import load_model, out_paths, parse_vector, print_summary, summarize, torque_options, write_outputs
 
 
@@ -215,7 +215,7 @@ _SCENARIO_KEYS = {
 
 
 def _run_scenario(ctx, spec: str, out) -> None:
-    from ..simulation_scenario import load, run
+    from ..simulation.scenario import load, run
 
     for opt, key in _SCENARIO_KEYS.items():
         if ctx.get_parameter_source(opt) not in (None, click.core.ParameterSource.DEFAULT):
@@ -260,7 +260,7 @@ def read_actuators(path):
     """The `actuators:` block of a YAML file (or the whole file if it is the block itself) as an Actuators."""
     import yaml
 
-    from ..actuators import Actuators
+    from ..simulation.actuators import Actuators
 
     p = Path(path)
     if not p.exists():

@@ -266,7 +266,7 @@ def plot(runs: dict, problem: Problem, out, prefix: str = "closed_loop_") -> lis
     """Position and angle error of the end effector against time for each run (open loop, policy, MPC)."""
     from pathlib import Path
 
-    from ..viz._backend import pyplot
+    from ..viz import pyplot
 
     plt = pyplot()
     out = Path(out)

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import _core
-from ..viz._backend import pyplot
+from ..viz import pyplot
 from .ddp import Problem, dq_to_pose, pose_errors
 
 

@@ -16,6 +16,9 @@ import numpy as np
 
 from .. import _core
 
+#: the seven parameters `v(M)` of one body, in the order of Valverde 2018 §4.1
+PARAM_NAMES = ("I11", "I12", "I13", "I22", "I23", "I33", "m")
+
 
 def inertia_params(mass: float, inertia) -> np.ndarray:
     """`v(M) = [I11, I12, I13, I22, I23, I33, m]` of a body of `mass` [kg] and 3×3 `inertia` about its CoM [kg m²]."""

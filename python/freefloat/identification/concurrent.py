@@ -27,6 +27,7 @@ import numpy as np
 
 from .. import _core
 from .._core import InputError
+from ..dq.regressor import PARAM_NAMES
 
 __all__ = [
     "PARAM_NAMES",
@@ -41,8 +42,6 @@ __all__ = [
     "time_within",
 ]
 
-#: the seven parameters of one body, in the order of Valverde 2018 §4.1
-PARAM_NAMES = ("I11", "I12", "I13", "I22", "I23", "I33", "m")
 #: the SVD gains: the thesis' (9.27) (the default) and the truncated one (9.27') that accelerates a weak direction only
 #: when the estimate's residual along it is at least `kappa` noise standard deviations
 GAINS = ("thesis", "truncated")

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..dq.regressor import PARAM_NAMES
 from ..viz import pyplot
-from .concurrent import PARAM_NAMES
 
 __all__ = ["comparison_figure", "noise_figure", "ns_figures", "run_figures"]
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
 #: trajectory file types `--out` accepts; any other suffix is refused (not taken for a directory name)
 TRAJECTORY_SUFFIXES = (".parquet", ".pq", ".csv")
 
@@ -79,3 +81,13 @@ def write_run(traj, summary: dict, out, stem: str, title: str) -> list[Path]:
     conservation(traj, png, title)
     js.write_text(json.dumps(summary, indent=2))
     return [pq, js, png]
+
+
+def json_default(o):
+    """`json.dumps(..., default=json_default)`: numpy scalars and arrays as plain numbers and lists (every
+    results.json, the campaign's run keys)."""
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    raise TypeError(f"not JSON serialisable: {type(o).__name__}")

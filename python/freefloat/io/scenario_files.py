@@ -21,15 +21,8 @@ import yaml
 from .._core import InputError
 from . import data, scenario_schemas, schema  # noqa: F401  (scenario_schemas declares the kinds)
 
-#: kind -> the command that runs scenarios of that kind
-KINDS = {
-    "postcapture": "freefloat identify postcapture",
-    "control_adaptive": "freefloat control adaptive",
-    "identify_cl": "freefloat identify cl",
-    "control_ddp": "freefloat control ddp",
-    "simulate": "freefloat simulate",
-    "mission": "freefloat mission",
-}
+#: kind -> the command that runs scenarios of that kind (declared with each kind's schema: `scenario_schemas.py`)
+KINDS = schema.commands()
 DEFAULT_KIND = "postcapture"
 
 

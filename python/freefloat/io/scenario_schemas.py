@@ -9,11 +9,12 @@ block shared by several kinds with `schema.register_block`."""
 from __future__ import annotations
 
 import math
-from typing import Annotated, Any
+from typing import Annotated
 
-from pydantic import BeforeValidator, Field, PlainValidator, model_validator
+from pydantic import BeforeValidator, Field, create_model, model_validator
 
-from ..actuators import WHEEL_DEFAULTS
+from ..simulation import environment as env
+from ..simulation.actuators import BLOCKS as ACTUATOR_BLOCKS
 from .schema import (
     _TYPES_ONLY,
     Anything,
@@ -32,14 +33,6 @@ from .schema import (
     register_block,
     register_kind,
 )
-
-
-def _tank_ref(x):
-    # a thruster's tank: its name or its index in the tanks list
-    if isinstance(x, bool) or not isinstance(x, (str, int)) or (isinstance(x, int) and x < 0):
-        raise _Bad(f"expected a tank name or index, got {x!r}")
-    return x
-
 
 Numbers = numbers()
 NumberOrNumbers = numbers(scalar_ok=True)
@@ -488,12 +481,12 @@ class Campaign(Block):
     paper: Anything = None
 
 
-register_kind("postcapture", Postcapture)
-register_kind("control_adaptive", ControlAdaptive)
-register_kind("identify_cl", IdentifyCl)
-register_kind("control_ddp", ControlDdp)
-register_kind("simulate", Simulate)
-register_kind("mission", Mission)
+register_kind("postcapture", Postcapture, command="freefloat identify postcapture")
+register_kind("control_adaptive", ControlAdaptive, command="freefloat control adaptive")
+register_kind("identify_cl", IdentifyCl, command="freefloat identify cl")
+register_kind("control_ddp", ControlDdp, command="freefloat control ddp")
+register_kind("simulate", Simulate, command="freefloat simulate")
+register_kind("mission", Mission, command="freefloat mission")
 register_kind("campaign", Campaign)
 
 
@@ -511,50 +504,12 @@ def _norm(x) -> float:
     return math.sqrt(sum(float(c) ** 2 for c in x))
 
 
-# the wheel defaults are the engine's (`Wheel::new`, read through the binding): one copy
-_WD = WHEEL_DEFAULTS
-
-
-class ActLimit(Block):
-    joint: Text
-    effort: Positive | None = None
-    velocity: Positive | None = None
-
-
-class ActWheel(Block):
-    joint: Text
-    max_torque: Positive | None = _WD["max_torque"]
-    max_speed: Positive | None = _WD["max_speed"]
-    max_power: Positive | None = _WD["max_power"]
-    coulomb: NonNegative = _WD["coulomb"]
-    static_friction: NonNegative = _WD["static_friction"]
-    stribeck_speed: Positive | None = _WD["stribeck_speed"]
-    viscous: NonNegative = _WD["viscous"]
-    limit_cycle_speed: Positive = _WD["limit_cycle_speed"]
-    static_imbalance: NonNegative = _WD["static_imbalance"]
-    dynamic_imbalance: NonNegative = _WD["dynamic_imbalance"]
-
-
-class ActThruster(Block):
-    name: Text | None = None
-    body: Text | None = None
-    position: Vec3 = None
-    direction: Vec3
-    max_thrust: Positive
-    min_on_time: NonNegative = 0.0
-    ramp_on: NonNegative = 0.0
-    ramp_off: NonNegative = 0.0
-    isp: Positive | None = None
-    tank: Annotated[Any, PlainValidator(_tank_ref)] = None
-    firings: list[numbers(2)] = []
-
-
-class ActTank(Block):
-    name: Text
-    body: Text | None = None
-    position: Vec3 = None
-    mass: Positive
-    radius: NonNegative = 0.0
+# the keys of each actuator, their types, ranges and defaults: declared once, by the classes that run them
+# (`freefloat.Wheel`, ...; the engine's key order and wheel defaults)
+ActLimit = ACTUATOR_BLOCKS["limits"]
+ActWheel = ACTUATOR_BLOCKS["wheels"]
+ActThruster = ACTUATOR_BLOCKS["thrusters"]
+ActTank = ACTUATOR_BLOCKS["tanks"]
 
 
 class ActuatorsBlock(Block):
@@ -619,33 +574,11 @@ class ActuatorsBlock(Block):
         return self
 
 
-class EnvCentralBody(Block):
-    mu: Positive = 3.986004418e14
-    radius: Positive = 6378137.0
-    j2: Number = 1.0826267e-3
-
-
-class EnvOrbit(Block):
-    altitude: Positive | None = None
-    semi_major_axis: Positive | None = None
-    eccentricity: number(lo=0.0, hi=1.0, hi_open=True) = None
-    inclination_deg: Number = None
-    raan_deg: Number = None
-    arg_periapsis_deg: Number = None
-    true_anomaly_deg: Number = None
-    inclination: Number = None
-    raan: Number = None
-    arg_periapsis: Number = None
-    true_anomaly: Number = None
-    position: Vec3 = None
-    velocity: Vec3 = None
-
-
-class EnvDisturbance(Block):
-    force: Vec3 = None
-    torque: Vec3 = None
-    axes: literal("inertial", "body") = "inertial"
-    body: integer(lo=0) = 0
+# the keys of the `environment:` block, their types and defaults (the Earth's constants): declared once, by the
+# module that reads the block (`freefloat.simulation.environment`)
+EnvCentralBody = create_model("EnvCentralBody", __base__=Block, **env.CENTRAL_BODY_KEYS)
+EnvOrbit = create_model("EnvOrbit", __base__=Block, **env.ORBIT_KEYS)
+EnvDisturbance = create_model("EnvDisturbance", __base__=Block, **env.DISTURBANCE_KEYS)
 
 
 class EnvironmentBlock(Block):

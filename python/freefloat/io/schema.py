@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import dataclasses
 import difflib
 import math
 import re
@@ -40,8 +41,11 @@ from .._core import InputError
 
 __all__ = [
     "Block",
+    "block_of",
     "check",
+    "commands",
     "fields_of",
+    "key",
     "kinds",
     "register_block",
     "register_kind",
@@ -187,15 +191,60 @@ NonNegative = number(lo=0)
 Bool = Annotated[bool, Field(strict=True)]
 Anything = Any  # free-form blocks (the paper's printed values, notes): not checked
 
+
+def _name_or_index(x):
+    if isinstance(x, bool) or not isinstance(x, (str, int)) or (isinstance(x, int) and x < 0):
+        raise _Bad(f"expected a tank name or index, got {x!r}")
+    return x
+
+
+#: a reference to an item of a list by its name or its index (a thruster's tank)
+TankRef = Annotated[Any, PlainValidator(_name_or_index)]
+
+
+# -- blocks declared by the objects that run them ------------------------------------------------------------
+def key(schema_type, default=dataclasses.MISSING, *, default_factory=dataclasses.MISSING):
+    """A dataclass field that carries its schema type: the class that runs a block (an actuator, say) declares each
+    key once, with its default, and `block_of` makes the schema block from it."""
+    return dataclasses.field(default=default, default_factory=default_factory, metadata={"schema": schema_type})
+
+
+def block_of(cls, order=None, name: str | None = None) -> type[Block]:
+    """The schema block of a dataclass whose fields are declared with `key`: the same keys, defaults and
+    required keys, with their schema types, in `order` (the keys as the engine lists them; default: the class's)."""
+    fs = {f.name: f for f in dataclasses.fields(cls)}
+    names = list(order) if order is not None else list(fs)
+    if sorted(names) != sorted(fs):
+        raise TypeError(f"{cls.__name__}: schema order {names} is not its fields {list(fs)}")
+    spec = {}
+    for n in names:
+        f = fs[n]
+        if "schema" not in f.metadata:
+            raise TypeError(f"{cls.__name__}.{n}: declare it with schema.key(TYPE, default) to derive its schema")
+        if f.default is not dataclasses.MISSING:
+            default = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            default = ...
+        spec[n] = (f.metadata["schema"], default)
+    return create_model(name or f"{cls.__name__}Block", __base__=Block, **spec)
+
+
 # -- registry ------------------------------------------------------------------------------------------------
 _KINDS: dict[str, type[BaseModel]] = {}
+_COMMANDS: dict[str, str] = {}
 _BLOCKS: dict[str, tuple[type[BaseModel], tuple[str, ...]]] = {}
 _BUILT: dict[str, type[BaseModel]] = {}
 
 
-def register_kind(kind: str, model: type[BaseModel]) -> None:
-    """Declare the schema of a scenario kind (or of the campaign spec, kind 'campaign')."""
+def register_kind(kind: str, model: type[BaseModel], command: str | None = None) -> None:
+    """Declare a scenario kind: its schema and the command that runs its files (the one registry of scenario kinds:
+    the readers, `freefloat scenarios` and the schemas use it). The campaign spec is kind 'campaign', without a
+    command (it is not a scenario)."""
     _KINDS[kind] = model
+    if command is not None:
+        _COMMANDS[kind] = command
     _BUILT.clear()
 
 
@@ -216,6 +265,11 @@ def refuse_block(name: str, kind: str, why: str) -> None:
 
 def kinds() -> list[str]:
     return list(_KINDS)
+
+
+def commands() -> dict[str, str]:
+    """Scenario kind -> the command that runs its files, in the order the kinds were declared."""
+    return dict(_COMMANDS)
 
 
 def _model(kind: str) -> type[BaseModel]:

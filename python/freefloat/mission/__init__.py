@@ -186,7 +186,7 @@ def write(res: dict, out_dir) -> list:
     import json
     from pathlib import Path
 
-    from ..campaign.spec import _jsonable
+    from ..io.results import json_default
     from . import plots
 
     out = Path(out_dir)
@@ -195,7 +195,7 @@ def write(res: dict, out_dir) -> list:
     complete = "berth" in res.get("phases_done", [])  # an interrupted run keeps its numbers, not half a figure
     if complete:
         data["series"] = series(res)
-    (out / "results.json").write_text(json.dumps(data, indent=1, default=_jsonable), encoding="utf-8")
+    (out / "results.json").write_text(json.dumps(data, indent=1, default=json_default), encoding="utf-8")
     (out / "table.txt").write_text(table(res), encoding="utf-8")
     files = [out / "results.json", out / "table.txt"]
     if complete:

@@ -121,10 +121,10 @@ def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
     momentum rows balance angular momentum about the moving base point whatever the named scenario says (the
     paper-reproduction scenarios keep the paper's inertial origin; a mission measures a drifting stack with
     sensors, where only the base point holds up: docs/postcapture.md), as the adaptive berth's rows do."""
-    from ..postcapture.scenario import scenario_blocks
+    from ..io.scenario_blocks import scenario_blocks
 
     if isinstance(mission.detumble, dict):  # the post-capture blocks given inline, for this servicer
-        from ..postcapture.scenario import _parse
+        from ..postcapture.scenario import parse_scenario
 
         b = mission.detumble
         nj = len(mission.joints)
@@ -140,7 +140,7 @@ def detumble_scenario(mission: Mission, q0, v0, truth=None) -> Scenario:
             "identification": b["identification"],
         }
         try:
-            sc = _parse(d, f"{mission.source}: key 'detumble'", model=truth)
+            sc = parse_scenario(d, f"{mission.source}: key 'detumble'", model=truth)
         except KeyError as e:
             raise InputError(f"{mission.source}: key 'detumble': missing key {e}") from None
     else:

@@ -8,7 +8,7 @@ import numpy as np
 def timeline(res: dict, path):
     """Three panels on one time axis: the base rate through detumble and berth, the target's estimate over truth
     during identification (with the handover), and the target's pose error in the berth for each model."""
-    from ..viz._backend import pyplot
+    from ..viz import pyplot
 
     plt = pyplot()
     ident = res["traces"]["identify"]

@@ -13,6 +13,13 @@ from .scenario import Scenario
 
 METHODS = ("momentum", "force")
 SOLVERS = ("modified_rls", "standard_rls")
+#: the solvers' names in tables and figures
+SOLVER_TITLES = {"modified_rls": "paper (modified RLS)", "standard_rls": "standard params (RLS)"}
+
+
+def is_product(name: str) -> bool:
+    """Whether a parameter name is a product of inertia (Ixy, Ixz, Iyz of any body)."""
+    return name[-2:] in ("xy", "xz", "yz") and name[0] == "I"
 
 
 def parameter_names(planar: bool) -> list[str]:

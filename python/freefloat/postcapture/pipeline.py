@@ -11,6 +11,7 @@ import numpy as np
 from .. import models
 from .._core import Interrupted
 from . import equations as eq
+from . import spacecraft
 from .estimators import (
     METHODS,
     SOLVERS,
@@ -137,8 +138,6 @@ def _interrupted(res: PostcaptureResult) -> Interrupted:
 def _spacecraft_extras(m, sim: dict, sc: Scenario, res: PostcaptureResult) -> None:
     """The base's truth over time, the propellant used, the balance checks and the tracking summary of a run
     with actuators/sensors (results.json)."""
-    from . import spacecraft
-
     planar = m.joint_types[0] == "planar"
     res.truth_history = spacecraft.truth_history(m, sim, planar, target_index(m))
     if sc.actuators:
@@ -205,3 +204,54 @@ def noise_study(sc: Scenario, scales=(0.0, 0.01, 0.1, 1.0), seeds=(0, 1, 2)) -> 
             {"scale": scale, "noise": s.noise, "median_error": {k: np.median(v, 0).tolist() for k, v in errs.items()}}
         )
     return out
+
+
+def noise_forgetting_study(
+    sc: Scenario, gyro_noise=(1e-6, 1e-5, 1e-4), forgetting=(0.98, 0.99, 0.995, 1.0), progress=None
+):
+    """The tracking error of the force-based standard RLS against the gyro's noise density and the forgetting
+    factor, from ONE simulation of the scenario (the sensors are re-run per noise level, the estimator per λ).
+    Returns rows {gyro_noise, forgetting, memory_s, rms (second half, per base/target parameter), predicted lag}.
+
+        import freefloat.postcapture as pc
+        from freefloat.postcapture.pipeline import noise_forgetting_study
+        rows = noise_forgetting_study(pc.load_scenario("zhang2020_3d_thrusters"))
+    """
+    if sc.sensors is None or not any(
+        (s.get("type") if isinstance(s, dict) else getattr(s, "TYPE", "")) == "gyro" for s in sc.sensors.sensors
+    ):
+        raise ValueError("the scenario needs a gyro in its sensors: block")
+    m = models.load(sc.model)
+    sim = simulate(sc, m)
+    th = spacecraft.truth_history(m, sim, m.joint_types[0] == "planar", target_index(m))
+    rows = []
+    for n in gyro_noise:
+        sens = dataclasses.replace(
+            sc.sensors, sensors=[dict(s) if isinstance(s, dict) else s.to_dict() for s in sc.sensors.sensors]
+        )
+        for s in sens.sensors:
+            if s["type"] == "gyro":
+                s.pop("noise_per_sample", None)
+                s["noise_density"] = float(n)
+        for lam in forgetting:
+            s2 = dataclasses.replace(sc, sensors=sens, forgetting=float(lam))
+            res = identify(m, measure(m, sim, s2), s2, methods=("force",))
+            res.truth_history = th
+            tr = spacecraft.tracking(res, s2)["estimators"]["force/standard_rls"]
+            t, h = res.histories[("force", "standard_rls")]
+            truth = res.truth_at(t)
+            half = t >= t[0] + 0.5 * (t[-1] - t[0])
+            rel = np.abs(h - truth) / np.where(np.abs(truth) > 0, np.abs(truth), 1.0)
+            rms = np.sqrt(np.mean(rel[half] ** 2, 0))
+            rows.append(
+                {
+                    "gyro_noise": float(n),
+                    "forgetting": float(lam),
+                    "memory_s": sc.sample_period / (1 - lam) if lam < 1 else None,
+                    "rms_second_half": {nm: float(rms[j]) for j, nm in enumerate(res.names)},
+                    "predicted_lag": tr["predicted_lag_relative_error"],
+                }
+            )
+            if progress:
+                progress(len(rows), len(gyro_noise) * len(forgetting))
+    return rows

@@ -4,12 +4,15 @@ the initial-velocity sweep (Figs. 6-9 style)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..viz import pyplot
-from .estimators import METHODS, SOLVERS
-from .results import SOLVER_TITLES, PostcaptureResult, _is_product
+from .estimators import METHODS, SOLVER_TITLES, SOLVERS, is_product
+
+if TYPE_CHECKING:  # annotations only: results.py draws its figures with this module
+    from .results import PostcaptureResult
 
 
 def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
@@ -22,7 +25,7 @@ def plot_histories(res: PostcaptureResult, out: Path) -> list[Path]:
     for method in METHODS:
         if (method, "modified_rls") not in res.histories:
             continue
-        show = [j for j, n in enumerate(res.names) if not _is_product(n)]
+        show = [j for j, n in enumerate(res.names) if not is_product(n)]
         ncol = 4
         nrow = int(np.ceil(len(show) / ncol))
         fig, axes = plt.subplots(nrow, ncol, figsize=(3.2 * ncol, 2.4 * nrow), constrained_layout=True, squeeze=False)
@@ -85,7 +88,7 @@ def plot_base_tracking(res: PostcaptureResult, out: Path) -> Path:
     estimate, one panel per base parameter (mass, centre of mass, principal inertias), and the propellant left."""
     plt = pyplot()
     th_t, th = res.truth_history
-    show = [j for j, n in enumerate(res.names) if len(n) > 1 and n[1] == "1" and not _is_product(n)]
+    show = [j for j, n in enumerate(res.names) if len(n) > 1 and n[1] == "1" and not is_product(n)]
     prop = res.extra.get("propellant_history")
     npan = len(show) + (1 if prop else 0)
     ncol = 4

@@ -9,10 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .estimators import METHODS, SOLVERS
+from .estimators import METHODS, SOLVER_TITLES, SOLVERS, is_product
 from .scenario import Scenario
-
-SOLVER_TITLES = {"modified_rls": "paper (modified RLS)", "standard_rls": "standard params (RLS)"}
 
 
 def transit_times(t, hist, truth, tol, zero_abs=1e-8):
@@ -177,7 +175,7 @@ class PostcaptureResult:
             err = {s: self.rel_error(method, s) for s in SOLVERS}
             ftr = self.final_truth(method, SOLVERS[0])
             for j, n in enumerate(self.names):
-                if n not in paper and paper and _is_product(n):
+                if n not in paper and paper and is_product(n):
                     continue
                 p = paper.get(n)
                 ptxt = (
@@ -224,10 +222,6 @@ class PostcaptureResult:
 
             plot_base_tracking(self, out)
         return out / "results.json"
-
-
-def _is_product(n):
-    return n[-2:] in ("xy", "xz", "yz") and n[0] == "I"
 
 
 def sweep_table(sw: dict, params=("In", "I1", "mn", "bnx"), paper: dict | None = None) -> str:

@@ -14,6 +14,7 @@ from .. import models
 from .._core import InputError
 from ..algorithms import quat_to_matrix
 from ..io import scenario_files
+from ..io.scenario_blocks import scenario_blocks
 
 # Noise study levels (the paper has no noise): white, per sample. Velocities [m/s, rad/s] and accelerations
 # [m/s², rad/s²] at the 10 Hz samples; thrust [N, N·m] at the 1 kHz step rate before integration.
@@ -72,12 +73,12 @@ def load_scenario(spec: str | Path) -> Scenario:
     """A post-capture scenario by built-in name or file path."""
     d, source = scenario_files.read(spec, kind="postcapture")
     try:
-        return _parse(d, source)
+        return parse_scenario(d, source)
     except KeyError as e:
         raise InputError(f"{source}: missing key {e}") from None
 
 
-def _parse(d: dict, source: str, model=None) -> Scenario:
+def parse_scenario(d: dict, source: str, model=None) -> Scenario:
     """A checked scenario mapping as a Scenario; `model` (a freefloat.Model) instead of the built-in robot that
     `d["model"]` names (a mission's servicer with its target attached)."""
     m = model if model is not None else models.load(d["model"])
@@ -133,58 +134,6 @@ def _parse(d: dict, source: str, model=None) -> Scenario:
         environment=env,
         sensors=sset,
     )
-
-
-def scenario_blocks(d: dict, source: str, m):
-    """The `actuators:`, `environment:` and `sensors:`/`telemetry:` blocks as the Python API objects that run
-    them (the same readers as `freefloat simulate --actuators/--environment` and `freefloat measure --sensors`),
-    checked against the robot by the engine now, so that a tank heavier than its body or an unknown joint is
-    refused before the run with the file, line and key."""
-    from .. import _core
-    from .. import sensors as sn
-    from ..actuators import Actuators
-    from ..environment import environment_from_dict
-    from ..io import schema
-
-    # the blocks as the schema read them: numbers written as YAML 1.1 text (1e5) are numbers, as everywhere
-    d = dict(d)
-    for key in ("actuators", "environment", "telemetry"):
-        if d.get(key) is not None:
-            d[key] = schema.validated_block(key, d[key]).model_dump(exclude_unset=True)
-    if d.get("sensors") is not None:
-        d["sensors"] = [s.model_dump(exclude_unset=True) for s in schema.validated_block("sensors", d["sensors"])]
-    acts = env = sset = None
-    if d.get("actuators"):
-        try:
-            acts = Actuators.from_dict(d["actuators"]).to_dict()
-            ntanks = len(acts.get("tanks", []))
-            # resolves names and runs every engine check (ActuatorRt::new) without simulating
-            _core.postcapture_thruster_wrench(m._core, acts, np.zeros(1), np.zeros((1, ntanks)))
-        except InputError as e:
-            raise scenario_files.error_at(source, e) from None
-    if d.get("environment"):
-        try:
-            env = environment_from_dict(d["environment"])
-        except InputError as e:
-            raise scenario_files.error_at(source, e) from None
-    if d.get("sensors"):
-        spec = {"sensors": d["sensors"]}
-        if d.get("telemetry"):
-            spec["telemetry"] = d["telemetry"]
-        try:
-            sset = sn.load(spec)
-            sset.names()  # the engine's check of the whole set
-            for j, s in enumerate(sset.to_dicts()):
-                named = s.get("joints") or ([s["joint"]] if s.get("joint") else [])
-                for k, jn in enumerate(named):
-                    if jn not in m.joint_names:
-                        key = f"sensors[{j}].joints[{k}]" if s.get("joints") else f"sensors[{j}].joint"
-                        raise InputError(
-                            f"{key}: the robot '{m.name}' has no joint '{jn}' (joints: {', '.join(m.joint_names)})"
-                        )
-        except InputError as e:
-            raise scenario_files.error_at(source, e) from None
-    return acts, env, sset
 
 
 def _base_attitude(m, q) -> np.ndarray:

@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from . import _core
-from ._arrays import as_f64
-from ._core import InputError
-from .model import Model
+from .. import _core
+from .._arrays import as_f64
+from .._core import InputError
+from ..model import Model
 
 MOMENTUM_NAMES = ["px", "py", "pz", "Lx", "Ly", "Lz"]
 #: the standard inertial parameters of a body, in `Model.parameters()` order (the `base_parameters` columns)
@@ -167,7 +167,7 @@ class Trajectory:
         base_parameters.<m…Izz>, orbit.<x…vz>); the model name and run statistics in the metadata."""
         import pyarrow.parquet as pq
 
-        from .io import arrow
+        from ..io import arrow
 
         meta = {"freefloat": json.dumps({"model": self.model_name, "stats": self.stats})}
         pq.write_table(arrow.table(self._columns(), meta), str(path))
@@ -468,7 +468,7 @@ def simulate_driven(
     base floats with zero total momentum, its initial twist solved from the momentum model,
     A_b v_b = −A_j q̇_j (Naveen, Shah, Misra; the engine's `base_twist_for_momentum`). t_final: default the
     trajectory's duration."""
-    from .algorithms import base_twist_for_momentum
+    from ..algorithms import base_twist_for_momentum
 
     presc = trajectory.prescription(model, joints)  # entries it does not drive: neutral angle, at rest
     q0, v0, _ = presc(0.0)
@@ -500,7 +500,7 @@ def _bar_callback(bar, total: float):
 
 def _radius(model: Model, q) -> float:
     """Largest distance of a body's centre of mass from the system's, at q (a length scale)."""
-    from .algorithms import center_of_mass, forward_kinematics, quat_to_matrix
+    from ..algorithms import center_of_mass, forward_kinematics, quat_to_matrix
 
     fk = forward_kinematics(model, q)
     P = model.parameters()
@@ -513,7 +513,7 @@ def _rotational_inertia(model: Model, q) -> float:
     """Largest principal moment (kg m²) of the whole system's inertia about its centre of mass at q, the bodies
     locked (from the engine's composite inertia: the base block of the joint-space inertia matrix); 0 for a
     base that is not free."""
-    from .algorithms import crba
+    from ..algorithms import crba
 
     if model.nvs[0] != 6:
         return 0.0

@@ -21,10 +21,12 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field, fields
 
-from ._core import InputError, actuator_fields
+from .._core import InputError, actuator_fields
+from ..io.schema import NonNegative, Positive, TankRef, Text, block_of, key, numbers
 
-# The keys the engine reads and its wheel defaults (`Wheel::new`): one copy, in the engine; the classes below and
-# the scenario schema (`io/scenario_schemas.py`) take theirs from here.
+# The keys the engine reads and its wheel defaults (`Wheel::new`): one copy, in the engine; the classes below take
+# theirs from here and declare each key's type and range once (`key(TYPE, default)`); the scenario schema's blocks
+# (`io/scenario_schemas.py`) are made from these classes (`BLOCKS`, below).
 FIELDS = actuator_fields()
 WHEEL_DEFAULTS = FIELDS["wheels"]["defaults"]
 
@@ -36,12 +38,13 @@ class JointLimit:
     command is clipped to [-effort, effort] (N m or N) and gives no force that drives |rate| further past
     `velocity` (rad/s or m/s)."""
 
-    joint: str
-    effort: float | None = None
-    velocity: float | None = None
+    joint: str = key(Text)
+    effort: float | None = key(Positive | None, None)
+    velocity: float | None = key(Positive | None, None)
 
 
 _W = WHEEL_DEFAULTS
+_VEC3 = numbers(3)
 
 
 @dataclass
@@ -51,17 +54,17 @@ class Wheel:
     drives |Ω| further past max_speed, Basilisk's order) once per step and subtracts friction at every stage.
     Limits are optional (None: none). Units: N m, rad/s, W, N m s/rad, kg m, kg m²."""
 
-    joint: str
-    max_torque: float | None = _W["max_torque"]
-    max_speed: float | None = _W["max_speed"]
-    max_power: float | None = _W["max_power"]
-    coulomb: float = _W["coulomb"]
-    static_friction: float = _W["static_friction"]
-    stribeck_speed: float | None = _W["stribeck_speed"]
-    viscous: float = _W["viscous"]
-    limit_cycle_speed: float = _W["limit_cycle_speed"]
-    static_imbalance: float = _W["static_imbalance"]
-    dynamic_imbalance: float = _W["dynamic_imbalance"]
+    joint: str = key(Text)
+    max_torque: float | None = key(Positive | None, _W["max_torque"])
+    max_speed: float | None = key(Positive | None, _W["max_speed"])
+    max_power: float | None = key(Positive | None, _W["max_power"])
+    coulomb: float = key(NonNegative, _W["coulomb"])
+    static_friction: float = key(NonNegative, _W["static_friction"])
+    stribeck_speed: float | None = key(Positive | None, _W["stribeck_speed"])
+    viscous: float = key(NonNegative, _W["viscous"])
+    limit_cycle_speed: float = key(Positive, _W["limit_cycle_speed"])
+    static_imbalance: float = key(NonNegative, _W["static_imbalance"])
+    dynamic_imbalance: float = key(NonNegative, _W["dynamic_imbalance"])
 
 
 @dataclass
@@ -71,17 +74,17 @@ class Thruster:
     than min_on_time lasts min_on_time; thrust ramps linearly over ramp_on/ramp_off seconds. A thruster fed by a
     `tank` (its name or index) needs `isp` (s) and stops when the tank is empty."""
 
-    direction: tuple
-    max_thrust: float
-    position: tuple = (0.0, 0.0, 0.0)
-    body: str | None = None
-    min_on_time: float = 0.0
-    ramp_on: float = 0.0
-    ramp_off: float = 0.0
-    isp: float | None = None
-    tank: str | int | None = None
-    firings: list = field(default_factory=list)
-    name: str | None = None
+    direction: tuple = key(_VEC3)
+    max_thrust: float = key(Positive)
+    position: tuple = key(_VEC3, (0.0, 0.0, 0.0))
+    body: str | None = key(Text | None, None)
+    min_on_time: float = key(NonNegative, 0.0)
+    ramp_on: float = key(NonNegative, 0.0)
+    ramp_off: float = key(NonNegative, 0.0)
+    isp: float | None = key(Positive | None, None)
+    tank: str | int | None = key(TankRef, None)
+    firings: list = key(list[numbers(2)], default_factory=list)
+    name: str | None = key(Text | None, None)
 
 
 @dataclass
@@ -90,11 +93,11 @@ class Tank:
     already included in the body's mass in the model; a point mass (radius 0) or a uniform sphere of `radius` m.
     The body's inertial parameters follow the propellant left."""
 
-    name: str
-    mass: float
-    position: tuple = (0.0, 0.0, 0.0)
-    body: str | None = None
-    radius: float = 0.0
+    name: str = key(Text)
+    mass: float = key(Positive)
+    position: tuple = key(_VEC3, (0.0, 0.0, 0.0))
+    body: str | None = key(Text | None, None)
+    radius: float = key(NonNegative, 0.0)
 
 
 @dataclass
@@ -109,9 +112,9 @@ class Actuators:
     def to_dict(self) -> dict:
         """The plain mapping the engine reads (also the layout of a YAML `actuators:` block)."""
         out = {}
-        for key, kind in _KINDS:
+        for lst, kind in _KINDS:
             items = []
-            for j, a in enumerate(getattr(self, key)):
+            for j, a in enumerate(getattr(self, lst)):
                 if isinstance(a, dict):
                     items.append(dict(a))
                 elif isinstance(a, kind):
@@ -123,9 +126,9 @@ class Actuators:
                     items.append({k: v for k, v in d.items() if v is not None})
                 else:
                     raise InputError(
-                        f"actuators.{key}[{j}]: expected a freefloat.{kind.__name__}, got {type(a).__name__}"
+                        f"actuators.{lst}[{j}]: expected a freefloat.{kind.__name__}, got {type(a).__name__}"
                     )
-            out[key] = items
+            out[lst] = items
         return out
 
     @classmethod
@@ -140,27 +143,32 @@ class Actuators:
         if unknown:
             raise InputError(f"{where}: unknown key(s) {sorted(unknown)} (allowed: {allowed})")
         lists = {}
-        for key, kind in _KINDS:
-            items = d.get(key) or []
+        for lst, kind in _KINDS:
+            items = d.get(lst) or []
             if not isinstance(items, list):
-                raise InputError(f"{where}.{key}: expected a list")
+                raise InputError(f"{where}.{lst}: expected a list")
             names = {f.name for f in fields(kind)}
             out = []
             for j, it in enumerate(items):
                 if not isinstance(it, dict):
-                    raise InputError(f"{where}.{key}[{j}]: expected a mapping of settings")
+                    raise InputError(f"{where}.{lst}[{j}]: expected a mapping of settings")
                 bad = set(it) - names
                 if bad:
-                    raise InputError(f"{where}.{key}[{j}]: unknown key(s) {sorted(bad)} (allowed: {sorted(names)})")
+                    raise InputError(f"{where}.{lst}[{j}]: unknown key(s) {sorted(bad)} (allowed: {sorted(names)})")
                 try:
                     out.append(kind(**it))
                 except TypeError as e:  # a required field is missing
-                    raise InputError(f"{where}.{key}[{j}]: {e}") from None
-            lists[key] = out
+                    raise InputError(f"{where}.{lst}[{j}]: {e}") from None
+            lists[lst] = out
         return cls(**lists)
 
 
 _KINDS = (("limits", JointLimit), ("wheels", Wheel), ("thrusters", Thruster), ("tanks", Tank))
+#: the schema block of each list of an `actuators:` block, made from the class above (keys in the engine's order)
+BLOCKS = {
+    lst: block_of(kind, FIELDS[lst]["keys"], name=name)
+    for (lst, kind), name in zip(_KINDS, ("ActLimit", "ActWheel", "ActThruster", "ActTank"))
+}
 
 
 def add_wheels(model_yaml: dict, n: int = 3, *, axes=None, inertia=(0.1, 0.05), mass: float = 1.0, radius=0.2):

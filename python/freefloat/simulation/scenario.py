@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ._core import InputError
-from .model import Model
+from .._core import InputError
+from ..model import Model
 
 
 @dataclass
@@ -73,7 +73,7 @@ class SimulationRun:
 
 
 def _model(spec: str, source: str, base_dir: Path | None) -> Model:
-    from . import models
+    from .. import models
 
     p = Path(spec)
     if not p.suffix and models.is_builtin(spec):
@@ -106,7 +106,7 @@ def _vector(x, n: int, key: str, source: str, default: np.ndarray) -> np.ndarray
 
 def _joint_column(m: Model, name: str, key: str, source: str) -> int:
     """The velocity index of the one-coordinate joint `name` (the key names where it was given)."""
-    from .io import scenario_files
+    from ..io import scenario_files
 
     if name not in m.joint_names[1:]:
         raise scenario_files.error_at(
@@ -158,8 +158,8 @@ def _torque_table(spec: str, m: Model, source: str, base_dir: Path | None):
     """Read a torque table: CSV or Parquet, a column t [s] (strictly increasing, from 0) and one column
     tau.<coordinate> per driven coordinate (`Model.v_labels()`, as a trajectory file names them; absent
     coordinates get zero). A trajectory file's other columns are ignored, any other column is refused."""
-    from .io import scenario_files
-    from .io.telemetry import check_finite, check_increasing, read_columns
+    from ..io import scenario_files
+    from ..io.telemetry import check_finite, check_increasing, read_columns
 
     p = Path(spec)
     if base_dir is not None and not p.is_absolute():
@@ -205,8 +205,8 @@ def load(spec) -> SimulationScenario:
     """Read a `kind: simulate` scenario (a file path or a built-in name), checked against its schema and then,
     by the engine, against its robot (joint names, tank masses, sensor joints): every error names the file,
     line and key."""
-    from .io import scenario_files
-    from .postcapture.scenario import scenario_blocks
+    from ..io import scenario_files
+    from ..io.scenario_blocks import scenario_blocks
 
     d, source = scenario_files.read(spec, kind="simulate")
     p = Path(spec)
@@ -245,8 +245,8 @@ def load(spec) -> SimulationScenario:
 def run(sc: SimulationScenario | str | Path, progress=False, max_steps: int | None = None) -> SimulationRun:
     """Simulate the scenario (freefloat.simulate with its actuators and environment) and, with sensors, measure
     the run (freefloat.sensors.measure with the scenario's seed)."""
-    from . import sensors as sn
-    from .simulation import simulate
+    from .. import sensors as sn
+    from .run import simulate
 
     if not isinstance(sc, SimulationScenario):
         sc = load(sc)

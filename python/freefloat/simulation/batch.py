@@ -12,11 +12,11 @@ Every argument that varies is stacked on a leading batch axis of B members (q0 (
 
 from __future__ import annotations
 
-from . import _core
-from ._arrays import as_f64
-from ._core import InputError
-from .model import Model
-from .simulation import Trajectory
+from .. import _core
+from .._arrays import as_f64
+from .._core import InputError
+from ..model import Model
+from .run import Trajectory
 
 
 class Trajectories(list):

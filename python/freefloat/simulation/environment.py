@@ -30,26 +30,50 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from ._core import Environment, InputError
+from .._core import Environment, InputError
+from ..io.schema import Bool, Number, Positive, integer, literal, number, numbers
 
-__all__ = ["Environment", "environment_from_dict", "load_environment"]
+__all__ = ["EARTH", "Environment", "environment_from_dict", "load_environment"]
 
-_ORBIT_KEYS = {
-    "altitude",
-    "semi_major_axis",
-    "eccentricity",
-    "inclination_deg",
-    "raan_deg",
-    "arg_periapsis_deg",
-    "true_anomaly_deg",
-    "inclination",
-    "raan",
-    "arg_periapsis",
-    "true_anomaly",
-    "position",
-    "velocity",
+#: the default central body, the Earth (the engine's `CentralBody::EARTH`: μ in m³/s², equatorial radius in m, J2;
+#: tests/test_environment.py checks μ and the radius against the engine)
+EARTH = {"mu": 3.986004418e14, "radius": 6378137.0, "j2": 1.0826267e-3}
+
+# The keys of an `environment:` block, with their schema types and defaults: declared once, here. The reader below
+# takes the names; the scenario schema (`io/scenario_schemas.py`) makes its blocks from the whole declaration.
+_VEC3 = numbers(3)
+CENTRAL_BODY_KEYS = {"mu": (Positive, EARTH["mu"]), "radius": (Positive, EARTH["radius"]), "j2": (Number, EARTH["j2"])}
+ORBIT_KEYS = {
+    "altitude": (Positive | None, None),
+    "semi_major_axis": (Positive | None, None),
+    "eccentricity": (number(lo=0.0, hi=1.0, hi_open=True), None),
+    "inclination_deg": (Number, None),
+    "raan_deg": (Number, None),
+    "arg_periapsis_deg": (Number, None),
+    "true_anomaly_deg": (Number, None),
+    "inclination": (Number, None),
+    "raan": (Number, None),
+    "arg_periapsis": (Number, None),
+    "true_anomaly": (Number, None),
+    "position": (_VEC3, None),
+    "velocity": (_VEC3, None),
 }
-_TOP_KEYS = {"central_body", "orbit", "gravity_gradient", "j2", "disturbance"}
+DISTURBANCE_KEYS = {
+    "force": (_VEC3, None),
+    "torque": (_VEC3, None),
+    "axes": (literal("inertial", "body"), "inertial"),
+    "body": (integer(lo=0), 0),
+}
+#: the top-level keys: the three sections above and the two switches
+TOP_KEYS = {
+    "central_body": None,
+    "orbit": None,
+    "gravity_gradient": (Bool, False),
+    "j2": (Bool, False),
+    "disturbance": None,
+}
+_ORBIT_KEYS = set(ORBIT_KEYS)
+_TOP_KEYS = set(TOP_KEYS)
 
 
 def _number(x: Any, key: str) -> float:
@@ -79,7 +103,7 @@ def environment_from_dict(block: Mapping | None) -> Environment | None:
     if cb is not None:
         if not isinstance(cb, Mapping):
             raise InputError("environment.central_body: expected a mapping with mu, radius, j2")
-        _keys(cb, {"mu", "radius", "j2"}, "environment.central_body")
+        _keys(cb, set(CENTRAL_BODY_KEYS), "environment.central_body")
         if "mu" in cb:
             mu = _number(cb["mu"], "central_body.mu")
             if mu <= 0:
@@ -127,7 +151,7 @@ def environment_from_dict(block: Mapping | None) -> Environment | None:
     if dist is not None:
         if not isinstance(dist, Mapping):
             raise InputError("environment.disturbance: expected a mapping with force, torque, axes, body")
-        _keys(dist, {"force", "torque", "axes", "body"}, "environment.disturbance")
+        _keys(dist, set(DISTURBANCE_KEYS), "environment.disturbance")
         for k in ("force", "torque"):
             if k in dist:
                 v = dist[k]
