@@ -13,10 +13,10 @@
 //! For an under-actuated system with `τ = B u`, use `Fu · B` (for a free-floating robot whose base
 //! is not actuated: the last nv − 6 columns of `Fu`).
 
-use super::lie::{integrate_jacobians_unchecked, integrate_unchecked, tangent_map, tangent_map_jacobians};
 use super::rnea_derivatives::aba_derivatives_unchecked;
 use super::{check_workspace, gemm, Derivatives};
 use crate::check::{check_args, with_unit_q, Args};
+use crate::config::{integrate_jacobians_unchecked, integrate_unchecked, tangent_map, tangent_map_jacobians};
 use crate::data::Data;
 use crate::dynamics::hybrid_aba_unchecked;
 use crate::error::{FfError, Result};
