@@ -49,6 +49,8 @@ pub mod sim;
 pub mod spatial;
 /// How many threads the parallel passes may use (the process's cores, read once).
 pub mod threads;
+/// The record a simulation returns (`sim::Trajectory`).
+pub mod trajectory;
 
 pub use data::Data;
 pub use error::{FfError, Result};

@@ -15,6 +15,7 @@ pub use batch::{batch_size, simulate_many, simulate_many_interruptible, BatchSpe
 pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 
+use crate::check::check_vec;
 use crate::config::{
     dexpinv_unchecked as dexpinv, retract_unchecked as retract, tangent_magnitude_unchecked as tangent_magnitude,
     tangent_rate_unchecked as tangent_rate,
@@ -22,7 +23,7 @@ use crate::config::{
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba_placed_no_totals_unchecked, hybrid_aba_placed_unchecked, Prescribed};
 use crate::environment::{EnvWorkspace, Environment};
-use crate::error::{check_vec, FfError, Partial, Result};
+use crate::error::{FfError, Partial, Result};
 use crate::interrupt::Poller;
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;

@@ -58,7 +58,7 @@ pub struct FloatingRobot {
     /// for an ordinary problem). Past the end of a reference table the last entry holds.
     pub(crate) offset: usize,
     /// Scratch of the full-DDP step Hessian (`step_hessian`), made on first use.
-    pub(crate) hess: Option<super::step_hessian::HessianWork>,
+    pub(crate) hess: Option<super::workspace::HessianWork>,
     /// The rate-driven tail, if any (see the module notes).
     pub(crate) rate: Option<RateDriven>,
 }
