@@ -26,7 +26,7 @@ LAYERS: list[list[str]] = [
     ["model"],
     ["dualquat"],
     ["data", "check"],
-    ["config"],
+    ["config", "rk"],
     ["kinematics", "dynamics", "regressors"],
     ["dqdynamics", "environment", "sensors"],
     ["sim"],

@@ -41,6 +41,8 @@ pub mod model;
 pub mod postcapture;
 /// Momentum and inverse-dynamics regressors, linear in the standard inertial parameters.
 pub mod regressors;
+/// The one explicit Runge-Kutta stage loop (Runge-Kutta-Munthe-Kaas on a group) and its tableaux.
+pub mod rk;
 /// Sensor models (gyro, star tracker, encoders, tachometers, F/T) and `measure`: a run turned into telemetry.
 pub mod sensors;
 /// Lie-group Runge-Kutta simulation (RK4, Dormand-Prince 5(4)) with inputs and trajectories.
