@@ -47,7 +47,8 @@ pub mod rk;
 pub mod sensors;
 /// Lie-group Runge-Kutta simulation (RK4, Dormand-Prince 5(4)) with inputs and trajectories.
 pub mod sim;
-/// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers.
+/// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers; `spatial::lie`, the one copy of the
+/// SO(3)/SE(3) exponentials, logarithms and Jacobians.
 pub mod spatial;
 /// How many threads the parallel passes may use (the process's cores, read once).
 pub mod threads;
