@@ -247,6 +247,21 @@ pub(crate) fn normalized_into(m: &Model, q: &[f64], buf: &mut Vec<f64>) {
     }
 }
 
+/// `Model::checked_q` is defined here, not in `model`, so that `model` does not import the check that imports it.
+impl Model {
+    /// Check `q` (size, finiteness, unit quaternions: `check::check_q`) and return it with every
+    /// quaternion normalised (a copy in `buf` only when one was off by round-off).
+    /// Policy: a quaternion whose norm is off by more than 1e-6 is rejected, not silently fixed,
+    /// because such an input almost always means a wrong layout (e.g. w first) rather than round-off.
+    pub fn checked_q<'a>(&self, q: &'a [f64], buf: &'a mut Vec<f64>) -> Result<&'a [f64]> {
+        if !check_q(self, q)? {
+            return Ok(q);
+        }
+        normalized_into(self, q, buf);
+        Ok(&buf[..])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::check_finite;

@@ -58,7 +58,7 @@ pub enum FfError {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Partial {
     /// A simulation's samples up to the interrupt.
-    Trajectory(Box<crate::sim::Trajectory>),
+    Trajectory(Box<crate::trajectory::Trajectory>),
     /// The first `n` samples of a per-sample output (e.g. the estimates of
     /// `estimation::concurrent::estimate_recorded_interruptible`) are finished.
     Samples(usize),
@@ -83,5 +83,3 @@ impl FfError {
         matches!(self, FfError::Interrupted { .. })
     }
 }
-
-pub use crate::check::check_vec;

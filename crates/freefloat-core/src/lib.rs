@@ -41,14 +41,19 @@ pub mod model;
 pub mod postcapture;
 /// Momentum and inverse-dynamics regressors, linear in the standard inertial parameters.
 pub mod regressors;
+/// The one explicit Runge-Kutta stage loop (Runge-Kutta-Munthe-Kaas on a group) and its tableaux.
+pub mod rk;
 /// Sensor models (gyro, star tracker, encoders, tachometers, F/T) and `measure`: a run turned into telemetry.
 pub mod sensors;
 /// Lie-group Runge-Kutta simulation (RK4, Dormand-Prince 5(4)) with inputs and trajectories.
 pub mod sim;
-/// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers.
+/// SE(3), spatial motion and force vectors, rigid-body inertia, SO(3) helpers; `spatial::lie`, the one copy of the
+/// SO(3)/SE(3) exponentials, logarithms and Jacobians.
 pub mod spatial;
 /// How many threads the parallel passes may use (the process's cores, read once).
 pub mod threads;
+/// The record a simulation returns (`sim::Trajectory`).
+pub mod trajectory;
 
 pub use data::Data;
 pub use error::{FfError, Result};

@@ -1,31 +1,14 @@
-//! Condition number of the system matrix S of (6.17) (Valverde 2018, Figs. 5.5 and 7.x).
+//! Condition number of the system matrix S of (6.17) (Valverde 2018, Figs. 5.5 and 7.x), from the blocks that
+//! `system.rs` assembles. The public entry `condition_number` is in `system.rs`, beside the solve it runs, so that
+//! this file does not import the one that calls it.
 
 use super::sixvec::M6;
-use super::system::{solve_system, Solver};
-use super::workspace::{DqData, Joint};
-use crate::check::{check_args, Args};
+use super::workspace::Joint;
 use crate::dualquat::DualInertia;
-use crate::error::Result;
-use crate::model::Model;
 use nalgebra::DMatrix;
 
-/// 2-norm condition number of the thesis' system matrix S (6.17) at configuration `q` (it does not depend
-/// on velocities or forces): the quantity of Figs. 5.5 and 7.x. Assembled densely from the same blocks as
-/// the solve: `S11 = blkdiag(H(M_i))`, `S12 = −G`, `S21 = Gᵀ P_swap` — the thesis' matrix up to a row
-/// permutation of S21 (its E-selector order), which leaves singular values unchanged. The scalar slots the
-/// 6-vectors drop are decoupled rows with singular value 1 (the ones of (2.45)), folded in at the end.
-/// Checks `q`. Allocates its own workspace and the dense matrix (an analysis routine, not a hot path).
-pub fn condition_number(m: &Model, q: &[f64]) -> Result<f64> {
-    let mut qbuf = Vec::new();
-    check_args(m, None, &Args::q(q))?;
-    let q = m.checked_q(q, &mut qbuf)?;
-    let (v, tau) = (vec![0.0; m.nv], vec![0.0; m.nv]);
-    let mut c = f64::NAN;
-    let mut w = DqData::new(m);
-    solve_system(m, &mut w, q, &v, &tau, None, None, None, Solver::Tree, Some(&mut c))?;
-    Ok(c)
-}
-
+/// The dense system matrix S of (6.17) from the blocks the solve assembled, and its 2-norm condition number
+/// (the quantity `condition_number` returns; `system.rs` calls this when asked for it).
 pub(super) fn full_system_condition(joints: &[Joint], inert: &[Option<DualInertia>], n: usize, r_total: usize) -> f64 {
     let mut boff = vec![usize::MAX; n];
     let mut nb = 0;

@@ -12,8 +12,7 @@ mod tree_solve;
 mod workspace;
 
 pub use body_samples::{com_motion, com_wrenches};
-pub use condition::condition_number;
 pub use sixvec::{ad_in, ad_out, reduce};
 pub(crate) use system::solve_system_unchecked;
-pub use system::{dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, Solver};
+pub use system::{condition_number, dq_dynamics, dq_dynamics_with, dq_hybrid_dynamics, Solver};
 pub use workspace::{DqData, DqDynamics};

@@ -499,3 +499,20 @@ pub(super) fn solve_system(
     }
     Ok(())
 }
+
+/// 2-norm condition number of the thesis' system matrix S (6.17) at configuration `q` (it does not depend
+/// on velocities or forces): the quantity of Figs. 5.5 and 7.x. Assembled densely from the same blocks as
+/// the solve: `S11 = blkdiag(H(M_i))`, `S12 = −G`, `S21 = Gᵀ P_swap` — the thesis' matrix up to a row
+/// permutation of S21 (its E-selector order), which leaves singular values unchanged. The scalar slots the
+/// 6-vectors drop are decoupled rows with singular value 1 (the ones of (2.45)), folded in at the end.
+/// Checks `q`. Allocates its own workspace and the dense matrix (an analysis routine, not a hot path).
+pub fn condition_number(m: &Model, q: &[f64]) -> Result<f64> {
+    let mut qbuf = Vec::new();
+    check_args(m, None, &Args::q(q))?;
+    let q = m.checked_q(q, &mut qbuf)?;
+    let (v, tau) = (vec![0.0; m.nv], vec![0.0; m.nv]);
+    let mut c = f64::NAN;
+    let mut w = DqData::new(m);
+    solve_system(m, &mut w, q, &v, &tau, None, None, None, Solver::Tree, Some(&mut c))?;
+    Ok(c)
+}

@@ -23,9 +23,10 @@ pub mod orbit;
 pub use disturbance::{Axes, Disturbance};
 pub use orbit::{CentralBody, Elements, Orbit, Propagator, ReferenceState};
 
+use crate::check::check_vec;
 use crate::data::Data;
 use crate::dualquat::orbital::{tidal_roots, tidal_x};
-use crate::error::{check_vec, FfError, Result};
+use crate::error::{FfError, Result};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
 use crate::spatial::{Force, M3, V3};

@@ -34,13 +34,25 @@ pub use analysis::{unexcited_directions, Direction, RANK_RTOL};
 pub use gram::{gram_rows_upper, GramLs, GRAM_TILE};
 pub use modified_rls::{CoupledSample, Coupling, ModifiedRls};
 pub use momentum::{
-    identify_momentum, identify_momentum_interruptible, identify_momentum_with, momentum_regressor_pass, Method,
+    identify_momentum, identify_momentum_interruptible, identify_momentum_with, momentum_regressor_pass,
     MomentumProblem, GRAM_DIRECT_KAPPA_MAX, GRAM_KAPPA_MAX,
 };
 pub use rls::Rls;
 pub use streaming::StreamingLs;
 
 use nalgebra::{DMatrix, DVector};
+
+/// Which solver produced the estimate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// normal equations on equilibrated columns + one refinement pass (well-conditioned problems)
+    GramRefined,
+    /// normal equations on equilibrated columns, one pass (very well-conditioned problems with a
+    /// residual large enough to be recovered from the normal equations; see [`GRAM_DIRECT_KAPPA_MAX`])
+    Gram,
+    /// streaming Householder QR (ill-conditioned problems, or when asked directly)
+    StreamingQr,
+}
 
 /// Solution of a least-squares problem with its statistics.
 #[derive(Debug, Clone)]

@@ -2,10 +2,11 @@
 
 use super::analysis::{check_rank, finish};
 use super::gram::{gram_rows_upper, GramLs, GRAM_TILE};
-use super::{LsResult, StreamingLs};
+use super::{LsResult, Method, StreamingLs};
+use crate::check::check_vec;
 use crate::check::{check_finite, check_len};
 use crate::data::Data;
-use crate::error::{check_vec, FfError, Result};
+use crate::error::{FfError, Result};
 use crate::interrupt::{Hook, POLL_INTERVAL};
 use crate::kinematics::{forward_velocities_unchecked, Kin4};
 use crate::model::Model;
@@ -40,18 +41,6 @@ const PARALLEL_MIN_SAMPLES: usize = 4096;
 /// multiple of both block sizes, so that only the last chunk ends with a partial block.
 const CHUNK_SAMPLES: usize = 2048;
 const _: () = assert!(CHUNK_SAMPLES.is_multiple_of(BLOCK_SAMPLES) && CHUNK_SAMPLES.is_multiple_of(ROW_BLOCK_SAMPLES));
-
-/// Which solver produced the estimate.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
-    /// normal equations on equilibrated columns + one refinement pass (well-conditioned problems)
-    GramRefined,
-    /// normal equations on equilibrated columns, one pass (very well-conditioned problems with a
-    /// residual large enough to be recovered from the normal equations; see [`GRAM_DIRECT_KAPPA_MAX`])
-    Gram,
-    /// streaming Householder QR (ill-conditioned problems, or when asked directly)
-    StreamingQr,
-}
 
 /// A momentum identification problem, all arrays flat and row-major over samples.
 #[derive(Debug, Clone, Copy)]

@@ -16,8 +16,9 @@
 //! controllable by an in-plane base.
 
 use super::forward_velocities_unchecked;
+use crate::check::check_vec;
 use crate::data::Data;
-use crate::error::{check_vec, FfError, Result};
+use crate::error::{FfError, Result};
 use crate::model::{JointType, Model};
 use crate::spatial::{Force, Inertia, V3};
 use nalgebra::{Matrix6x3, Vector3, Vector6};

@@ -475,18 +475,6 @@ impl Model {
         }
         q
     }
-
-    /// Check `q` (size, finiteness, unit quaternions: `check::check_q`) and return it with every
-    /// quaternion normalised (a copy in `buf` only when one was off by round-off).
-    /// Policy: a quaternion whose norm is off by more than 1e-6 is rejected, not silently fixed,
-    /// because such an input almost always means a wrong layout (e.g. w first) rather than round-off.
-    pub fn checked_q<'a>(&self, q: &'a [f64], buf: &'a mut Vec<f64>) -> Result<&'a [f64]> {
-        if !crate::check::check_q(self, q)? {
-            return Ok(q);
-        }
-        crate::check::normalized_into(self, q, buf);
-        Ok(&buf[..])
-    }
 }
 
 fn check_unique(what: &str, names: &[String]) -> Result<()> {

@@ -19,8 +19,9 @@
 //! is `I#[[0, 1, 3, 2, 4, 5]]`); `mono(b) = [bx², bx by, bx bz, by², by bz, bz²]`;
 //! `m J(b') = [m, m b', m mono(b')]` (eq. 23).
 
+use crate::check::check_vec;
 use crate::data::Data;
-use crate::error::{check_vec, FfError, Result};
+use crate::error::{FfError, Result};
 use crate::kinematics::classical_acceleration;
 use crate::model::{JointType, Model};
 use crate::regressors::{dynamics_regressor, momentum_regressor};

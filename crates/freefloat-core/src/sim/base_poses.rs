@@ -81,7 +81,7 @@ fn check_samples(twists: &[f64], width: usize, pose0: &[f64], nq: usize, out: &[
     if let Some(k) = twists.iter().position(|x| !x.is_finite()) {
         return Err(FfError::arg("twists", format!("sample {}, entry {} is not finite", k / width, k % width)));
     }
-    crate::error::check_vec("pose0", pose0, nq)?;
+    crate::check::check_vec("pose0", pose0, nq)?;
     let n = twists.len() / width;
     if out.len() != n * nq {
         return Err(FfError::arg("out", format!("expected {} numbers ({n} × {nq}), got {}", n * nq, out.len())));

@@ -6,7 +6,6 @@ pub mod actuators;
 mod base_poses;
 mod batch;
 mod inputs;
-pub(crate) mod tableau;
 mod trajectory;
 
 pub use actuators::{Actuators, JointLimit, Tank, Thruster, Wheel};
@@ -15,6 +14,7 @@ pub use batch::{batch_size, simulate_many, simulate_many_interruptible, BatchSpe
 pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
 pub use trajectory::Trajectory;
 
+use crate::check::check_vec;
 use crate::config::{
     dexpinv_unchecked as dexpinv, retract_unchecked as retract, tangent_magnitude_unchecked as tangent_magnitude,
     tangent_rate_unchecked as tangent_rate,
@@ -22,11 +22,11 @@ use crate::config::{
 use crate::data::Data;
 use crate::dynamics::{hybrid_aba_placed_no_totals_unchecked, hybrid_aba_placed_unchecked, Prescribed};
 use crate::environment::{EnvWorkspace, Environment};
-use crate::error::{check_vec, FfError, Partial, Result};
+use crate::error::{FfError, Partial, Result};
 use crate::interrupt::Poller;
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
-use tableau::{Tableau, DOPRI5, RK4};
+use crate::rk::{self, Tableau, DOPRI5, RK4};
 
 /// Integration method.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -143,7 +143,6 @@ struct Stepper<'m, 'i> {
     mp: Vec<f64>,
     mps: Vec<f64>,
     mp1: Vec<f64>,
-    kmp: Vec<Vec<f64>>,
     /// A copy of the model whose tank bodies' inertias follow the propellant (tanks only).
     var_model: Option<Model>,
     presc_mask: Vec<bool>,
@@ -152,11 +151,11 @@ struct Stepper<'m, 'i> {
     presc_a: Vec<f64>,
     qs: Vec<f64>,
     vs: Vec<f64>,
-    kq: Vec<Vec<f64>>,
-    kv: Vec<Vec<f64>>,
-    kw: Vec<f64>,
-    dq: Vec<f64>,
-    dv: Vec<f64>,
+    /// One row per Runge-Kutta stage, the rate of everything integrated (`Rates` names the parts):
+    /// `[tangent rate of q (nv) | acceleration (nv) | propellant flow (tanks) | power (1)]`.
+    k: Vec<Vec<f64>>,
+    /// The stage increment `h Σⱼ a_sj k_j` (then the step's), laid out as a row of `k`.
+    delta: Vec<f64>,
     /// RK45 error control: tangent magnitudes at both ends of a step
     mag0: Vec<f64>,
     mag1: Vec<f64>,
@@ -197,7 +196,6 @@ impl<'m, 'i> Stepper<'m, 'i> {
             mps: mp.clone(),
             mp1: mp.clone(),
             mp,
-            kmp: vec![vec![0.0; nt]; stages],
             var_model,
             presc_mask,
             presc_q: vec![0.0; m.nq],
@@ -205,11 +203,8 @@ impl<'m, 'i> Stepper<'m, 'i> {
             presc_a: vec![0.0; m.nv],
             qs: vec![0.0; m.nq],
             vs: vec![0.0; m.nv],
-            kq: vec![vec![0.0; m.nv]; stages],
-            kv: vec![vec![0.0; m.nv]; stages],
-            kw: vec![0.0; stages],
-            dq: vec![0.0; m.nv],
-            dv: vec![0.0; m.nv],
+            k: vec![vec![0.0; 2 * m.nv + nt + 1]; stages],
+            delta: vec![0.0; 2 * m.nv + nt + 1],
             mag0: vec![0.0; m.nv],
             mag1: vec![0.0; m.nv],
             evals: 0,
@@ -244,7 +239,20 @@ impl<'m, 'i> Stepper<'m, 'i> {
     /// Derivative at (t, qs, vs) into stage `s`: tangent rate, acceleration, power. Leaves the joint
     /// accelerations and forces of this evaluation in `self.d`.
     fn eval(&mut self, t: f64, s: usize) -> Result<()> {
+        let mut k = std::mem::take(&mut self.k);
+        let r = self.eval_into(t, s, &mut k[s]);
+        self.k = k;
+        r
+    }
+
+    /// `eval` writing the stage's rates into `ks` (a row of `k`).
+    fn eval_into(&mut self, t: f64, s: usize, ks: &mut [f64]) -> Result<()> {
         let m = self.m;
+        let (nv, nt) = (m.nv, self.mp.len());
+        let (kq, rest) = ks.split_at_mut(nv);
+        let (kv, rest) = rest.split_at_mut(nv);
+        let (kmp, kw) = rest.split_at_mut(nt);
+        let kw = &mut kw[0];
         let (mut qs, mut vs) = (std::mem::take(&mut self.qs), std::mem::take(&mut self.vs));
         self.impose(t, &mut qs, &mut vs)?;
         // The command: read at the step's start (stage 0) and held, or at every stage (see InputTiming).
@@ -260,7 +268,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
         }
         self.tau.copy_from_slice(&self.cmd);
         // Actuator forces at this stage: wheel friction, external wrenches, propellant flow.
-        self.act.forces(t, s > 0, &qs, &vs, &self.mps, &mut self.tau, &mut self.fext, &mut self.kmp[s]);
+        self.act.forces(t, s > 0, &qs, &vs, &self.mps, &mut self.tau, &mut self.fext, kmp);
         if let Some(vm) = self.var_model.as_mut() {
             self.act.deplete(vm, &self.mps);
         }
@@ -323,12 +331,12 @@ impl<'m, 'i> Stepper<'m, 'i> {
         if let Some(k) = self.d.ddq.iter().position(|x| !x.is_finite()) {
             return Err(FfError::Numerical(format!("acceleration {k} became non-finite at t = {t}")));
         }
-        tangent_rate(m, &qs, &vs, &mut self.kq[s]);
-        self.kv[s].copy_from_slice(&self.d.ddq);
-        self.kw[s] = self.d.tau.iter().zip(&vs).map(|(a, b)| a * b).sum();
+        tangent_rate(m, &qs, &vs, kq);
+        kv.copy_from_slice(&self.d.ddq);
+        *kw = self.d.tau.iter().zip(&vs).map(|(a, b)| a * b).sum();
         if fext.is_some() && self.formulation == Formulation::Aba {
             // Power of the external wrenches: ABA summed each one's inertial-frame image on its body's twist.
-            self.kw[s] += self.d.aba_fext_power;
+            *kw += self.d.aba_fext_power;
         } else if fext.is_some() {
             // The same sum here (the dual-quaternion solve leaves the placements and the twists at the inertial
             // origin in `d` but not this sum).
@@ -339,7 +347,7 @@ impl<'m, 'i> Stepper<'m, 'i> {
                     continue;
                 }
                 let f = crate::spatial::Force::from_slice(fe);
-                self.kw[s] += d.ov[i].dot(&d.o_mi[i].act_force(&f));
+                *kw += d.ov[i].dot(&d.o_mi[i].act_force(&f));
             }
         }
         self.evals += 1;
@@ -348,29 +356,10 @@ impl<'m, 'i> Stepper<'m, 'i> {
         Ok(())
     }
 
-    /// `dq = Σⱼ wⱼ kqⱼ`, `dv = Σⱼ wⱼ kvⱼ` over the stages (a row of the tableau's a, or its b), column-wise and
-    /// skipping the zero weights (RK4 has one non-zero a per stage): the same sums in the same order as the full
-    /// inner product over j (adding the skipped ±0 terms to the running sum, which starts at +0, changes
-    /// nothing), bit for bit.
-    fn combine_stages(&mut self, w: &[f64]) {
-        let nv = self.m.nv;
-        let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
-        dq.fill(0.0);
-        dv.fill(0.0);
-        for (j, &wj) in w.iter().enumerate() {
-            if wj == 0.0 {
-                continue;
-            }
-            let (kq, kv) = (&self.kq[j][..nv], &self.kv[j][..nv]);
-            for k in 0..nv {
-                dq[k] += wj * kq[k];
-                dv[k] += wj * kv[k];
-            }
-        }
-    }
-
     /// One Runge-Kutta step from (t, q0, v0, w0). Stage 0 must already hold f(y0) (see `eval`).
-    /// Writes the new state into q1, v1 and returns (w1, error norm or 0).
+    /// Writes the new state into q1, v1 and returns (w1, error norm or 0). The stage loop is the engine's one
+    /// (`rk::step`); this supplies the stage: `q_s = q0 ⊕ δq` (`config::retract`), `v_s = v0 + δv`, the propellant
+    /// `mp + δmp`, the rates there, and the tangent rate mapped through dexp⁻¹(δq) (RKMK).
     #[allow(clippy::too_many_arguments)]
     fn step(
         &mut self,
@@ -385,42 +374,41 @@ impl<'m, 'i> Stepper<'m, 'i> {
         tol: Option<(f64, f64)>,
     ) -> Result<(f64, f64)> {
         let m = self.m;
-        let nv = m.nv;
-        // Every buffer as a slice of exactly nv entries: the loops below index them by k < nv without bounds checks
-        // (and without the zip chains they replaced).
+        let (nv, nt) = (m.nv, self.mp.len());
         let (q0, v0, v1) = (&q0[..m.nq], &v0[..nv], &mut v1[..nv]);
-        for s in 1..tab.stages() {
-            self.combine_stages(tab.a[s]);
-            let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
+        let (mut k, mut delta) = (std::mem::take(&mut self.k), std::mem::take(&mut self.delta));
+        let r = rk::step(tab, t, h, &mut k, &mut delta, |s, ts, dl, ks| {
+            let (dq, rest) = dl.split_at(nv);
+            let (dv, dmp) = rest.split_at(nv);
             let vs = &mut self.vs[..nv];
-            for k in 0..nv {
-                dq[k] *= h;
-                dv[k] *= h;
-                vs[k] = v0[k] + dv[k];
+            for i in 0..nv {
+                vs[i] = v0[i] + dv[i];
             }
             retract(m, q0, dq, &mut self.qs);
-            for k in 0..self.mp.len() {
-                self.mps[k] =
-                    self.mp[k] + h * tab.a[s].iter().enumerate().map(|(j, a)| a * self.kmp[j][k]).sum::<f64>();
+            for i in 0..nt {
+                self.mps[i] = self.mp[i] + dmp[i];
             }
-            self.eval(t + tab.c[s] * h, s)?;
-            dexpinv(m, &self.dq, &mut self.kq[s]);
+            self.eval_into(ts, s, ks)?;
+            dexpinv(m, dq, &mut ks[..nv]);
+            Ok(())
+        });
+        self.k = k;
+        if let Err(e) = r {
+            self.delta = delta;
+            return Err(e);
         }
-        self.combine_stages(tab.b);
-        let (dq, dv) = (&mut self.dq[..nv], &mut self.dv[..nv]);
-        let mut w1 = w0;
-        for (j, b) in tab.b.iter().enumerate() {
-            w1 += h * b * self.kw[j];
+        let (dq, rest) = delta.split_at(nv);
+        let (dv, rest) = rest.split_at(nv);
+        let (dmp, dw) = rest.split_at(nt);
+        let w1 = w0 + dw[0];
+        for i in 0..nv {
+            v1[i] = v0[i] + dv[i];
         }
-        for k in 0..nv {
-            dq[k] *= h;
-            dv[k] *= h;
-            v1[k] = v0[k] + dv[k];
-        }
-        for k in 0..self.mp.len() {
-            self.mp1[k] = self.mp[k] + h * tab.b.iter().enumerate().map(|(j, b)| b * self.kmp[j][k]).sum::<f64>();
+        for i in 0..nt {
+            self.mp1[i] = self.mp[i] + dmp[i];
         }
         retract(m, q0, dq, q1);
+        self.delta = delta;
         let mut err = 0.0;
         if let (Some(e), Some((rtol, atol))) = (tab.e, tol) {
             // Hairer's RMS error norm over the tangent coordinates of q and over v.
@@ -431,8 +419,8 @@ impl<'m, 'i> Stepper<'m, 'i> {
             for k in 0..nv {
                 let (mut eq, mut ev) = (0.0, 0.0);
                 for (j, ej) in e.iter().enumerate() {
-                    eq += ej * self.kq[j][k];
-                    ev += ej * self.kv[j][k];
+                    eq += ej * self.k[j][k];
+                    ev += ej * self.k[j][nv + k];
                 }
                 let sq = atol + rtol * mag0[k].max(mag1[k]);
                 let sv = atol + rtol * v0[k].abs().max(v1[k].abs());

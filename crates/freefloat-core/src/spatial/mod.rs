@@ -13,11 +13,11 @@ pub mod trig;
 mod vectors;
 
 pub use inertia::{m6_mul_motion, transform_inertia_to_parent, Inertia};
+pub use lie::{quat_exp, so3_log, so3_right_jacobian_inv};
 pub use se3::Se3;
 pub use so3::{
-    principal_axis, quat_exp, quat_from_rot, quat_mul, quat_normalize, rot_from_quat, rot_to_rpy,
-    rotate_about_principal_axis, rotation_about_axis, rotation_about_axis_sc, rpy_to_rot, so3_log,
-    so3_right_jacobian_inv,
+    principal_axis, quat_from_rot, quat_mul, quat_normalize, rot_from_quat, rot_to_rpy, rotate_about_principal_axis,
+    rotation_about_axis, rotation_about_axis_sc, rpy_to_rot,
 };
 pub(crate) use vectors::cross as cross_fma;
 pub use vectors::{Force, Motion};

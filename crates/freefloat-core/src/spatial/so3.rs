@@ -1,5 +1,5 @@
 //! Rotations: quaternions in the (x, y, z, w) order used by `q`, rotation matrices, the SO(3)
-//! exponential/logarithm and the inverse right Jacobian that the Lie-group integrator needs.
+//! axis-angle rotations and roll-pitch-yaw angles. The exponential, logarithm and Jacobians are in `lie`.
 
 use super::lanes::Real;
 use super::{trig, M3, V3};
@@ -74,23 +74,6 @@ pub fn quat_from_rot(r: &M3) -> [f64; 4] {
     q
 }
 
-/// Quaternion of the rotation vector `phi` (axis * angle): exp(phi/2) in quaternion form.
-#[inline]
-pub fn quat_exp(phi: &V3) -> [f64; 4] {
-    let th2 = phi.norm_squared();
-    // Near zero (th < 1e-4, every integrator step of a slowly turning base) sin(th/2)/th and cos(th/2) by their
-    // Taylor series, exact to round-off there (the next terms, th⁴/3840 and th⁶/46080, are below 1e-19): no sqrt
-    // and no libm call. Otherwise one sincos of half the angle.
-    let (k, w) = if th2 < 1e-8 {
-        (0.5 - th2 / 48.0, 1.0 - th2 / 8.0 + th2 * th2 / 384.0)
-    } else {
-        let th = th2.sqrt();
-        let (s, c) = (0.5 * th).sin_cos();
-        (s / th, c)
-    };
-    [k * phi.x, k * phi.y, k * phi.z, w]
-}
-
 /// Rotation matrix about a unit axis by `angle` (Rodrigues): `R = c 1 + s [a]× + (1 − c) a aᵀ`, entry by entry
 /// (the same matrix as `1 + s [a]× + (1 − c)[a]ײ` for a unit axis, without the 3×3 products of skew matrices that
 /// made it a tenth of forward kinematics). The sine and cosine are the engine's (`trig::sin_cos`), the same bits as
@@ -158,35 +141,6 @@ fn mix_columns<const A: usize, const B: usize>(r: &M3, s: f64, c: f64) -> M3 {
         out[(row, B)] = b.mul_add(c, -(a * s));
     }
     out
-}
-
-/// Rotation vector of a rotation matrix (inverse of the exponential), angle in [0, pi].
-pub fn so3_log(r: &M3) -> V3 {
-    let q = quat_from_rot(r);
-    let v = V3::new(q[0], q[1], q[2]);
-    let s = v.norm();
-    if s < 1e-12 {
-        return v * 2.0;
-    }
-    let th = 2.0 * s.atan2(q[3]);
-    v * (th / s)
-}
-
-/// Inverse of the right Jacobian of SO(3): if `R(t) = R0 exp(theta(t))` and `R' = R [w]`, then
-/// `theta' = Jr(theta)^-1 w`. This is the dexp⁻¹ correction that makes Runge-Kutta on the rotation
-/// group fourth order (Munthe-Kaas); without it RK4 on the base attitude is only second order.
-pub fn so3_right_jacobian_inv(theta: &V3, w: &V3) -> V3 {
-    let th2 = theta.norm_squared();
-    let tw = theta.cross(w);
-    let ttw = theta.cross(&tw);
-    // coefficient of [theta]^2: 1/th^2 - (1 + cos th)/(2 th sin th), series 1/12 + th^2/720 near 0.
-    let c2 = if th2 < 1e-6 {
-        1.0 / 12.0 + th2 / 720.0
-    } else {
-        let th = th2.sqrt();
-        1.0 / th2 - (1.0 + th.cos()) / (2.0 * th * th.sin())
-    };
-    w + tw * 0.5 + ttw * c2
 }
 
 /// URDF roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll).

@@ -15,7 +15,7 @@ use crate::dualquat::pose::checked_pose;
 use crate::dualquat::realisable::realisability;
 use crate::dualquat::DualInertia;
 use crate::error::{FfError, Result};
-use crate::sim::tableau::{DOPRI5, RK4};
+use crate::rk::{self, DOPRI5, RK4};
 
 /// Integration method of the closed loop.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -306,6 +306,7 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
             let mut x = x0;
             let mut k = [[0.0; NX]; 4];
             let mut xs = [0.0; NX];
+            let mut delta = [0.0; NX];
             for step in 0..=n {
                 let t = step as f64 * dt;
                 d.offer(t, &x);
@@ -320,24 +321,22 @@ pub fn simulate(setup: &Setup, opts: &RunOptions, mut progress: Option<Progress>
                 if step >= opts.max_steps {
                     return Err(FfError::Numerical(format!("gave up after {step} steps at t = {t} (max_steps)")));
                 }
-                for s in 0..4 {
+                // the engine's one stage loop (`rk::step`) on the vector space of x: ⊕ is +, dexp⁻¹ the identity
+                // stage 0 at x (the first n_active entries; the rest of xs stays zero, as every stage sees it)
+                xs[..n_active].copy_from_slice(&x[..n_active]);
+                k[0] = [0.0; NX];
+                d.f(t, &xs, &mut k[0]);
+                rk::step(&RK4, t, dt, &mut k, &mut delta[..n_active], |_, ts, dl, ks| {
                     for i in 0..n_active {
-                        let mut acc = 0.0;
-                        for (j, a) in RK4.a[s].iter().enumerate() {
-                            acc += a * k[j][i];
-                        }
-                        xs[i] = x[i] + dt * acc;
+                        xs[i] = x[i] + dl[i];
                     }
-                    let mut ks = [0.0; NX];
-                    d.f(t + RK4.c[s] * dt, &xs, &mut ks);
-                    k[s] = ks;
-                }
+                    let ks: &mut [f64; NX] = ks.try_into().expect("every stage row holds NX entries");
+                    *ks = [0.0; NX];
+                    d.f(ts, &xs, ks);
+                    Ok(())
+                })?;
                 for i in 0..n_active {
-                    let mut acc = 0.0;
-                    for (j, b) in RK4.b.iter().enumerate() {
-                        acc += b * k[j][i];
-                    }
-                    x[i] += dt * acc;
+                    x[i] += delta[i];
                 }
                 d.run.steps += 1;
                 if report((step + 1) as f64 * dt, step + 1) {
@@ -412,7 +411,7 @@ fn dopri5(
     let h1 = if d1.max(d2) <= 1e-15 { (h0 * 1e-3).max(1e-6) } else { (0.01 / d1.max(d2)).powf(0.2) };
     let mut h = (100.0 * h0).min(h1).min(max_step).min(tf);
     let mut xs = [0.0; NX];
-    let mut xn = [0.0; NX];
+    let mut delta = [0.0; NX];
     let e = DOPRI5.e.expect("DOPRI5 has an error estimate");
     let mut rejected_last = false;
     loop {
@@ -423,21 +422,17 @@ fn dopri5(
         if last {
             h = tf - t;
         }
-        for s in 1..7 {
+        // the engine's one stage loop (`rk::step`); the 7th stage is at the new point (b = a[6], FSAL)
+        rk::step(&DOPRI5, t, h, &mut k, &mut delta[..n], |_, ts, dl, ks| {
             for i in 0..n {
-                let mut acc = 0.0;
-                for (j, a) in DOPRI5.a[s].iter().enumerate() {
-                    acc += a * k[j][i];
-                }
-                xs[i] = x[i] + h * acc;
+                xs[i] = x[i] + dl[i];
             }
-            if s == 6 {
-                xn = xs; // b = a[6]: the 7th stage is at the new point (FSAL)
-            }
-            let mut ks = [0.0; NX];
-            d.f(t + DOPRI5.c[s] * h, &xs, &mut ks);
-            k[s] = ks;
-        }
+            let ks: &mut [f64; NX] = ks.try_into().expect("every stage row holds NX entries");
+            *ks = [0.0; NX];
+            d.f(ts, &xs, ks);
+            Ok(())
+        })?;
+        let xn = xs;
         let err = rms(n, |i| {
             let mut acc = 0.0;
             for (j, ej) in e.iter().enumerate() {

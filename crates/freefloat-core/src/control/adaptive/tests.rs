@@ -176,7 +176,7 @@ fn regression_holds_along_the_simulated_motion() {
 #[test]
 fn dense_output_is_fourth_order() {
     // one DOPRI5 step of y' = cos(t) y from y(0) = 1; the interpolant at interior points against exp(sin t)
-    let tab = &crate::sim::tableau::DOPRI5;
+    let tab = &crate::rk::DOPRI5;
     let f = |t: f64, y: f64| t.cos() * y;
     let mut errs = vec![];
     for &h in &[0.2, 0.1] {

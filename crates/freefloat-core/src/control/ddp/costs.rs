@@ -7,10 +7,10 @@
 //! (the base dual-velocity penalty is its velocity block); a control residual `u − u_ref`.
 //! Weights may follow the iteration schedule of Table 8.2.
 
-use super::lie::{log6, se3_right_jacobian_inv};
 use crate::dualquat::{pose, DualQuat, Quat};
 use crate::error::{FfError, Result};
 use crate::model::{JointType, Model};
+use crate::spatial::lie::{log6, se3_right_jacobian_inv};
 use crate::spatial::{Se3, V3, V6};
 
 /// Piecewise-linear iteration schedule (Valverde 2018, §8.6, eqs. (8.63)–(8.64), Table 8.2):

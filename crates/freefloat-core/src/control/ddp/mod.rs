@@ -6,7 +6,7 @@
 //! integrated on the group in the rollout and never linearised in its redundant coordinates.
 //!
 //! Files by job: `problem` (the action-model trait), `workspace` (per-node buffers), `backward`,
-//! `forward` (rollouts), `regularisation`, `solver` (driver), `costs`, `lie` (SE(3) exp/log),
+//! `forward` (rollouts), `regularisation`, `solver` (driver), `costs` (SE(3) exp/log and the free-flyer retraction are `spatial::lie`'s),
 //! `robot` (the floating-base robot action model), `step_jacobians` (analytic step Jacobians), `step_hessian` (the
 //! second-order terms of full DDP), `fd_step` (the central-difference oracle of the Jacobians for the tests).
 
@@ -24,7 +24,6 @@ pub use solver::{DdpOptions, IterInfo, Solution, Solver, StopReason, Timings, Va
 pub use workspace::Workspace;
 pub mod costs;
 pub mod fd_step;
-pub mod lie;
 pub mod mpc;
 pub use mpc::{Mpc, MpcOptions, MpcStats, Policy};
 pub mod robot;

@@ -16,7 +16,6 @@
 use super::costs::{
     dual_quat_jacobian, frame_dual_quat, keep_out, placement_residual, reference_sign, CostTerm, KeepOut, Residual,
 };
-use super::lie::{ff_difference, ff_integrate, se3_right_jacobian_inv};
 use super::problem::{ActionModel, NodeDiff};
 use crate::data::Data;
 use crate::dynamics::aba;
@@ -24,6 +23,7 @@ use crate::dynamics::derivatives::Derivatives;
 use crate::error::{FfError, Result};
 use crate::kinematics::{jacobian_from_data, Reference};
 use crate::model::{JointType, Model};
+use crate::spatial::lie::{ff_difference, ff_integrate, log6, se3_right_jacobian_inv};
 use crate::spatial::V6;
 use nalgebra::{DMatrix, DVector};
 
@@ -58,7 +58,7 @@ pub struct FloatingRobot {
     /// for an ordinary problem). Past the end of a reference table the last entry holds.
     pub(crate) offset: usize,
     /// Scratch of the full-DDP step Hessian (`step_hessian`), made on first use.
-    pub(crate) hess: Option<super::step_hessian::HessianWork>,
+    pub(crate) hess: Option<super::workspace::HessianWork>,
     /// The rate-driven tail, if any (see the module notes).
     pub(crate) rate: Option<RateDriven>,
 }
@@ -329,7 +329,7 @@ impl FloatingRobot {
             match &t.residual {
                 Residual::FramePlacement { body, placement, refs } => {
                     let o_mf = self.data.o_mi[*body].compose(placement);
-                    let r = super::lie::log6(&refs[(k + self.offset).min(refs.len() - 1)].inv_compose(&o_mf));
+                    let r = log6(&refs[(k + self.offset).min(refs.len() - 1)].inv_compose(&o_mf));
                     total += (0..6).map(|i| w[i] * r[i] * r[i]).sum::<f64>();
                 }
                 Residual::FrameDualQuat { body, placement, refs, nearest_sign } => {

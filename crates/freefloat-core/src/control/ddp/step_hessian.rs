@@ -16,41 +16,11 @@
 
 use super::problem::{ActionModel, DynamicsHessian};
 use super::robot::FloatingRobot;
+use super::workspace::HessianWork;
 use crate::error::{FfError, Result};
-use nalgebra::{DMatrix, DVector};
 
 /// Step of the central differences of the analytic gradient (≈ ε^(1/3)).
 const H: f64 = 6e-6;
-
-/// Scratch of the step Hessian (allocated on the first full-DDP call, then reused).
-#[derive(Clone, Debug)]
-pub(crate) struct HessianWork {
-    fx: DMatrix<f64>,
-    fu: DMatrix<f64>,
-    xp: Vec<f64>,
-    up: Vec<f64>,
-    dz: Vec<f64>,
-    lambda: DVector<f64>,
-    g_plus: DVector<f64>,
-    g_minus: DVector<f64>,
-    h: DMatrix<f64>,
-}
-
-impl HessianWork {
-    pub(crate) fn new(nx: usize, ndx: usize, nu: usize) -> HessianWork {
-        HessianWork {
-            fx: DMatrix::zeros(ndx, ndx),
-            fu: DMatrix::zeros(ndx, nu),
-            xp: vec![0.0; nx],
-            up: vec![0.0; nu],
-            dz: vec![0.0; ndx + nu],
-            lambda: DVector::zeros(ndx),
-            g_plus: DVector::zeros(ndx + nu),
-            g_minus: DVector::zeros(ndx + nu),
-            h: DMatrix::zeros(ndx + nu, ndx + nu),
-        }
-    }
-}
 
 impl FloatingRobot {
     /// `g = [Fx Fu]ᵀ λ` (λ in `w.lambda`) at (x ⊕ δx, u + δu), the perturbation `w.dz` = [δx; δu].

@@ -14,11 +14,11 @@
 //! identity for scalar joints. The derivatives' tangent of q (base displacement and rotation vector in base
 //! axes) agrees with the SE(3) local tangent to first order, which is all a Jacobian sees.
 
-use super::lie::{exp6, se3_right_jacobian_inv};
 use super::robot::FloatingRobot;
 use crate::dynamics::derivatives::aba_derivatives;
 use crate::error::{FfError, Result};
 use crate::model::JointType;
+use crate::spatial::lie::{exp6, se3_right_jacobian_inv};
 use crate::spatial::{skew, M6, V6};
 use nalgebra::DMatrix;
 

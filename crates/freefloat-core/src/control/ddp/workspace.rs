@@ -136,3 +136,34 @@ impl Workspace {
         self.gaps.iter().map(|g| g.amax()).fold(0.0, f64::max)
     }
 }
+
+/// Scratch of the robot's step Hessian (`step_hessian`; allocated on the first full-DDP call, then reused). Here,
+/// not in `step_hessian`, so that the robot, which owns one, does not import the module that uses it.
+#[derive(Clone, Debug)]
+pub(crate) struct HessianWork {
+    pub(crate) fx: DMatrix<f64>,
+    pub(crate) fu: DMatrix<f64>,
+    pub(crate) xp: Vec<f64>,
+    pub(crate) up: Vec<f64>,
+    pub(crate) dz: Vec<f64>,
+    pub(crate) lambda: DVector<f64>,
+    pub(crate) g_plus: DVector<f64>,
+    pub(crate) g_minus: DVector<f64>,
+    pub(crate) h: DMatrix<f64>,
+}
+
+impl HessianWork {
+    pub(crate) fn new(nx: usize, ndx: usize, nu: usize) -> HessianWork {
+        HessianWork {
+            fx: DMatrix::zeros(ndx, ndx),
+            fu: DMatrix::zeros(ndx, nu),
+            xp: vec![0.0; nx],
+            up: vec![0.0; nu],
+            dz: vec![0.0; ndx + nu],
+            lambda: DVector::zeros(ndx),
+            g_plus: DVector::zeros(ndx + nu),
+            g_minus: DVector::zeros(ndx + nu),
+            h: DMatrix::zeros(ndx + nu, ndx + nu),
+        }
+    }
+}

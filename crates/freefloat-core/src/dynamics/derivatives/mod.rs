@@ -32,12 +32,11 @@
 //! Universal joints are not supported (their subspace depends on q); the entry points say so.
 
 mod frame;
-mod lie;
 mod rnea_derivatives;
 mod step;
 
+pub use crate::config::{difference, difference_jacobians, integrate, integrate_jacobians};
 pub use frame::{frame_dq_pose_derivatives, frame_log_error_derivatives, se3_log, se3_log_jacobian};
-pub use lie::{difference, difference_jacobians, integrate, integrate_jacobians};
 pub use rnea_derivatives::{aba_derivatives, rnea_derivatives};
 pub(crate) use rnea_derivatives::{cholesky_inverse, dot};
 pub use step::{step, step_derivatives, Scheme};

@@ -13,10 +13,10 @@
 //! For an under-actuated system with `τ = B u`, use `Fu · B` (for a free-floating robot whose base
 //! is not actuated: the last nv − 6 columns of `Fu`).
 
-use super::lie::{integrate_jacobians_unchecked, integrate_unchecked, tangent_map, tangent_map_jacobians};
 use super::rnea_derivatives::aba_derivatives_unchecked;
 use super::{check_workspace, gemm, Derivatives};
 use crate::check::{check_args, with_unit_q, Args};
+use crate::config::{integrate_jacobians_unchecked, integrate_unchecked, tangent_map, tangent_map_jacobians};
 use crate::data::Data;
 use crate::dynamics::hybrid_aba_unchecked;
 use crate::error::{FfError, Result};
@@ -254,6 +254,13 @@ fn euler(
 /// `q⁺ = q ⊕ h Σ b_s K_s`, `v⁺ = v + h Σ b_s a_s`. Derivatives by the chain rule through every
 /// stage: `∂q_s = J_q(δ_s)[I 0] + J_δ(δ_s) ∂δ_s`, `∂a_s = A_q ∂q_s + A_v ∂v_s (+ M⁻¹ for u)`,
 /// `∂K_s = T_δ ∂δ_s + T_v ∂v_s`.
+///
+/// This is RK4's stage loop written out, not the engine's `rk::step` (which the simulator, the concurrent-learning
+/// driver and the adaptive controller share): each stage here also carries its Jacobians (nv × 2nv and nv × nv
+/// matrices), propagated by the chain rule through the same recursion, `∂δ_{s+1} = c_{s+1} h ∂K_s`, and the stage
+/// lives in the derivatives' chart (`config::integrate`, `config::tangent_map`), so its states and rates are not the
+/// simulator's rows. `tests/test_derivatives.py::test_rk4_step_is_the_simulators_step` checks that its step is the
+/// simulator's to 1e-12.
 #[allow(clippy::too_many_arguments)]
 fn rk4(
     m: &Model,

@@ -16,6 +16,7 @@ use crate::dynamics::hybrid_aba_unchecked;
 use crate::error::{FfError, Partial, Result};
 use crate::interrupt::{Hook, Poller, POLL_INTERVAL};
 use crate::model::{JointType, Model};
+use crate::rk::{self, RK4};
 
 /// The joint actuation of (9.28): `amplitude · sin(frequency · t + phase)` on every joint DOF (N for a
 /// prismatic joint, N·m otherwise) for `t_start ≤ t ≤ t_end`, zero elsewhere; the base is unactuated.
@@ -189,16 +190,12 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
     let (mut q, mut v) = (q0, sc.v0.clone());
     let (mut qs, mut vs) = (vec![0.0; nq], vec![0.0; nv]);
     let mut tau = vec![0.0; nv];
-    let mut kq = vec![vec![0.0; nv]; 4];
-    let mut kv = vec![vec![0.0; nv]; 4];
-    let mut dq = vec![0.0; nv];
-    let mut dv = vec![0.0; nv];
+    // one row per RK4 stage: [rate of the configuration's tangent coordinates (nv) | acceleration (nv)]
+    let mut stages = vec![vec![0.0; 2 * nv]; 4];
+    let mut delta = vec![0.0; 2 * nv];
     let mut est_row = vec![0.0; np];
     let exact = sc.noise.is_zero();
     let mut max_res: f64 = 0.0;
-    const A: [[f64; 3]; 4] = [[0.0; 3], [0.5, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 1.0]];
-    const C: [f64; 4] = [0.0, 0.5, 0.5, 1.0];
-    const B: [f64; 4] = [1.0 / 6.0, 1.0 / 3.0, 1.0 / 3.0, 1.0 / 6.0];
     let report_every = (steps / 200).max(1);
     let mut last_report = std::time::Instant::now();
 
@@ -244,42 +241,29 @@ pub fn run_cl(m: &Model, sc: &ClScenario, mut progress: Option<ProgressFn>) -> R
         }
         // the estimator over [t, t + dt]
         est.step(sc.dt)?;
-        // the robot over [t, t + dt]: RKMK with the classical RK4 tableau
-        tangent_rate_unchecked(m, &q, &v, &mut kq[0]);
-        kv[0].copy_from_slice(&d.dq.out.ddq);
-        for s in 1..4 {
-            for j in 0..nv {
-                let (mut sq, mut sv) = (0.0, 0.0);
-                for (l, a) in A[s].iter().enumerate().take(s) {
-                    sq += a * kq[l][j];
-                    sv += a * kv[l][j];
-                }
-                dq[j] = sc.dt * sq;
-                dv[j] = sc.dt * sv;
-            }
-            retract(m, &q, &dq, &mut qs);
+        // the robot over [t, t + dt]: RKMK with the classical RK4 tableau (the engine's one stage loop, `rk::step`)
+        let (kq0, kv0) = stages[0].split_at_mut(nv);
+        tangent_rate_unchecked(m, &q, &v, kq0);
+        kv0.copy_from_slice(&d.dq.out.ddq);
+        rk::step(&RK4, t, sc.dt, &mut stages, &mut delta, |_, ts, dl, ks| {
+            let (dq, dv) = dl.split_at(nv);
+            retract(m, &q, dq, &mut qs);
             for j in 0..nv {
                 vs[j] = v[j] + dv[j];
             }
-            e.fill(m, t + C[s] * sc.dt, &mut tau);
+            e.fill(m, ts, &mut tau);
             // intermediate stages need accelerations only: the engine's ABA (same dynamics as the
             // dual-quaternion solver to round-off, tests/dqdynamics.rs, and ~8x cheaper)
             hybrid_aba_unchecked(m, &mut d, &qs, &vs, &tau, None, None)?;
-            tangent_rate_unchecked(m, &qs, &vs, &mut kq[s]);
-            kv[s].copy_from_slice(&d.ddq);
+            let (kq, kv) = ks.split_at_mut(nv);
+            tangent_rate_unchecked(m, &qs, &vs, kq);
+            kv.copy_from_slice(&d.ddq);
             // RKMK: the stage's tangent rate is mapped back through dexp⁻¹ of the stage increment
-            dexpinv(m, &dq, &mut kq[s]);
-        }
-        for j in 0..nv {
-            let (mut sq, mut sv) = (0.0, 0.0);
-            for l in 0..4 {
-                sq += B[l] * kq[l][j];
-                sv += B[l] * kv[l][j];
-            }
-            dq[j] = sc.dt * sq;
-            dv[j] = sc.dt * sv;
-        }
-        retract(m, &q, &dq, &mut qs);
+            dexpinv(m, dq, kq);
+            Ok(())
+        })?;
+        let (dq, dv) = delta.split_at(nv);
+        retract(m, &q, dq, &mut qs);
         std::mem::swap(&mut q, &mut qs);
         for j in 0..nv {
             v[j] += dv[j];
