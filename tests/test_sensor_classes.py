@@ -76,11 +76,12 @@ def test_each_seed_is_another_sample_of_the_chaotic_capture_motion():
 
 def test_a_mems_joint_sensor_is_what_breaks_the_momentum_form(zhang_tactical):
     """The MEMS preset's joint rates (a 14-bit magnetic encoder differenced at 100 Hz: 0.15 rad/s) make the
-    momentum form fail; the navigation preset is at least as good as the tactical one on mass."""
+    momentum form fail; with the navigation preset it is well within the target. (The force form's error depends on
+    the particular motion even at this class, so one motion says little about it: see the spread test above.)"""
     mems = scl.run("zhang", "mems", 0)
     nav = scl.run("zhang", "navigation", 0)
     assert mems["zhang_momentum.inertia.100"] > 0.3
-    assert nav["zhang_momentum.inertia.100"] < 0.05 and nav["zhang_force.inertia.100"] < 0.05
+    assert nav["zhang_momentum.inertia.100"] < 0.05 and nav["zhang_momentum.mass.100"] < 0.01
 
 
 def test_summary_is_the_median_and_95th_percentile_over_the_runs():
