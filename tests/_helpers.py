@@ -107,3 +107,47 @@ def sigint_when(
     for th in readers:
         th.join(5)
     return Interrupted(p.returncode, took, "".join(err), "".join(out), sent - t0)
+
+
+def cycles(graph: dict) -> list[set]:
+    """The import cycles of a directed graph {node: iterable of the nodes it imports}: its strongly connected
+    components with more than one node (Tarjan's algorithm, iterative, so a deep import chain cannot overflow the
+    stack). Used by the import-direction tests of the Python package and of the Rust engine."""
+    index: dict = {}
+    low: dict = {}
+    stack: list = []
+    on_stack: set = set()
+    out: list[set] = []
+    for root in list(graph):
+        if root in index:
+            continue
+        work = [(root, iter(graph.get(root, ())))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            v, it = work[-1]
+            for w in it:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on_stack.add(w)
+                    work.append((w, iter(graph.get(w, ()))))
+                    break
+                if w in on_stack:
+                    low[v] = min(low[v], index[w])
+            else:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[v])
+                if low[v] == index[v]:
+                    comp = set()
+                    while True:
+                        w = stack.pop()
+                        on_stack.discard(w)
+                        comp.add(w)
+                        if w == v:
+                            break
+                    if len(comp) > 1:
+                        out.append(comp)
+    return out

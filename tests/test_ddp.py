@@ -309,35 +309,16 @@ def ddp_scenarios_dir():
 
 
 def criteria(prob: ddp.Problem, sol: dict) -> dict:
-    """The numbers of D.18-D.22 from the solution's states and controls: end-effector pose errors from the engine's
-    chain dual quaternion against the reference (final hold t >= t_f - 5 s, phase 2 of the tracking t in [7, 27] s,
-    the final node), the base twist's peaks (first six velocities, base axes), the summed squared base force and
-    torque, and the keep-out joints' fraction of nodes within 1 deg of zero."""
-    from freefloat import _core
+    """The numbers of D.18-D.22 from the solution's states and controls (`tools/ddp_thesis_table.py`, which prints
+    the tables of docs/ddp.md from the same function; it does not use `ddp.results`)."""
+    import importlib.util
+    from pathlib import Path
 
-    m, xs, us = prob.model, np.asarray(sol["xs"]), np.asarray(sol["us"])
-    g = _core.ddp_frame_dual_quats(m._core, np.ascontiguousarray(xs[:, : m.nq]), prob.frame)
-    e = ddp.pose_errors(g, prob.reference_dq)
-    pos, ang = np.linalg.norm(e["position"], axis=1), np.degrees(e["angle"])
-    t = np.arange(len(xs)) * prob.dt
-    hold, move = t >= t[-1] - 5 - 1e-9, (t >= 7) & (t <= 27)
-    vb = xs[:, m.nq : m.nq + 6]
-    dwell = {}
-    for j in ("shoulder", "elbow"):
-        theta = xs[:-1, m.idx_q[m.joint_names.index(j)]]
-        dwell[j] = float(np.mean(np.abs(np.angle(np.exp(1j * theta))) < math.radians(1.0)))
-    return {
-        "hold_pos": pos[hold].max(),
-        "hold_ang": ang[hold].max(),
-        "move_rms": float(np.sqrt(np.mean(pos[move] ** 2))),
-        "final_pos": pos[-1],
-        "final_ang": ang[-1],
-        "base_speed": np.linalg.norm(vb[:, :3], axis=1).max(),
-        "base_rate": np.linalg.norm(vb[:, 3:], axis=1).max(),
-        "f2": float(np.sum(us[:, :3] ** 2)),
-        "tau2": float(np.sum(us[:, 3:6] ** 2)),
-        "dwell": dwell,
-    }
+    path = Path(__file__).resolve().parents[1] / "tools" / "ddp_thesis_table.py"
+    spec = importlib.util.spec_from_file_location("ddp_thesis_table", path)
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    return tool.criteria(prob, sol)
 
 
 @pytest.fixture(scope="module")

@@ -17,6 +17,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from _helpers import cycles
+
 SRC = Path(__file__).resolve().parents[1] / "crates" / "freefloat-core" / "src"
 
 # Bottom first. Keep in step with docs/architecture.md ("Engine layers").
@@ -262,42 +264,7 @@ def test_no_cycle_between_files() -> None:
     graph: dict[Path, list[tuple[Path, int, str]]] = {}
     for a, b, lineno, line in edges():
         graph.setdefault(a, []).append((b, lineno, line))
-    # Tarjan's strongly connected components, then one cycle of each component spelled out
-    index: dict[Path, int] = {}
-    low: dict[Path, int] = {}
-    stack: list[Path] = []
-    on: set[Path] = set()
-    comps: list[list[Path]] = []
-    counter = [0]
-
-    def visit(v: Path) -> None:
-        index[v] = low[v] = counter[0]
-        counter[0] += 1
-        stack.append(v)
-        on.add(v)
-        for w, _, _ in graph.get(v, []):
-            if w not in index:
-                visit(w)
-                low[v] = min(low[v], low[w])
-            elif w in on:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            comp = []
-            while True:
-                w = stack.pop()
-                on.discard(w)
-                comp.append(w)
-                if w == v:
-                    break
-            if len(comp) > 1:
-                comps.append(comp)
-
-    import sys
-
-    sys.setrecursionlimit(10000)
-    for v in list(graph):
-        if v not in index:
-            visit(v)
+    comps = cycles({a: [b for b, _, _ in es] for a, es in graph.items()})
     msgs = []
     for comp in comps:
         members = set(comp)

@@ -24,6 +24,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+from _helpers import cycles
+
 ROOT = Path(__file__).resolve().parent.parent / "python" / "freefloat"
 
 # The layer order (docs/architecture.md): a module may import from its own layer and the layers before it. A module
@@ -168,34 +170,9 @@ def test_every_module_has_a_layer():
 
 def test_no_import_cycle():
     graph = {m: sorted({t for t, _, _ in es if t in MODULES}) for m, es in EDGES.items()}
-    index, low, stack, on_stack, cycles = {}, {}, [], set(), []
-
-    def strong(v):  # Tarjan's strongly connected components
-        index[v] = low[v] = len(index)
-        stack.append(v)
-        on_stack.add(v)
-        for w in graph.get(v, ()):
-            if w not in index:
-                strong(w)
-                low[v] = min(low[v], low[w])
-            elif w in on_stack:
-                low[v] = min(low[v], index[w])
-        if low[v] == index[v]:
-            comp = set()
-            while True:
-                w = stack.pop()
-                on_stack.discard(w)
-                comp.add(w)
-                if w == v:
-                    break
-            if len(comp) > 1:
-                cycles.append(comp)
-
-    for m in sorted(graph):
-        if m not in index:
-            strong(m)
+    found = cycles(graph)
     msgs = []
-    for comp in cycles:
+    for comp in found:
         edges = [
             f"{m} imports {t}{f' ({n})' if n else ''} at {_where(m, line)}"
             for m in sorted(comp)
@@ -249,3 +226,14 @@ def test_the_checker_sees_function_level_imports_and_skips_type_checking_ones():
     assert "freefloat.postcapture.plots" in {t for t, _, _ in EDGES["freefloat.postcapture.results"]}
     assert "freefloat.postcapture.results" not in {t for t, _, _ in EDGES["freefloat.postcapture.plots"]}
     assert len(EDGES) > 90, "the AST walk found too few modules: the checks would be vacuous"
+
+
+def test_the_cycle_finder_finds_every_cycle_and_nothing_else():
+    """`_helpers.cycles` (used here and by the engine's layer test): two cycles, a tail out of one, a self-contained
+    chain, and a chain long enough to overflow a recursive search."""
+    g = {"a": ["b"], "b": ["c"], "c": ["a", "d"], "d": [], "e": ["f"], "f": ["e"], "x": ["y"], "y": []}
+    assert sorted(map(sorted, cycles(g))) == [["a", "b", "c"], ["e", "f"]]
+    chain = {i: [i + 1] for i in range(20_000)}
+    assert cycles(chain) == []
+    chain[20_000] = [0]
+    assert [len(c) for c in cycles(chain)] == [20_001]

@@ -101,21 +101,27 @@ fn ddp_iterations_allocate_nothing() {
     assert_eq!(a2, a6, "4 more iterations allocated {} times", a6 as i64 - a2 as i64);
 }
 
+/// Allocations of one node's `calc` and `calc_diff` after a warm-up call of each.
+fn node_allocations(rob: &mut FloatingRobot, x0: &[f64]) -> (usize, usize) {
+    let mut xn = vec![0.0; 25];
+    let u = vec![0.1; 12];
+    let mut d = freefloat_core::control::ddp::NodeDiff::zeros(24, 12);
+    rob.calc(0, x0, &u, &mut xn).unwrap();
+    rob.calc_diff(0, x0, &u, &mut d).unwrap();
+    let a = count(|| {
+        rob.calc(0, x0, &u, &mut xn).unwrap();
+    });
+    let b = count(|| {
+        rob.calc_diff(0, x0, &u, &mut d).unwrap();
+    });
+    (a, b)
+}
+
 #[test]
 fn which_block_allocates() {
     let n = 6;
     let (mut rob, x0) = robot(n);
-    let mut xn = vec![0.0; 25];
-    let u = vec![0.1; 12];
-    let mut d = freefloat_core::control::ddp::NodeDiff::zeros(24, 12);
-    rob.calc(0, &x0, &u, &mut xn).unwrap();
-    rob.calc_diff(0, &x0, &u, &mut d).unwrap();
-    let a = count(|| {
-        rob.calc(0, &x0, &u, &mut xn).unwrap();
-    });
-    let b = count(|| {
-        rob.calc_diff(0, &x0, &u, &mut d).unwrap();
-    });
+    let (a, b) = node_allocations(&mut rob, &x0);
     let c = count(|| {
         rob.calc_terminal(&x0).unwrap();
     });
@@ -136,16 +142,5 @@ fn the_rate_driven_wrist_and_the_nearest_sign_allocate_nothing() {
         }
     }
     rob.set_rate_driven(3).unwrap();
-    let mut xn = vec![0.0; 25];
-    let u = vec![0.1; 12];
-    let mut d = freefloat_core::control::ddp::NodeDiff::zeros(24, 12);
-    rob.calc(0, &x0, &u, &mut xn).unwrap();
-    rob.calc_diff(0, &x0, &u, &mut d).unwrap();
-    let a = count(|| {
-        rob.calc(0, &x0, &u, &mut xn).unwrap();
-    });
-    let b = count(|| {
-        rob.calc_diff(0, &x0, &u, &mut d).unwrap();
-    });
-    assert_eq!((a, b), (0, 0));
+    assert_eq!(node_allocations(&mut rob, &x0), (0, 0));
 }
