@@ -20,14 +20,7 @@ impl Model {
             return Ok(self.clone());
         }
         let mut m = self.clone();
-        let mut new_index = vec![usize::MAX; n];
-        let mut k = 0;
-        for i in 0..n {
-            if !merged[i] {
-                new_index[i] = k;
-                k += 1;
-            }
-        }
+        let new_index = kept_index(&merged);
         let mut inertias = self.inertias.clone();
         let mut frames: Vec<Frame> = Vec::new();
         for i in (0..n).filter(|&i| merged[i]) {
@@ -45,13 +38,44 @@ impl Model {
             }
         }
         m.inertias = inertias;
-        // the per-body lists without the merged bodies
+        m.drop_bodies(&merged);
+        m.frames = frames;
+        m.finalize()?;
+        m.id = super::next_model_id();
+        Ok(m)
+    }
+
+    /// The model of its first `n` bodies: the last `nbodies − n` bodies (a subtree closed under descendants, since
+    /// every parent precedes its children) and the frames on them are dropped, the rest keeps its layout (q and v
+    /// of the kept joints are the leading entries of the full model's). The dynamics of the rest equal the full
+    /// model's when the dropped bodies are massless: what the DDP robot of Valverde 2018 ch. 8 needs for its
+    /// massless wrist driven by Euler-angle rates (§8.4, eq. (8.51)). A new layout identity.
+    pub fn leading_bodies(&self, n: usize) -> Result<Model> {
+        if n == 0 || n > self.nbodies() {
+            return Err(FfError::arg("n", format!("keep between 1 and {} bodies, got {n}", self.nbodies())));
+        }
+        if n == self.nbodies() {
+            return Ok(self.clone());
+        }
+        let mut m = self.clone();
+        m.drop_bodies(&(0..self.nbodies()).map(|i| i >= n).collect::<Vec<_>>());
+        m.frames.retain(|f| f.body < n);
+        m.finalize()?;
+        m.id = super::next_model_id();
+        Ok(m)
+    }
+
+    /// Remove the bodies with `drop[i]` from every per-body list and renumber the parents of the rest (which must
+    /// not be dropped bodies: callers drop leaves or whole tails). The frames and the derived layout are the
+    /// caller's to redo (`finalize`).
+    fn drop_bodies(&mut self, drop: &[bool]) {
+        let new_index = kept_index(drop);
         macro_rules! keep_all {
             ($($f:ident),*) => { $( {
                 let mut j = 0;
-                m.$f.retain(|_| {
+                self.$f.retain(|_| {
                     j += 1;
-                    !merged[j - 1]
+                    !drop[j - 1]
                 });
             } )* };
         }
@@ -68,43 +92,23 @@ impl Model {
             tags,
             allow_nonphysical
         );
-        for p in m.parents.iter_mut() {
+        for p in self.parents.iter_mut() {
             *p = p.map(|x| new_index[x]);
         }
-        m.frames = frames;
-        m.finalize()?;
-        m.id = super::next_model_id();
-        Ok(m)
     }
-    /// The model of its first `n` bodies: the last `nbodies − n` bodies (a subtree closed under descendants, since
-    /// every parent precedes its children) and the frames on them are dropped, the rest keeps its layout (q and v
-    /// of the kept joints are the leading entries of the full model's). The dynamics of the rest equal the full
-    /// model's when the dropped bodies are massless: what the DDP robot of Valverde 2018 ch. 8 needs for its
-    /// massless wrist driven by Euler-angle rates (§8.4, eq. (8.51)). A new layout identity.
-    pub fn leading_bodies(&self, n: usize) -> Result<Model> {
-        if n == 0 || n > self.nbodies() {
-            return Err(FfError::arg("n", format!("keep between 1 and {} bodies, got {n}", self.nbodies())));
+}
+
+/// The new index of each body once the ones with `drop[i]` are removed (`usize::MAX` for those).
+fn kept_index(drop: &[bool]) -> Vec<usize> {
+    let mut out = vec![usize::MAX; drop.len()];
+    let mut k = 0;
+    for (i, &d) in drop.iter().enumerate() {
+        if !d {
+            out[i] = k;
+            k += 1;
         }
-        if n == self.nbodies() {
-            return Ok(self.clone());
-        }
-        let mut m = self.clone();
-        m.body_names.truncate(n);
-        m.joint_names.truncate(n);
-        m.parents.truncate(n);
-        m.joint_types.truncate(n);
-        m.axes.truncate(n);
-        m.axes2.truncate(n);
-        m.placements.truncate(n);
-        m.inertias.truncate(n);
-        m.limits.truncate(n);
-        m.tags.truncate(n);
-        m.allow_nonphysical.truncate(n);
-        m.frames.retain(|f| f.body < n);
-        m.finalize()?;
-        m.id = super::next_model_id();
-        Ok(m)
     }
+    out
 }
 
 #[cfg(test)]
