@@ -205,3 +205,50 @@ def test_one_registry_of_scenario_kinds():
     assert list(scenario_files.KINDS) == [k for k in schema.kinds() if k != "campaign"]
     for s in scenario_files.listing():
         assert s.kind in scenario_files.KINDS
+
+
+def test_sensor_blocks_are_the_sensor_classes_and_the_engine_reads_the_same_keys_and_defaults():
+    """Each entry type of a `sensors:` block has exactly the fields of its class (freefloat.sensors.Gyro, ...) plus
+    the `type` key, with the class's defaults (made from the class: a field exists once). The engine, which runs
+    the sensors, reads every one of those keys (a wrong value is refused naming it) and has the same defaults (a
+    sensor with every default written out measures exactly what the bare sensor measures)."""
+    import dataclasses
+    import json
+
+    from freefloat import _core, models
+    from freefloat import sensors as sn
+    from freefloat.io import scenario_schemas as ss
+
+    assert set(ss.SENSOR_TYPES) == set(sn.TYPES) == {"gyro", "star_tracker", "encoder", "tachometer",
+                                                      "base_velocity", "base_position", "force_torque"}  # fmt: skip
+    m = models.load("naveen_dual_arm")
+    n, dt = 200, 1e-3
+    rng = np.random.default_rng(0)
+    q = np.zeros((n, m.nq))
+    q[:, 6] = 1.0
+    q[:, 7:] = 0.1 * rng.standard_normal(m.nq - 7)
+    v = 0.05 * rng.standard_normal((n, m.nv))
+    run = {"t": np.arange(n) * dt, "q": q, "v": v, "ddq": np.zeros((n, m.nv))}
+    joint = m.joint_names[1]
+    for t, cls in sn.TYPES.items():
+        block = ss.SENSOR_TYPES[t]
+        fields = {f.name: f for f in dataclasses.fields(cls)}
+        assert set(block.model_fields) == set(fields) | {"type"}, t
+        assert block.model_fields["type"].is_required()
+        for name, f in fields.items():
+            mf = block.model_fields[name]
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+                assert mf.is_required(), (t, name)
+            else:
+                assert mf.default == f.default, (t, name)
+        required = {"joint": joint} if t == "force_torque" else {}
+        bare = {"type": t, **required}
+        explicit = cls(**required).to_dict()  # every default that is a value, written out
+        assert set(explicit) - {"type"} <= set(fields)
+        assert json.loads(sn.SensorSet([explicit]).to_json()) == [explicit]
+        a = sn.measure(m, run, [bare], seed=5).streams[t].values
+        b = sn.measure(m, run, [explicit], seed=5).streams[t].values
+        np.testing.assert_array_equal(a, b, err_msg=t)
+        for name in fields:
+            with pytest.raises(InputError, match=name):
+                _core.check_sensors(json.dumps([{**bare, name: {"not": "a value"}}]))

@@ -6,17 +6,36 @@ control of spacecraft robotic systems using dual quaternions").
   (`.control(t, q_bd, w_bd)` -> dual force, `.update(t, dt, q_bd, w_bd, w_bd_dot, force)`, `.estimate`),
   `adaptive.run(scenario)` for the thesis' examples (`freefloat control adaptive SCENARIO`), and
   `realisability(v)`, whether a parameter vector `[I11, I12, I13, I22, I23, I33, m]` is a rigid body;
-- chapter 8: differential dynamic programming (DDP) for the multibody robot (not implemented yet);
-- chapter 9: concurrent-learning mass-property estimation during control (not implemented yet).
+- chapter 8 (`freefloat.control.ddp`): end-effector control of the multibody robot by differential dynamic
+  programming, open loop, closed loop (time-varying policy) and model-predictive (`freefloat control ddp
+  SCENARIO`; docs/ddp.md);
+- chapter 9, concurrent-learning mass-property estimation during control, is an estimator:
+  `freefloat.identification.concurrent` (`freefloat identify cl SCENARIO`).
 
 A multibody controller is a callable `f(t, q, v) -> tau` (generalized forces; for a free base the first six
 entries are the base-frame thruster wrench), so it plugs into `ff.simulate(..., controller=f,
 controller_period=dt)`; its numbers (laws, gradients) belong in the engine (`crates/freefloat-core/src/control/`),
 with this package driving them.
+
+Every module of this package is reachable as an attribute (`ff.control.ddp`) without being listed here: a new
+controller module needs no line in this file (docs/architecture.md, "Where new code goes").
 """
+
+import importlib
+import pkgutil
 
 from .._core import AdaptivePoseController
 from . import adaptive
 from .adaptive import realisability
 
-__all__: list[str] = ["AdaptivePoseController", "adaptive", "realisability"]
+#: the controller modules of this package (found on disk, so a new one is listed without editing this file)
+MODULES = sorted(m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_"))
+
+__all__: list[str] = ["AdaptivePoseController", "adaptive", "realisability", *(m for m in MODULES if m != "adaptive")]
+
+
+def __getattr__(name: str):
+    # import a controller module on first use (PEP 562): `ff.control.ddp` works without an import line here
+    if name in MODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

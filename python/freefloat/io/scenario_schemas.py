@@ -9,10 +9,12 @@ block shared by several kinds with `schema.register_block`."""
 from __future__ import annotations
 
 import math
+import typing
 from typing import Annotated
 
 from pydantic import BeforeValidator, Field, create_model, model_validator
 
+from ..sensors import TYPES as SENSOR_CLASSES
 from ..simulation import environment as env
 from ..simulation.actuators import BLOCKS as ACTUATOR_BLOCKS
 from .schema import (
@@ -25,6 +27,7 @@ from .schema import (
     Positive,
     Text,
     _Bad,
+    block_of,
     integer,
     literal,
     number,
@@ -628,21 +631,9 @@ class EnvironmentBlock(Block):
         return self
 
 
-class _SensorBase(Block):
-    name: Text | None = None
-    rate: Positive | None = None
-    latency: NonNegative = 0.0
-
-
-class SenGyro(_SensorBase):
-    type: literal("gyro")
-    noise_density: NonNegative | None = None
-    noise_per_sample: NonNegative | None = None
-    bias: numbers(3, scalar_ok=True) = None
-    bias_instability: NonNegative = 0.0
-    bias_correlation_time: Positive | None = None
-    rate_random_walk: NonNegative = 0.0
-
+# the keys of each sensor, their types, ranges and defaults: declared once, by the classes that run them
+# (`freefloat.sensors.Gyro`, ...); the file adds the `type` key that picks the class
+class _GyroChecks(Block):
     @model_validator(mode="after")
     def _one_noise(self):
         if not _TYPES_ONLY.get() and self.noise_density is not None and self.noise_per_sample is not None:
@@ -650,56 +641,18 @@ class SenGyro(_SensorBase):
         return self
 
 
-class SenStarTracker(_SensorBase):
-    type: literal("star_tracker")
-    sigma: numbers(3, scalar_ok=True, lo=0.0) = 0.0
-
-
-class SenEncoder(_SensorBase):
-    type: literal("encoder")
-    joints: list[Text] | None = None
-    counts_per_rev: Positive | None = None
-    resolution: Positive | None = None
-    noise: NonNegative = 0.0
-
-
-class SenTachometer(_SensorBase):
-    type: literal("tachometer")
-    joints: list[Text] | None = None
-    resolution: NonNegative = 0.0
-    noise: NonNegative = 0.0
-    bias: Number = 0.0
-
-
-class SenBaseVelocity(_SensorBase):
-    type: literal("base_velocity")
-    noise: NonNegOrNonNegs = 0.0
-    bias: numbers(3, scalar_ok=True) = None
-
-
-class SenBasePosition(_SensorBase):
-    type: literal("base_position")
-    noise: NonNegOrNonNegs = 0.0
-    bias: numbers(3, scalar_ok=True) = None
-
-
-class SenForceTorque(_SensorBase):
-    type: literal("force_torque")
-    joint: Text
-    force_noise: NonNegative = 0.0
-    torque_noise: NonNegative = 0.0
-    force_bias: numbers(3, scalar_ok=True) = None
-    torque_bias: numbers(3, scalar_ok=True) = None
-
-
+_SENSOR_CHECKS = {"gyro": _GyroChecks}
+#: the schema block of each sensor type, made from its class
 SENSOR_TYPES = {
-    c.model_fields["type"].annotation.__args__[0]: c
-    for c in (SenGyro, SenStarTracker, SenEncoder, SenTachometer, SenBaseVelocity, SenBasePosition, SenForceTorque)
+    t: block_of(
+        cls,
+        name=f"Sen{cls.__name__}",
+        base=_SENSOR_CHECKS.get(t),
+        tags={"type": literal(t)},
+    )
+    for t, cls in SENSOR_CLASSES.items()
 }
-Sensor = Annotated[
-    SenGyro | SenStarTracker | SenEncoder | SenTachometer | SenBaseVelocity | SenBasePosition | SenForceTorque,
-    Field(discriminator="type"),
-]
+Sensor = Annotated[typing.Union[tuple(SENSOR_TYPES.values())], Field(discriminator="type")]
 
 
 def _sensors_preset(x):

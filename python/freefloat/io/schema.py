@@ -209,14 +209,16 @@ def key(schema_type, default=dataclasses.MISSING, *, default_factory=dataclasses
     return dataclasses.field(default=default, default_factory=default_factory, metadata={"schema": schema_type})
 
 
-def block_of(cls, order=None, name: str | None = None) -> type[Block]:
+def block_of(cls, order=None, name: str | None = None, *, base: type[Block] | None = None, tags=None) -> type[Block]:
     """The schema block of a dataclass whose fields are declared with `key`: the same keys, defaults and
-    required keys, with their schema types, in `order` (the keys as the engine lists them; default: the class's)."""
+    required keys, with their schema types, in `order` (the keys as the engine lists them; default: the class's).
+    `base`: a Block subclass carrying cross-key checks; `tags`: required keys the file has but the class does not
+    (a sensor's `type`, which is the class itself), as {key: schema type}, listed first."""
     fs = {f.name: f for f in dataclasses.fields(cls)}
     names = list(order) if order is not None else list(fs)
     if sorted(names) != sorted(fs):
         raise TypeError(f"{cls.__name__}: schema order {names} is not its fields {list(fs)}")
-    spec = {}
+    spec = {k: (t, ...) for k, t in (tags or {}).items()}
     for n in names:
         f = fs[n]
         if "schema" not in f.metadata:
@@ -228,7 +230,7 @@ def block_of(cls, order=None, name: str | None = None) -> type[Block]:
         else:
             default = ...
         spec[n] = (f.metadata["schema"], default)
-    return create_model(name or f"{cls.__name__}Block", __base__=Block, **spec)
+    return create_model(name or f"{cls.__name__}Block", __base__=base or Block, **spec)
 
 
 # -- registry ------------------------------------------------------------------------------------------------

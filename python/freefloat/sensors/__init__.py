@@ -26,6 +26,12 @@ import numpy as np
 from .. import _core
 from .._core import InputError
 from ..constants import SIGMA_ANG, SIGMA_JOINT, SIGMA_LIN
+from ..io.schema import NonNegative, Number, Positive, Text, key, numbers
+
+# The keys of each sensor, their schema types, ranges and defaults: declared once, here, by the classes that run
+# them; the scenario files' `sensors:` block (`io/scenario_schemas.py`) is made from these classes (`schema.block_of`).
+_VEC3_OR_ONE = numbers(3, scalar_ok=True)
+_NONNEG_OR_NONNEGS = numbers(scalar_ok=True, lo=0.0)
 
 __all__ = [
     "Gyro",
@@ -36,6 +42,7 @@ __all__ = [
     "BasePosition",
     "ForceTorque",
     "SensorSet",
+    "TYPES",
     "Stream",
     "Measurement",
     "PRESETS",
@@ -57,11 +64,11 @@ __all__ = [
 @dataclass
 class _Sensor:
     #: sample rate [Hz]; None: every sample of the run
-    rate: float | None = None
+    rate: float | None = key(Positive | None, None)
     #: delay between the instant measured and its time stamp [s]
-    latency: float = 0.0
+    latency: float = key(NonNegative, 0.0)
     #: unique name (default: the type)
-    name: str | None = None
+    name: str | None = key(Text | None, None)
 
     TYPE = ""
 
@@ -77,13 +84,13 @@ class Gyro(_Sensor):
     [rad/s/√Hz], constant `bias` [rad/s] (one number or three), `bias_instability` B [rad/s] as a Gauss-Markov
     bias of `bias_correlation_time` [s], `rate_random_walk` K [rad/s/√s]."""
 
-    noise_density: float | None = None
+    noise_density: float | None = key(NonNegative | None, None)
     #: the white noise as a per-sample standard deviation [rad/s] instead of a density (exclusive with it)
-    noise_per_sample: float | None = None
-    bias: float | list | None = None
-    bias_instability: float = 0.0
-    bias_correlation_time: float | None = None
-    rate_random_walk: float = 0.0
+    noise_per_sample: float | None = key(NonNegative | None, None)
+    bias: float | list | None = key(_VEC3_OR_ONE, None)
+    bias_instability: float = key(NonNegative, 0.0)
+    bias_correlation_time: float | None = key(Positive | None, None)
+    rate_random_walk: float = key(NonNegative, 0.0)
     TYPE = "gyro"
 
 
@@ -92,7 +99,7 @@ class StarTracker(_Sensor):
     """Base attitude with a small random rotation of standard deviation `sigma` [rad] about the base x, y, z
     axes (one number or three)."""
 
-    sigma: float | list = 0.0
+    sigma: float | list = key(numbers(3, scalar_ok=True, lo=0.0), 0.0)
     TYPE = "star_tracker"
 
 
@@ -101,10 +108,10 @@ class Encoder(_Sensor):
     """Joint angles rounded to `counts_per_rev` (or a `resolution` [rad or m]), with white `noise` before
     quantisation. `joints`: names (None: every revolute/prismatic joint)."""
 
-    joints: list | None = None
-    counts_per_rev: float | None = None
-    resolution: float | None = None
-    noise: float = 0.0
+    joints: list | None = key(list[Text] | None, None)
+    counts_per_rev: float | None = key(Positive | None, None)
+    resolution: float | None = key(Positive | None, None)
+    noise: float = key(NonNegative, 0.0)
     TYPE = "encoder"
 
 
@@ -113,10 +120,10 @@ class Tachometer(_Sensor):
     """Joint (wheel) rates with white `noise` [rad/s per sample], constant `bias`, quantised to `resolution`
     [rad/s] (0: none). `joints`: names (None: every revolute/prismatic joint)."""
 
-    joints: list | None = None
-    resolution: float = 0.0
-    noise: float = 0.0
-    bias: float = 0.0
+    joints: list | None = key(list[Text] | None, None)
+    resolution: float = key(NonNegative, 0.0)
+    noise: float = key(NonNegative, 0.0)
+    bias: float = key(Number, 0.0)
     TYPE = "tachometer"
 
 
@@ -124,8 +131,8 @@ class Tachometer(_Sensor):
 class BaseVelocity(_Sensor):
     """Base linear velocity (base frame) with white `noise` [m/s per sample] and `bias` [m/s]."""
 
-    noise: float | list = 0.0
-    bias: float | list | None = None
+    noise: float | list = key(_NONNEG_OR_NONNEGS, 0.0)
+    bias: float | list | None = key(_VEC3_OR_ONE, None)
     TYPE = "base_velocity"
 
 
@@ -133,25 +140,27 @@ class BaseVelocity(_Sensor):
 class BasePosition(_Sensor):
     """Base position (inertial frame) with white `noise` [m per sample] and `bias` [m]."""
 
-    noise: float | list = 0.0
-    bias: float | list | None = None
+    noise: float | list = key(_NONNEG_OR_NONNEGS, 0.0)
+    bias: float | list | None = key(_VEC3_OR_ONE, None)
     TYPE = "base_position"
 
 
-@dataclass
+@dataclass(kw_only=True)
 class ForceTorque(_Sensor):
     """Six-axis force/torque sensor measuring the wrench `joint` transmits to its child body (child frame),
-    with white `force_noise` [N], `torque_noise` [N·m] and biases."""
+    with white `force_noise` [N], `torque_noise` [N·m] and biases. `joint` is required (keyword-only: the
+    sensor has no sensible default joint)."""
 
-    joint: str = ""
-    force_noise: float = 0.0
-    torque_noise: float = 0.0
-    force_bias: float | list | None = None
-    torque_bias: float | list | None = None
+    joint: str = key(Text)
+    force_noise: float = key(NonNegative, 0.0)
+    torque_noise: float = key(NonNegative, 0.0)
+    force_bias: float | list | None = key(_VEC3_OR_ONE, None)
+    torque_bias: float | list | None = key(_VEC3_OR_ONE, None)
     TYPE = "force_torque"
 
 
-_TYPES = {c.TYPE: c for c in (Gyro, StarTracker, Encoder, Tachometer, BaseVelocity, BasePosition, ForceTorque)}
+#: every sensor class by its `type` key (the scenario schema's `sensors:` entries are made from these)
+TYPES = {c.TYPE: c for c in (Gyro, StarTracker, Encoder, Tachometer, BaseVelocity, BasePosition, ForceTorque)}
 
 #: how the telemetry's configuration columns are made: "integrate" (Naveen, Shah, Misra, Appendix C: poses
 #: rebuilt by integrating the measured rates from the true initial configuration) or "measured" (from a
