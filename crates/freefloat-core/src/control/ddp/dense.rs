@@ -6,9 +6,10 @@
 //! - `mul_nn`: `C (+)= A B` in axpy form, a block of 8 (or 4) rows times 4 columns of C held in registers
 //!   while the inner dimension streams by (8 independent accumulator lanes per row block).
 //!
-//! A product with a transpose, `Aᵀ B`, is `mul_nn` on the transpose formed once (`transpose`): a kernel of dot
-//! products of contiguous columns (4 at once, 4 partial sums each) was several times slower per multiply-add at
-//! these sizes (the compiler vectorised it across the 4 columns, with shuffles), more than the copy costs.
+//! A product with a transpose, `Aᵀ B`, is `mul_nn` on the transpose formed once (`transpose`): the kernel of dot
+//! products of contiguous columns (4 at once, 4 partial sums each) it replaced took about 2–3 times as long per
+//! multiply-add at these sizes (measured by leaving products out of the backward pass), far more than the copy
+//! costs; in the code we inspected, the compiler had vectorised it across the 4 columns, with shuffles.
 //! Products that are symmetric in exact arithmetic keep their upper triangle (`mirror_upper`).
 //!
 //! The kernels only change the order of the floating-point additions against the textbook loops.
