@@ -167,6 +167,28 @@ def rows_ddp(res: dict) -> list[Row]:
     ]
 
 
+def rows_mpc(res: dict) -> list[Row]:
+    rows = []
+    cr = res.get("crocoddyl_replay")
+    for name, c in res["cases"].items():
+        s = c["replan_ms"]
+        peer = cr is not None and cr["case"] == name
+        rows.append(
+            Row(
+                f"MPC re-plan (H = 100, 5 it.), ch. 8 tracking, {name}: median / p95 / slowest",
+                "Crocoddyl 3.2.1 FDDP, same re-plans" if peer else "targets (issue 36)",
+                cr["replan_ms"]["median_ms"] / s["median_ms"] if peer else None,
+                freefloat=f"{s['median_ms']:.1f} / {s['p95_ms']:.1f} / {s['max_ms']:.1f} ms"
+                + (f" (CPU {c['replan_cpu_ms']['median_ms']:.1f} ms median)" if "replan_cpu_ms" in c else ""),
+                peer_value=f"{cr['replan_ms']['median_ms']:.1f} ms median" if peer else "",
+                target="median <= 25 ms, slowest <= 50 ms",
+                note=f"final hold {c['accuracy']['final_hold_position_max_mm']:.1f} mm / "
+                f"{c['accuracy']['final_hold_angle_max_deg']:.3f} deg",
+            )
+        )
+    return rows
+
+
 def rows_campaign(res: dict) -> list[Row]:
     return [
         Row("campaign throughput, 2 workers vs 1", "freefloat 1 worker", res["speedup_2_vs_1"], target=">= 1.8"),
@@ -406,6 +428,7 @@ BENCHES = {
     "cl": ("cl_vs_numpy.py", [], ["--quick"], (), rows_cl),
     "derivatives": ("derivatives_bench.py", [], ["--quick"], ("pinocchio", "crocoddyl"), rows_derivatives),
     "ddp": ("ddp_vs_crocoddyl.py", [], ["--quick"], ("pinocchio", "crocoddyl"), rows_ddp),
+    "mpc": ("mpc_bench.py", [], ["--quick"], (), rows_mpc),
     "campaign": ("campaign_bench.py", [], ["--quick"], ("distributed",), rows_campaign),
     "dq": ("dq_dynamics.py", [], ["--quick"], (), rows_dq),
     "kernels": (

@@ -85,6 +85,19 @@ def _check_ddp(out: Path) -> list[str]:
     return bad
 
 
+def _check_mpc(out: Path) -> list[str]:
+    res = json.loads((out / "mpc_bench.json").read_text())
+    bad = []
+    for name, c in res["cases"].items():
+        if c["accuracy_same_in_every_repeat"] is not True:
+            bad.append(f"{name}: the tracking accuracy changed between repeats")
+        if not (c["replan_ms"]["count"] >= 1 and c["replan_ms"]["median_ms"] > 0):
+            bad.append(f"{name}: no re-plan timed")
+        if c["troubled_replans"]:
+            bad.append(f"{name}: {c['troubled_replans']} troubled re-plans")
+    return bad
+
+
 def _check_dq(out: Path) -> list[str]:
     # the script aborts when dq_dynamics and aba disagree; check that it wrote its table
     return [] if (out / "dq_dynamics.md").is_file() else ["dq_dynamics.md not written"]
@@ -214,6 +227,7 @@ BENCHES = {
     "derivatives": ("derivatives_bench.py", [], ("pinocchio", "crocoddyl"), _check_derivatives),
     "campaign": ("campaign_bench.py", [], ("distributed",), _check_campaign),
     "ddp": ("ddp_vs_crocoddyl.py", [], ("pinocchio", "crocoddyl"), _check_ddp),
+    "mpc": ("mpc_bench.py", [], (), _check_mpc),
     "cl": ("cl_vs_numpy.py", [], (), _check_cl),
     "sensors": ("sensors_bench.py", [], ("scipy",), _check_sensors),
     "rate_smoother": ("rate_smoother_bench.py", [], ("scipy",), _check_rate_smoother),

@@ -90,6 +90,16 @@ def test_mpc_with_warm_starts_holds_the_pose(solved):
     assert st["troubled_replans"] == 0
     assert s["ee_position_error_final_hold_max_m"] < 0.2 * ol["ee_position_error_final_hold_max_m"], (s, ol)
     assert s["ee_position_error_final_hold_max_m"] < 0.02
+    # Per-re-plan records (benches/mpc_bench.py reads them) against the controller's own running totals.
+    raw = r["mpc"]
+    times, its = raw["replan_times_s"], raw["replan_iterations"]
+    assert len(times) == len(its) == len(raw["replan_costs"]) == raw["replans"]
+    assert sum(its) == raw["iterations"] and all(1 <= i <= 50 for i in its) and all(i <= 3 for i in its[1:])
+    assert abs(sum(times) - raw["solve_time_s"]) <= 1e-9 * raw["solve_time_s"]
+    assert max(times[1:]) == raw["max_replan_s"] and min(times) > 0
+    assert st["median_replan_s"] == float(np.median(times[1:]))
+    assert st["p95_replan_s"] == float(np.percentile(times[1:], 95))
+    assert "replan_times_s" not in st and "replan_iterations" not in st  # the summary keeps the statistics only
 
 
 def test_mpc_cold_start_converges_too(solved):

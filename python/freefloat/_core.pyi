@@ -106,7 +106,8 @@ every `replan` nodes (warm-started by the previous window shifted in time; the f
 window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
 `first_max_iter` bounds the first solve. `shrink`: no window reaches past the task's last node (the
 terminal cost lands on the task's end, a deadline); off, every window has `mpc_horizon` nodes. `stats()`: re-plans, iterations, solve time, slowest re-plan,
-troubled re-plans, last stop reason, the cost of each re-plan. `rate_joints` as in `ddp_solve`.
+troubled re-plans, last stop reason, the cost, wall time and iterations of each re-plan (`replan_costs`,
+`replan_times_s`, `replan_iterations`; the first re-plan included). `rate_joints` as in `ddp_solve`.
     """
     def __init__(self, model: Model, dt: float, horizon: ArrayLike, running: ArrayLike, terminal: ArrayLike, mpc_horizon: ArrayLike, replan: ArrayLike, keep_out: ArrayLike | None = None, options: ArrayLike | None = None, first_max_iter: ArrayLike = 50, guess_xs: ArrayLike | None = None, guess_us: ArrayLike | None = None, shrink: ArrayLike = False, rate_joints: ArrayLike | None = None) -> None: ...
     def control(self, k: ArrayLike, x: Any) -> Any:

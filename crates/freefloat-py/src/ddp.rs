@@ -551,7 +551,8 @@ impl PyDdpPolicy {
 /// window's feedback policy. `options` as in `ddp_solve` (per re-plan; `max_iter` is the re-plan budget);
 /// `first_max_iter` bounds the first solve. `shrink`: no window reaches past the task's last node (the
 /// terminal cost lands on the task's end, a deadline); off, every window has `mpc_horizon` nodes. `stats()`: re-plans, iterations, solve time, slowest re-plan,
-/// troubled re-plans, last stop reason, the cost of each re-plan. `rate_joints` as in `ddp_solve`.
+/// troubled re-plans, last stop reason, the cost, wall time and iterations of each re-plan (`replan_costs`,
+/// `replan_times_s`, `replan_iterations`; the first re-plan included). `rate_joints` as in `ddp_solve`.
 #[pyclass(name = "DdpMpc", module = "freefloat._core")]
 pub struct PyDdpMpc {
     mpc: Mpc,
@@ -624,6 +625,8 @@ impl PyDdpMpc {
         d.set_item("troubled_replans", s.troubled)?;
         d.set_item("last_stop", s.last_stop.clone())?;
         d.set_item("replan_costs", s.costs.clone())?;
+        d.set_item("replan_times_s", s.times.clone())?;
+        d.set_item("replan_iterations", s.replan_iterations.clone())?;
         d.set_item("model_updates", s.model_updates)?;
         d.set_item("horizon", self.mpc.options().horizon)?;
         d.set_item("replan", self.mpc.options().replan)?;

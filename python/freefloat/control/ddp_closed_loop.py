@@ -258,6 +258,13 @@ def summary(run_out: dict, final_hold_s: float = 5.0) -> dict:
     if "mpc" in run_out:
         s = dict(run_out["mpc"])
         s.pop("replan_costs", None)
+        s.pop("replan_iterations", None)
+        # the per-re-plan times as their median and 95th percentile, the first re-plan excluded as in
+        # `max_replan_s` (it is warm-started from the offline plan with `first_max_iter` iterations)
+        times = s.pop("replan_times_s", None)
+        if times is not None and len(times) > 1:
+            s["median_replan_s"] = float(np.median(times[1:]))
+            s["p95_replan_s"] = float(np.percentile(times[1:], 95))
         d["mpc"] = s
     return d
 

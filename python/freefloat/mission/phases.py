@@ -479,7 +479,8 @@ def berth_run(model, truth, x0, ref7, berth: dict, name: str, progress=None, obs
     }
     if "mpc" in out:
         s = dict(out["mpc"])
-        s.pop("replan_costs", None)
+        for k in ("replan_costs", "replan_times_s", "replan_iterations"):  # per-re-plan lists
+            s.pop(k, None)
         res["mpc"] = s
     return {"summary": res, "trace": {"t": t, "position_error": pos, "angle_error_deg": ang, "base_rate": w_base}}
 

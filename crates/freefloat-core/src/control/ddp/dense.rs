@@ -2,13 +2,17 @@
 //!
 //! The matrices of one DDP node are small (tens of rows) and of run-time size, where nalgebra's dynamic
 //! `gemm` packs through a heap buffer on every call and plain index loops neither vectorise nor hide the
-//! latency of the multiply-adds. Two kernels cover every product of the backward pass:
+//! latency of the multiply-adds. One kernel covers every product of the backward pass:
 //! - `mul_nn`: `C (+)= A B` in axpy form, a block of 8 (or 4) rows times 4 columns of C held in registers
-//!   while the inner dimension streams by (8 independent accumulator lanes per row block);
-//! - `mul_tn`: `C (+)= Aᵀ B`, every entry a dot product of two contiguous columns, 4 of them at once, each
-//!   with 4 separate partial sums (the compiler may not reassociate a floating-point sum on its own).
+//!   while the inner dimension streams by (8 independent accumulator lanes per row block).
 //!
-//! Both only change the order of the floating-point additions against the textbook loops.
+//! A product with a transpose, `Aᵀ B`, is `mul_nn` on the transpose formed once (`transpose`): the kernel of dot
+//! products of contiguous columns (4 at once, 4 partial sums each) it replaced took about 2–3 times as long per
+//! multiply-add at these sizes (measured by leaving products out of the backward pass), far more than the copy
+//! costs; in the code we inspected, the compiler had vectorised it across the 4 columns, with shuffles.
+//! Products that are symmetric in exact arithmetic keep their upper triangle (`mirror_upper`).
+//!
+//! The kernels only change the order of the floating-point additions against the textbook loops.
 
 /// `c (+)= a b` with `a` m × k, `b` k × n, `c` m × n, all column-major and contiguous; `acc`: add to `c`
 /// instead of overwriting it.
@@ -95,15 +99,9 @@ fn store(dst: &mut [f64], s: &[f64], acc: bool) {
 /// Dot product with 4 partial sums: the one in the dynamics derivatives (the Cholesky inverse uses it too).
 pub(crate) use crate::dynamics::derivatives::dot;
 
-/// `c (+)= aᵀ b` with `a` k × m, `b` k × n, `c` m × n, all column-major and contiguous.
-pub(crate) fn mul_tn(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, n: usize, acc: bool) {
-    mul_tn_impl(c, a, b, k, m, n, acc, false);
-}
-
-/// `mul_tn` for a product known to be symmetric (m × m; with `acc`, `c` symmetric too): the upper triangle
-/// is computed, the lower one copied from it.
-pub(crate) fn mul_tn_sym(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, acc: bool) {
-    mul_tn_impl(c, a, b, k, m, m, acc, true);
+/// Copy the upper triangle of the m × m column-major `c` onto its lower one (a product that is symmetric in exact
+/// arithmetic made exactly so).
+pub(crate) fn mirror_upper(c: &mut [f64], m: usize) {
     for j in 0..m {
         for i in j + 1..m {
             c[j * m + i] = c[i * m + j];
@@ -111,48 +109,12 @@ pub(crate) fn mul_tn_sym(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize
     }
 }
 
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn mul_tn_impl(c: &mut [f64], a: &[f64], b: &[f64], k: usize, m: usize, n: usize, acc: bool, upper: bool) {
-    debug_assert!(a.len() >= m * k && b.len() >= k * n && c.len() >= m * n);
-    let k4 = k - k % 4;
+/// `t = aᵀ` with `a` m × n column-major (`t` n × m).
+pub(crate) fn transpose(t: &mut [f64], a: &[f64], m: usize, n: usize) {
+    debug_assert!(a.len() >= m * n && t.len() >= m * n);
     for j in 0..n {
-        let bj = &b[j * k..(j + 1) * k];
-        let lim = if upper { (j + 1).min(m) } else { m };
-        let mut i = 0;
-        while i + 4 <= m && i < lim {
-            let ac = [
-                &a[i * k..(i + 1) * k],
-                &a[(i + 1) * k..(i + 2) * k],
-                &a[(i + 2) * k..(i + 3) * k],
-                &a[(i + 3) * k..(i + 4) * k],
-            ];
-            let mut s = [[0.0_f64; 4]; 4];
-            let mut p = 0;
-            while p < k4 {
-                let bp: &[f64; 4] = bj[p..p + 4].try_into().unwrap();
-                for (q, sq) in s.iter_mut().enumerate() {
-                    let aq: &[f64; 4] = ac[q][p..p + 4].try_into().unwrap();
-                    for l in 0..4 {
-                        sq[l] += aq[l] * bp[l];
-                    }
-                }
-                p += 4;
-            }
-            for (q, sq) in s.iter().enumerate() {
-                let mut t = (sq[0] + sq[1]) + (sq[2] + sq[3]);
-                for pp in k4..k {
-                    t += ac[q][pp] * bj[pp];
-                }
-                let cij = &mut c[j * m + i + q];
-                *cij = if acc { *cij + t } else { t };
-            }
-            i += 4;
-        }
-        for ii in i..lim {
-            let t = dot(&a[ii * k..(ii + 1) * k], bj);
-            let cij = &mut c[j * m + ii];
-            *cij = if acc { *cij + t } else { t };
+        for (i, &x) in a[j * m..(j + 1) * m].iter().enumerate() {
+            t[i * n + j] = x;
         }
     }
 }
@@ -195,22 +157,25 @@ mod tests {
             assert!((&c - (&c0 + &a * &b)).amax() < 1e-12, "mul_nn acc {m}x{k}x{n}");
             mul_nn(c.as_mut_slice(), a.as_slice(), b.as_slice(), m, k, n, false);
             assert!((&c - &a * &b).amax() < 1e-12, "mul_nn {m}x{k}x{n}");
+            // the transpose and a product with it, and a symmetric product mirrored: aᵀ a (+ a symmetric c)
             let at = filled(k, m, 0.4);
+            let mut t = DMatrix::zeros(m, k);
+            transpose(t.as_mut_slice(), at.as_slice(), k, m);
+            assert_eq!(t, at.transpose(), "transpose {k}x{m}");
             let mut c = c0.clone();
-            mul_tn(c.as_mut_slice(), at.as_slice(), b.as_slice(), k, m, n, true);
-            assert!((&c - (&c0 + at.transpose() * &b)).amax() < 1e-12, "mul_tn acc {m}x{k}x{n}");
-            mul_tn(c.as_mut_slice(), at.as_slice(), b.as_slice(), k, m, n, false);
-            assert!((&c - at.transpose() * &b).amax() < 1e-12, "mul_tn {m}x{k}x{n}");
-            // a symmetric product: aᵀ a (+ a symmetric c)
+            mul_nn(c.as_mut_slice(), t.as_slice(), b.as_slice(), m, k, n, true);
+            assert!((&c - (&c0 + at.transpose() * &b)).amax() < 1e-12, "aᵀ b {m}x{k}x{n}");
             let s0 = &c0.rows(0, m.min(n)).columns(0, m.min(n)).into_owned();
             let s0 = s0 + s0.transpose();
             let mm = s0.nrows();
             let a2 = filled(k, mm, 0.9);
+            let mut a2t = DMatrix::zeros(mm, k);
+            transpose(a2t.as_mut_slice(), a2.as_slice(), k, mm);
             let mut s = s0.clone();
-            mul_tn_sym(s.as_mut_slice(), a2.as_slice(), a2.as_slice(), k, mm, true);
-            assert!((&s - (&s0 + a2.transpose() * &a2)).amax() < 1e-12, "mul_tn_sym acc {mm}x{k}");
-            mul_tn_sym(s.as_mut_slice(), a2.as_slice(), a2.as_slice(), k, mm, false);
-            assert!((&s - a2.transpose() * &a2).amax() < 1e-12, "mul_tn_sym {mm}x{k}");
+            mul_nn(s.as_mut_slice(), a2t.as_slice(), a2.as_slice(), mm, k, mm, true);
+            mirror_upper(s.as_mut_slice(), mm);
+            assert_eq!(s, s.transpose(), "mirror_upper {mm}");
+            assert!((&s - (&s0 + a2.transpose() * &a2)).amax() < 1e-12, "aᵀ a {mm}x{k}");
             let x = filled(k, 1, 2.0);
             let mut y = filled(m, 1, 0.2);
             let y0 = y.clone();

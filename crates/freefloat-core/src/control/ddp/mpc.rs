@@ -176,6 +176,11 @@ pub struct MpcStats {
     pub last_stop: String,
     /// Cost of each re-plan's solution.
     pub costs: Vec<f64>,
+    /// Wall time of each re-plan (s), the first included (it may run more iterations: `first_max_iter`), so
+    /// that a caller can take medians and percentiles, not only the total and the maximum.
+    pub times: Vec<f64>,
+    /// Iterations of each re-plan.
+    pub replan_iterations: Vec<usize>,
     /// Times the model's inertial parameters were replaced (`Mpc::set_parameters`).
     pub model_updates: usize,
 }
@@ -359,6 +364,8 @@ impl Mpc {
         }
         s.last_stop = sol.stop.describe();
         s.costs.push(sol.cost);
+        s.times.push(dt);
+        s.replan_iterations.push(sol.iterations);
         self.plan = Some((k, policy));
         Ok(())
     }

@@ -65,7 +65,11 @@ pub struct Workspace {
     pub pu: DMatrix<f64>,
     /// nu × ndx scratch (Q_ux + Q_uu L).
     pub tmp_ux: DMatrix<f64>,
-    /// [L; Q_ux] (2 nu × ndx) of the value update.
+    /// Fuᵀ (nu × ndx).
+    pub fut: DMatrix<f64>,
+    /// Fxᵀ (ndx × ndx).
+    pub fxt: DMatrix<f64>,
+    /// [L; Q_ux]ᵀ (ndx × 2 nu, in a 2 nu × ndx matrix's storage) of the value update.
     pub z1: DMatrix<f64>,
     /// [Q_ux + Q_uu L; L] (2 nu × ndx).
     pub z2: DMatrix<f64>,
@@ -116,6 +120,8 @@ impl Workspace {
             px: DMatrix::zeros(ndx, ndx),
             pu: DMatrix::zeros(ndx, nu),
             tmp_ux: DMatrix::zeros(nu, ndx),
+            fut: DMatrix::zeros(nu, ndx),
+            fxt: DMatrix::zeros(ndx, ndx),
             z1: DMatrix::zeros(2 * nu, ndx),
             z2: DMatrix::zeros(2 * nu, ndx),
             tmp_u: DVector::zeros(nu),
