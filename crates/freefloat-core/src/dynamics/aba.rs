@@ -114,7 +114,7 @@ fn hybrid_aba_placed<const TOTALS: bool>(
     let (jts, parents, idx_v, nvs, inertias) =
         (&m.joint_types[..n], &m.parents[..n], &m.idx_v[..n], &m.nvs[..n], &m.inertias[..n]);
     for i in 0..n {
-        let omi = o_mi[i];
+        let omi = &o_mi[i];
         let iv = idx_v[i];
         // Joint twist oS q̇, specialised by joint type: a revolute joint's child-frame subspace is [0; a]
         // (oS = [p × R a; R a]) and a prismatic one's [a; 0] (oS = [R a; 0]), so neither needs the
@@ -122,7 +122,7 @@ fn hybrid_aba_placed<const TOTALS: bool>(
         // itself, applied to the base twist in one step (its columns are not needed, see pass 3).
         let vj = match jts[i] {
             JointType::Revolute | JointType::Prismatic => {
-                let col = subspace_column_at(m, &omi, &s_all[i], i, 0);
+                let col = subspace_column_at(m, omi, &s_all[i], i, 0);
                 os[i].set_column(0, &col.to_v6());
                 col * v[iv]
             }
@@ -152,7 +152,7 @@ fn hybrid_aba_placed<const TOTALS: bool>(
             let bias = omi.act_motion(&joint_bias_at(m, &s_all[i], i, v));
             oc[i] += bias;
         }
-        let oi = inertias[i].transformed(&omi);
+        let oi = inertias[i].transformed(omi);
         ias[i] = oi.to_matrix();
         let hi = oi.mul_motion(&vi);
         if TOTALS {

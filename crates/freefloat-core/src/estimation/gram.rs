@@ -138,44 +138,65 @@ pub const GRAM_TILE: usize = 8;
 const GRAM_CHUNK: usize = 24;
 
 /// `g += BᵀB` on and above the diagonal, for B = the `rows` rows of the row-major block `b` (row r at
-/// `b[r·w..]`), its first `cols` columns (a multiple of [`GRAM_TILE`], at most `w`); `g` is w × w, row-major
-/// (entry (i, j) at `i·w + j`). Entries below the diagonal inside the diagonal tiles are accumulated too and are
-/// to be ignored.
+/// `b[r·w..]`), its first `cols` columns (a multiple of 4, at most `w`); `g` is w × w, row-major (entry (i, j) at
+/// `i·w + j`). Some entries below the diagonal, next to it, are accumulated too and are to be ignored.
 ///
 /// Why not the BLAS-style product of [`gram_update`]: that computes both triangles and packs both operands into
 /// panels on every call (in `perf` of the identification, packing took 38 % of the product's time). Here the block
-/// builder writes the rows in the layout the kernel reads, so nothing is packed, and only the tiles on or above
-/// the diagonal are formed (56 of the 98 tiles for 53 columns padded to 56). Each tile of G is 4 rows × 8 columns,
-/// held in eight 4-wide registers while the rows stream past: per row, two vector loads, four broadcasts, eight
-/// FMAs. On 192 rows × 53 columns: 210 ns per sample against 470 for [`GramLs`] (`examples/identify_profile.rs
-/// gram 3000`, same checksum). Public for that benchmark; the identification calls it through its own pass.
+/// builder writes the rows in the layout the kernel reads, so nothing is packed, and only the tiles that reach the
+/// diagonal or lie above it are formed. Each tile of G is 4 rows × 8 columns, held in eight 4-wide registers while
+/// the rows stream past: per row, two vector loads, four broadcasts, eight FMAs. On 192 rows × 53 columns: 210 ns
+/// per sample against 470 for [`GramLs`] (`examples/identify_profile.rs gram 3000`, same checksum). Where a
+/// whole 4 × 8 tile would mostly lie below the diagonal or in the padding, a 4 × 4 tile does: the lower half of a
+/// diagonal 8 × 8 block needs only its right four columns, and `cols` that is 4 past a multiple of 8 ends with a
+/// 4-wide column strip (the identification's 17 linear columns are then padded to 20, not 24). That drops a fifth
+/// of the multiply-adds of the identification's Gram pass; every entry on and above the diagonal is the same chain
+/// of fused multiply-adds, row by row, as with whole tiles (the same bits). Public for that benchmark; the
+/// identification calls it through its own pass.
 pub fn gram_rows_upper(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
-    assert!(
-        cols.is_multiple_of(GRAM_TILE) && cols <= w && g.len() == w * w && b.len() >= rows * w,
-        "Gram rows: shapes"
-    );
+    assert!(cols.is_multiple_of(4) && cols <= w && g.len() == w * w && b.len() >= rows * w, "Gram rows: shapes");
     // Rows are taken GRAM_CHUNK at a time so that they stay in L1 while every tile of G passes over them.
     for chunk in b[..rows * w].chunks(GRAM_CHUNK * w) {
-        for j0 in (0..cols).step_by(GRAM_TILE) {
-            for i0 in (0..j0 + GRAM_TILE).step_by(4) {
-                let mut acc = [[0.0f64; GRAM_TILE]; 4];
-                for (ii, a) in acc.iter_mut().enumerate() {
-                    a.copy_from_slice(&g[(i0 + ii) * w + j0..(i0 + ii) * w + j0 + GRAM_TILE]);
+        let mut j0 = 0;
+        while j0 < cols {
+            if j0 + GRAM_TILE <= cols {
+                // rows above the diagonal block, and its upper half: all eight columns
+                for i0 in (0..=j0).step_by(4) {
+                    gram_tile::<GRAM_TILE>(g, chunk, w, i0, j0);
                 }
-                for row in chunk.chunks_exact(w) {
-                    let bj: &[f64; GRAM_TILE] = row[j0..j0 + GRAM_TILE].try_into().expect("tile inside the row");
-                    let bi: &[f64; 4] = row[i0..i0 + 4].try_into().expect("tile inside the row");
-                    for (a, &x) in acc.iter_mut().zip(bi) {
-                        for (s, &y) in a.iter_mut().zip(bj) {
-                            *s = x.mul_add(y, *s);
-                        }
-                    }
+                // its lower half: only the right four columns reach the diagonal
+                gram_tile::<4>(g, chunk, w, j0 + 4, j0 + 4);
+                j0 += GRAM_TILE;
+            } else {
+                // a last strip four columns wide
+                for i0 in (0..=j0).step_by(4) {
+                    gram_tile::<4>(g, chunk, w, i0, j0);
                 }
-                for (ii, a) in acc.iter().enumerate() {
-                    g[(i0 + ii) * w + j0..(i0 + ii) * w + j0 + GRAM_TILE].copy_from_slice(a);
-                }
+                j0 += 4;
             }
         }
+    }
+}
+
+/// `g[i0..i0+4, j0..j0+W] += Bᵀ B` over the rows of `chunk` (row length `w`): the tile of G in 4·W/4 registers
+/// while the rows stream past, each entry one chain of fused multiply-adds in row order.
+#[inline(always)]
+fn gram_tile<const W: usize>(g: &mut [f64], chunk: &[f64], w: usize, i0: usize, j0: usize) {
+    let mut acc = [[0.0f64; W]; 4];
+    for (ii, a) in acc.iter_mut().enumerate() {
+        a.copy_from_slice(&g[(i0 + ii) * w + j0..(i0 + ii) * w + j0 + W]);
+    }
+    for row in chunk.chunks_exact(w) {
+        let bj: &[f64; W] = row[j0..j0 + W].try_into().expect("tile inside the row");
+        let bi: &[f64; 4] = row[i0..i0 + 4].try_into().expect("tile inside the row");
+        for (a, &x) in acc.iter_mut().zip(bi) {
+            for (s, &y) in a.iter_mut().zip(bj) {
+                *s = x.mul_add(y, *s);
+            }
+        }
+    }
+    for (ii, a) in acc.iter().enumerate() {
+        g[(i0 + ii) * w + j0..(i0 + ii) * w + j0 + W].copy_from_slice(a);
     }
 }
 
@@ -193,7 +214,7 @@ mod tests {
         // row counts below, at and across the L1 chunk; column tiles narrower than the row
         let w = 24;
         for rows in [1, 7, GRAM_CHUNK, GRAM_CHUNK + 1, 3 * GRAM_CHUNK + 5] {
-            for cols in [8, 16, 24] {
+            for cols in [4, 8, 12, 16, 20, 24] {
                 let b: Vec<f64> = (0..rows * w).map(|k| mix(k / w, k % w)).collect();
                 let mut g = vec![1.0; w * w]; // accumulates onto what is there
                 gram_rows_upper(&mut g, &b, w, rows, cols);

@@ -112,7 +112,7 @@ struct RowLayout {
     slot: Vec<usize>,
     /// the padded row width: n + 1 rounded up to a multiple of [`GRAM_TILE`]
     width: usize,
-    /// the padded width of the leading columns whose linear rows can be nonzero
+    /// the width (a multiple of 4) of the leading columns whose linear rows can be nonzero
     lin_width: usize,
 }
 
@@ -125,7 +125,8 @@ impl RowLayout {
         for (k, j) in linear.iter().copied().chain(rest).enumerate() {
             slot[j] = k + 1;
         }
-        let lin_width = (linear.len() + 1).next_multiple_of(GRAM_TILE);
+        // the Gram kernel takes a four-wide last strip: the linear rows' product stops at a multiple of 4
+        let lin_width = (linear.len() + 1).next_multiple_of(4);
         RowLayout { slot, width: (n + 1).next_multiple_of(GRAM_TILE), lin_width }
     }
 }

@@ -12,7 +12,7 @@ pub use actuators::{Actuators, JointLimit, Tank, Thruster, Wheel};
 pub use base_poses::{integrate_base_poses, integrate_planar_base_poses, Steps};
 pub use batch::{batch_size, simulate_many, simulate_many_interruptible, BatchSpec, Stacked};
 pub use inputs::{Controller, Hold, InputTiming, Prescription, PrescriptionFn, TorqueFn, TorqueSource};
-pub use trajectory::Trajectory;
+pub use trajectory::{recycle, Trajectory, SPARE_BYTES};
 
 use crate::check::check_vec;
 use crate::config::{
