@@ -8,7 +8,7 @@ use crate::dynamics::{crba_unchecked, gravity_acceleration, hybrid_aba_unchecked
 use crate::error::{FfError, Result};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
-use crate::spatial::{Force, Motion, M6, V3};
+use crate::spatial::{m6_mul_motion, skew, Force, Inertia, Motion, M6, V3};
 use nalgebra::DMatrix;
 
 /// Column `c` of a 6×k subspace as a motion.
@@ -89,7 +89,9 @@ pub(crate) fn aba_derivatives_unchecked(
     Ok(())
 }
 
-/// Both derivative passes, after forward kinematics at q.
+/// ∂τ/∂q, ∂τ/∂v (into `w.dtau_dq`, `w.dtau_dv`) and τ (into `d.tau`) after forward kinematics at q: the
+/// single-pass algorithm of Carpentier and Mansard, RSS 2018, Alg. 1 (one forward pass, one backward pass; see
+/// the module documentation for the derivation in this engine's notation).
 pub(crate) fn rnea_derivatives_core(
     m: &Model,
     d: &mut Data,
@@ -99,228 +101,120 @@ pub(crate) fn rnea_derivatives_core(
     fext: Option<&[f64]>,
 ) {
     let n = m.nbodies();
-    // Nominal RNEA in inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
-    // vᵢ = v_λ + Sᵢq̇ᵢ, aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ, fᵢ = Iᵢaᵢ + vᵢ ×* Iᵢvᵢ − fextᵢ, τᵢ = Sᵢᵀ Σ_subtree f.
     let ag = gravity_acceleration(m);
+    // Forward pass (Alg. 1, lines 2-9), inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
+    // vᵢ = v_λ + Sᵢq̇ᵢ, aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ, fᵢ = Iᵢaᵢ + vᵢ ×* Iᵢvᵢ − fextᵢ; and per joint column ψ
+    // the parts of ∂v/∂q and ∂a/∂q that do not merely turn with the moved subtree, Ψ̇ = v_λ × ψ and
+    // Ψ̈ = a_λ × ψ + v_λ × Ψ̇ (line 7), and ∂a/∂q̇ = Ψ̇ + vᵢ × ψ (the Ṡ term of line 8).
     for i in 0..n {
         let omi = d.o_mi[i];
         let (k, iv) = (m.nvs[i], m.idx_v[i]);
+        let (vp, ap) = match m.parents[i] {
+            Some(p) => (w.ov[p], w.oa[p]),
+            None => (Motion::ZERO, ag),
+        };
         let (mut vj, mut aj) = (Motion::ZERO, Motion::ZERO);
         for c in 0..k {
             let s = omi.act_motion(&col(&d.s[i], c));
             d.os[i].set_column(c, &s.to_v6());
             vj += s * v[iv + c];
             aj += s * a[iv + c];
+            let pd = vp.cross_motion(&s);
+            w.psi_d[iv + c] = pd;
+            w.psi_dd[iv + c] = ap.cross_motion(&s) + vp.cross_motion(&pd);
         }
-        let (vp, ap) = match m.parents[i] {
-            Some(p) => (w.ov[p], w.oa[p]),
-            None => (Motion::ZERO, ag),
-        };
         let ov = vp + vj;
         let oa = ap + aj + ov.cross_motion(&vj);
+        for c in 0..k {
+            w.dadv[iv + c] = w.psi_d[iv + c] + ov.cross_motion(&col(&d.os[i], c));
+        }
         let oi = m.inertias[i].transformed(&omi);
         let h = oi.mul_motion(&ov);
-        let g = oi.mul_motion(&oa);
         let fe = match fext {
             Some(f) => omi.act_force(&Force::from_slice(&f[6 * i..6 * i + 6])),
             None => Force::ZERO,
         };
         w.ov[i] = ov;
         w.oa[i] = oa;
-        w.vj[i] = vj;
-        w.aj[i] = aj;
         w.oi[i] = oi;
-        w.h[i] = h;
-        w.g[i] = g;
-        w.fe[i] = fe;
-        w.ff[i] = g + ov.cross_force(&h) - fe;
+        w.ic[i] = oi;
+        w.bc[i] = b_matrix(&oi, &ov, &h);
+        w.ff[i] = oi.mul_motion(&oa) + ov.cross_force(&h) - fe;
     }
-    for i in (1..n).rev() {
+
+    // Backward pass (Alg. 1, lines 10-19). With the subtree composites Fᵢ = Σ f, Icᵢ = Σ I and Bcᵢ = Σ B (line 12),
+    // for joint i and any joint j on its path to the root (j ⪯ i; column ψ of j):
+    //   ∂τᵢ/∂q_j = Sᵢᵀ (Icᵢ Ψ̈_j + Bcᵢ Ψ̇_j)                ∂τᵢ/∂q̇_j = Sᵢᵀ (Bcᵢ ψ + Icᵢ (Ψ̇_j + Ṡ_j))
+    // (row i, line 15), and for the strict ancestors j of i, with ψ now a column of i,
+    //   ∂τ_j/∂qᵢ = S_jᵀ (ψ ×* Fᵢ + Icᵢ Ψ̈ᵢ + Bcᵢ Ψ̇ᵢ)        ∂τ_j/∂q̇ᵢ = S_jᵀ (Bcᵢ ψ + Icᵢ (Ψ̇ᵢ + Ṡᵢ))
+    // (column i, lines 16-17). Every other entry is zero (joints on different branches).
+    w.dtau_dq.fill(0.0);
+    w.dtau_dv.fill(0.0);
+    for i in (0..n).rev() {
+        let (k, iv) = (m.nvs[i], m.idx_v[i]);
+        let (ic, bc, f) = (w.ic[i], w.bc[i], w.ff[i]);
+        for r in 0..k {
+            let row = iv + r;
+            let s = col(&d.os[i], r);
+            d.tau[row] = s.dot(&f);
+            // Sᵢᵀ Icᵢ and Sᵢᵀ Bcᵢ as covectors (Icᵢ is symmetric)
+            let u1 = ic.mul_motion(&s);
+            let u2 = Force::from_v6(&bc.tr_mul(&s.to_v6()));
+            let mut j = Some(i);
+            while let Some(jj) = j {
+                for c in m.idx_v[jj]..m.idx_v[jj] + m.nvs[jj] {
+                    w.dtau_dq[(row, c)] = w.psi_dd[c].dot(&u1) + w.psi_d[c].dot(&u2);
+                    w.dtau_dv[(row, c)] = col(&d.os[jj], c - m.idx_v[jj]).dot(&u2) + w.dadv[c].dot(&u1);
+                }
+                j = m.parents[jj];
+            }
+            let xq = s.cross_force(&f) + ic.mul_motion(&w.psi_dd[row]) + m6_mul_motion(&bc, &w.psi_d[row]);
+            let xv = m6_mul_motion(&bc, &s) + ic.mul_motion(&w.dadv[row]);
+            let mut j = m.parents[i];
+            while let Some(jj) = j {
+                for c in 0..m.nvs[jj] {
+                    let sj = col(&d.os[jj], c);
+                    w.dtau_dq[(m.idx_v[jj] + c, row)] = sj.dot(&xq);
+                    w.dtau_dv[(m.idx_v[jj] + c, row)] = sj.dot(&xv);
+                }
+                j = m.parents[jj];
+            }
+        }
         if let Some(p) = m.parents[i] {
-            let f = w.ff[i];
+            w.ic[p] = w.ic[p].add(&ic);
+            w.bc[p] += bc;
             w.ff[p] += f;
         }
     }
-    for i in 0..n {
-        let f6 = w.ff[i].to_v6();
-        for c in 0..m.nvs[i] {
-            d.tau[m.idx_v[i] + c] = d.os[i].column(c).dot(&f6);
-        }
-    }
-
-    // ∂τ/∂v in closed form. A unit rate e = Sⱼ,c of joint j adds e to every twist of j's subtree
-    // (dvᵢ = e) and changes the accelerations by daᵢ = e × (vᵢ − wⱼ), wⱼ = v_λ(j) + vⱼ (the chain rule
-    // through aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ). So dfᵢ = Bᵢ e − Iᵢ (e × wⱼ) with the per-body linear map
-    // Bᵢ e = Iᵢ (e × vᵢ) + e ×* (Iᵢ vᵢ) + vᵢ ×* (Iᵢ e), and summed over a subtree
-    // dFₖ = Bcₖ e − Icₖ (e × wⱼ) with the composites Bc, Ic: dτᵢ = Sᵢᵀ dF_{i or j, the deeper}.
-    for i in 0..n {
-        let (ov, h, oi) = (w.ov[i], w.h[i], w.oi[i]);
-        for k in 0..6 {
-            let mut e = Motion::ZERO;
-            if k < 3 {
-                e.lin[k] = 1.0;
-            } else {
-                e.ang[k - 3] = 1.0;
-            }
-            let b = oi.mul_motion(&e.cross_motion(&ov)) + e.cross_force(&h) + ov.cross_force(&oi.mul_motion(&e));
-            w.bc[i].set_column(k, &b.to_v6());
-        }
-        w.ic[i] = oi;
-    }
-    for i in (1..n).rev() {
-        if let Some(p) = m.parents[i] {
-            let b = w.bc[i];
-            w.bc[p] += b;
-            w.ic[p] = w.ic[p].add(&w.ic[i]);
-        }
-    }
-    for i in 0..n {
-        for r in 0..m.nvs[i] {
-            let s = col(&d.os[i], r);
-            let sb = w.bc[i].transpose() * s.to_v6();
-            w.sb[i].set_column(r, &sb);
-            let si = w.ic[i].mul_motion(&s).to_v6();
-            w.si[i].set_column(r, &si);
-        }
-    }
-
-    // ∂τ/∂q: one forward-mode pass per tangent direction (joint j, column c).
-    for j in 0..n {
-        for c in 0..m.nvs[j] {
-            let col_idx = m.idx_v[j] + c;
-            let psi = col(&d.os[j], c);
-            if m.parents[j].is_none() {
-                root_q_column(m, d, w, psi, ag, col_idx);
-            } else {
-                direction(m, w, j, psi);
-                write_column(m, d, w, j, psi, col_idx);
-            }
-            dtau_dv_column(m, d, w, j, psi, col_idx);
-        }
-    }
 }
 
-/// Column of ∂τ/∂v for the unit rate along e = Sⱼ,c (see the closed form above).
-fn dtau_dv_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, e: Motion, c: usize) {
-    let n = m.nbodies();
-    let wj = match m.parents[j] {
-        Some(p) => w.ov[p] + w.ov[j],
-        None => w.ov[j],
-    };
-    let z = e.cross_motion(&wj).to_v6();
-    let e6 = e.to_v6();
-    let mut colm = w.dtau_dv.column_mut(c);
-    colm.fill(0.0);
-    for i in j..n {
-        let inside = i == j || m.parents[i].is_some_and(|p| p >= j && w.in_sub[p]);
-        w.in_sub[i] = inside;
-        if !inside {
-            continue;
-        }
-        for r in 0..m.nvs[i] {
-            colm[m.idx_v[i] + r] = w.sb[i].column(r).dot(&e6) - w.si[i].column(r).dot(&z);
-        }
-    }
-    let xj = w.bc[j] * e6 - w.ic[j].mul_motion(&Motion::from_v6(&z)).to_v6();
-    let mut k = m.parents[j];
-    while let Some(p) = k {
-        for r in 0..m.nvs[p] {
-            colm[m.idx_v[p] + r] = d.os[p].column(r).dot(&xj);
-        }
-        k = m.parents[p];
-    }
+/// The 6×6 matrix of the map `e ↦ I (e × v) + e ×* (I v) + v ×* (I e)`: the derivative of a body's force
+/// `f = I a + v ×* I v` along a change `e` of its twist that also enters its acceleration as `e × v` (Carpentier
+/// and Mansard 2018, eq. (14): Bᵢ). With X = [v×] the motion cross-product matrix and `[v×*] = −Xᵀ`, it is
+/// `H − I X − (I X)ᵀ`, where H (the map `e ↦ e ×* h`, h = I v) is antisymmetric.
+fn b_matrix(oi: &Inertia, ov: &Motion, h: &Force) -> M6 {
+    let x = motion_cross_matrix(ov);
+    let ix = oi.to_matrix() * x;
+    // e ×* h = (e_ang × h_lin, e_ang × h_ang + e_lin × h_lin) = (−[h_lin] e_ang, −[h_lin] e_lin − [h_ang] e_ang)
+    let (hl, ha) = (skew(&h.lin), skew(&h.ang));
+    let mut b = -(ix + ix.transpose());
+    let mut blk = b.fixed_view_mut::<3, 3>(0, 3);
+    blk -= hl;
+    let mut blk = b.fixed_view_mut::<3, 3>(3, 0);
+    blk -= hl;
+    let mut blk = b.fixed_view_mut::<3, 3>(3, 3);
+    blk -= ha;
+    b
 }
 
-/// ∂τ/∂q along a root-joint direction ψ, in closed form. The whole tree moves rigidly, so every
-/// inertial-frame quantity is covariant (`d x = ψ × x`) except the gravity acceleration a_g, which
-/// stays put: `dFᵢ = ψ ×* Fᵢ − Icᵢ (ψ × a_g)` with Icᵢ the composite inertia of i's subtree, and since
-/// `(ψ × S)ᵀ F + Sᵀ (ψ ×* F) = 0`, `dτᵢ = −Sᵢᵀ Icᵢ (ψ × a_g)`: zero without gravity (orbital robots).
-fn root_q_column(m: &Model, d: &Data, w: &mut Derivatives, psi: Motion, ag: Motion, c: usize) {
-    let n = m.nbodies();
-    let ga = psi.cross_motion(&ag);
-    // w.ic holds the composite inertias (computed with the ∂τ/∂v maps)
-    let mut colm = w.dtau_dq.column_mut(c);
-    colm.fill(0.0);
-    if ga.lin.norm_squared() + ga.ang.norm_squared() == 0.0 {
-        return;
-    }
-    for i in 0..n {
-        let f = w.ic[i].mul_motion(&ga).to_v6();
-        for r in 0..m.nvs[i] {
-            colm[m.idx_v[i] + r] = -d.os[i].column(r).dot(&f);
-        }
-    }
-}
-
-/// Forward-mode sweep over the subtree of `j` for a perturbation of joint j's configuration along
-/// ψ (the subtree moves rigidly with twist ψ). Leaves the subtree-summed force derivatives in
-/// `w.dff` (subtree of j only).
-#[inline]
-fn direction(m: &Model, w: &mut Derivatives, j: usize, psi: Motion) {
-    let n = m.nbodies();
-    for i in j..n {
-        let inside = i == j || m.parents[i].is_some_and(|p| p >= j && w.in_sub[p]);
-        w.in_sub[i] = inside;
-        if !inside {
-            continue;
-        }
-        let (dvp, dap) = match m.parents[i] {
-            Some(p) if i != j => (w.dov[p], w.doa[p]),
-            _ => (Motion::ZERO, Motion::ZERO),
-        };
-        let (ov, vj, oa) = (w.ov[i], w.vj[i], w.oa[i]);
-        let oi = &w.oi[i];
-        let h = w.h[i];
-        // Everything fixed to body i turns with ψ: d(Sq̇) = ψ × Sq̇, d(Sq̈) = ψ × Sq̈,
-        // d(I x) = ψ ×* (I x) − I (ψ × x), d(fext) = ψ ×* fext.
-        let dvj = psi.cross_motion(&vj);
-        let daj = psi.cross_motion(&w.aj[i]);
-        let dov = dvp + dvj;
-        let doa = dap + daj + dov.cross_motion(&vj) + ov.cross_motion(&dvj);
-        let dh = psi.cross_force(&h) + oi.mul_motion(&(dov - psi.cross_motion(&ov)));
-        let df = psi.cross_force(&w.g[i])
-            + oi.mul_motion(&(doa - psi.cross_motion(&oa)))
-            + dov.cross_force(&h)
-            + ov.cross_force(&dh)
-            - psi.cross_force(&w.fe[i]);
-        w.dov[i] = dov;
-        w.doa[i] = doa;
-        w.dff[i] = df;
-    }
-    for i in (j + 1..n).rev() {
-        if w.in_sub[i] {
-            let p = m.parents[i].unwrap_or(0);
-            let f = w.dff[i];
-            w.dff[p] += f;
-        }
-    }
-}
-
-/// Write one column of ∂τ/∂q from the sweep's force derivatives:
-/// `dτᵢ = (ψ × Sᵢ)ᵀ Fᵢ + Sᵢᵀ dFᵢ` in the subtree, `Sᵢᵀ dFⱼ` on the ancestors of j, 0 elsewhere.
-fn write_column(m: &Model, d: &Data, w: &mut Derivatives, j: usize, psi: Motion, c: usize) {
-    let n = m.nbodies();
-    let out = &mut w.dtau_dq;
-    let mut colm = out.column_mut(c);
-    colm.fill(0.0);
-    for i in j..n {
-        if !w.in_sub[i] {
-            continue;
-        }
-        let df = w.dff[i].to_v6();
-        for r in 0..m.nvs[i] {
-            let s = col(&d.os[i], r);
-            colm[m.idx_v[i] + r] = s.to_v6().dot(&df) + psi.cross_motion(&s).dot(&w.ff[i]);
-        }
-    }
-    let dfj = w.dff[j].to_v6();
-    let mut k = m.parents[j];
-    while let Some(p) = k {
-        for r in 0..m.nvs[p] {
-            colm[m.idx_v[p] + r] = d.os[p].column(r).dot(&dfj);
-        }
-        k = m.parents[p];
-    }
+/// `[v×]`: the matrix of `e ↦ v × e` on motions `[lin; ang]`, `[[ω×, v_lin×], [0, ω×]]`.
+fn motion_cross_matrix(v: &Motion) -> M6 {
+    let (w, l) = (skew(&v.ang), skew(&v.lin));
+    let mut x = M6::zeros();
+    x.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
+    x.fixed_view_mut::<3, 3>(0, 3).copy_from(&l);
+    x.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
+    x
 }
 
 /// Cholesky factor `l` of the symmetric positive-definite `a` and `inv = a⁻¹` (full), in place,
