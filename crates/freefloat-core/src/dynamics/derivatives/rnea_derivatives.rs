@@ -1,14 +1,15 @@
 //! ∂τ/∂q, ∂τ/∂v of the recursive Newton-Euler algorithm and ∂a/∂(q, v, τ) of forward dynamics, by
 //! exact forward-mode differentiation in inertial coordinates (see the module documentation).
 
+use super::minv::minv_core;
 use super::{check_workspace, gemm, Derivatives};
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
-use crate::dynamics::{crba_unchecked, gravity_acceleration, hybrid_aba_unchecked};
+use crate::dynamics::{gravity_acceleration, hybrid_aba_unchecked};
 use crate::error::{FfError, Result};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
-use crate::spatial::{m6_mul_motion, skew, Force, Inertia, Motion, M6, V3};
+use crate::spatial::{skew, Force, Inertia, Motion, M3, M6, V3};
 use nalgebra::DMatrix;
 
 /// Column `c` of a 6×k subspace as a motion.
@@ -70,18 +71,13 @@ pub(crate) fn aba_derivatives_unchecked(
     tau: &[f64],
     fext: Option<&[f64]>,
 ) -> Result<()> {
-    // CRBA first: under a free root it leaves `d.o_mi`, `d.ic` and `d.os` relative to the base (see
-    // `crba_unchecked`), and callers (the DDP cost Jacobians among them) read world-frame kinematics from `d`
-    // after this call. ABA and the derivative passes below overwrite them in the inertial frame; neither touches
-    // `d.mass_matrix`.
-    crba_unchecked(m, d, q);
     hybrid_aba_unchecked(m, d, q, v, tau, fext, None)?;
     w.ddq.copy_from_slice(&d.ddq);
     let a = std::mem::take(&mut w.ddq);
     // ABA ran forward kinematics at q already.
     rnea_derivatives_core(m, d, w, v, &a, fext);
     w.ddq = a;
-    if !cholesky_inverse(&d.mass_matrix, &mut w.chol, &mut w.minv) {
+    if !minv_core(m, d, w) {
         return Err(FfError::Numerical("the mass matrix is not positive definite".into()));
     }
     gemm(&mut w.da_dq, -1.0, &w.minv, &w.dtau_dq, 0.0);
@@ -100,8 +96,9 @@ pub(crate) fn rnea_derivatives_core(
     a: &[f64],
     fext: Option<&[f64]>,
 ) {
-    let n = m.nbodies();
+    let (n, nv) = (m.nbodies(), m.nv);
     let ag = gravity_acceleration(m);
+    let Derivatives { ov: ovs, oa: oas, oi: ois, ff, ic, bc, sw, psi_d, psi_dd, dadv, dtau_dq, dtau_dv, .. } = w;
     // Forward pass (Alg. 1, lines 2-9), inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
     // vᵢ = v_λ + Sᵢq̇ᵢ, aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ, fᵢ = Iᵢaᵢ + vᵢ ×* Iᵢvᵢ − fextᵢ; and per joint column ψ
     // the parts of ∂v/∂q and ∂a/∂q that do not merely turn with the moved subtree, Ψ̇ = v_λ × ψ and
@@ -110,23 +107,24 @@ pub(crate) fn rnea_derivatives_core(
         let omi = d.o_mi[i];
         let (k, iv) = (m.nvs[i], m.idx_v[i]);
         let (vp, ap) = match m.parents[i] {
-            Some(p) => (w.ov[p], w.oa[p]),
+            Some(p) => (ovs[p], oas[p]),
             None => (Motion::ZERO, ag),
         };
         let (mut vj, mut aj) = (Motion::ZERO, Motion::ZERO);
         for c in 0..k {
             let s = omi.act_motion(&col(&d.s[i], c));
             d.os[i].set_column(c, &s.to_v6());
+            sw[iv + c] = s;
             vj += s * v[iv + c];
             aj += s * a[iv + c];
             let pd = vp.cross_motion(&s);
-            w.psi_d[iv + c] = pd;
-            w.psi_dd[iv + c] = ap.cross_motion(&s) + vp.cross_motion(&pd);
+            psi_d[iv + c] = pd;
+            psi_dd[iv + c] = ap.cross_motion(&s) + vp.cross_motion(&pd);
         }
         let ov = vp + vj;
         let oa = ap + aj + ov.cross_motion(&vj);
-        for c in 0..k {
-            w.dadv[iv + c] = w.psi_d[iv + c] + ov.cross_motion(&col(&d.os[i], c));
+        for c in iv..iv + k {
+            dadv[c] = psi_d[c] + ov.cross_motion(&sw[c]);
         }
         let oi = m.inertias[i].transformed(&omi);
         let h = oi.mul_motion(&ov);
@@ -134,12 +132,12 @@ pub(crate) fn rnea_derivatives_core(
             Some(f) => omi.act_force(&Force::from_slice(&f[6 * i..6 * i + 6])),
             None => Force::ZERO,
         };
-        w.ov[i] = ov;
-        w.oa[i] = oa;
-        w.oi[i] = oi;
-        w.ic[i] = oi;
-        w.bc[i] = b_matrix(&oi, &ov, &h);
-        w.ff[i] = oi.mul_motion(&oa) + ov.cross_force(&h) - fe;
+        ovs[i] = ov;
+        oas[i] = oa;
+        ois[i] = oi;
+        ic[i] = oi;
+        bc[i] = BMap::of(&oi, &ov, &h);
+        ff[i] = oi.mul_motion(&oa) + ov.cross_force(&h) - fe;
     }
 
     // Backward pass (Alg. 1, lines 10-19). With the subtree composites Fᵢ = Σ f, Icᵢ = Σ I and Bcᵢ = Σ B (line 12),
@@ -148,73 +146,91 @@ pub(crate) fn rnea_derivatives_core(
     // (row i, line 15), and for the strict ancestors j of i, with ψ now a column of i,
     //   ∂τ_j/∂qᵢ = S_jᵀ (ψ ×* Fᵢ + Icᵢ Ψ̈ᵢ + Bcᵢ Ψ̇ᵢ)        ∂τ_j/∂q̇ᵢ = S_jᵀ (Bcᵢ ψ + Icᵢ (Ψ̇ᵢ + Ṡᵢ))
     // (column i, lines 16-17). Every other entry is zero (joints on different branches).
-    w.dtau_dq.fill(0.0);
-    w.dtau_dv.fill(0.0);
+    let (tq, tv) = (dtau_dq.as_mut_slice(), dtau_dv.as_mut_slice());
+    tq.fill(0.0);
+    tv.fill(0.0);
     for i in (0..n).rev() {
         let (k, iv) = (m.nvs[i], m.idx_v[i]);
-        let (ic, bc, f) = (w.ic[i], w.bc[i], w.ff[i]);
-        for r in 0..k {
-            let row = iv + r;
-            let s = col(&d.os[i], r);
+        let (ici, bci, f) = (ic[i], bc[i], ff[i]);
+        for row in iv..iv + k {
+            let s = sw[row];
             d.tau[row] = s.dot(&f);
-            // Sᵢᵀ Icᵢ and Sᵢᵀ Bcᵢ as covectors (Icᵢ is symmetric)
-            let u1 = ic.mul_motion(&s);
-            let u2 = Force::from_v6(&bc.tr_mul(&s.to_v6()));
+            // Sᵢᵀ Icᵢ (Icᵢ is symmetric) and Sᵢᵀ Bcᵢ (angular part only) as covectors
+            let u1 = ici.mul_motion(&s);
+            let u2 = bci.tr_apply(&s);
             let mut j = Some(i);
             while let Some(jj) = j {
                 for c in m.idx_v[jj]..m.idx_v[jj] + m.nvs[jj] {
-                    w.dtau_dq[(row, c)] = w.psi_dd[c].dot(&u1) + w.psi_d[c].dot(&u2);
-                    w.dtau_dv[(row, c)] = col(&d.os[jj], c - m.idx_v[jj]).dot(&u2) + w.dadv[c].dot(&u1);
+                    tq[c * nv + row] = psi_dd[c].dot(&u1) + psi_d[c].ang.dot(&u2);
+                    tv[c * nv + row] = sw[c].ang.dot(&u2) + dadv[c].dot(&u1);
                 }
                 j = m.parents[jj];
             }
-            let xq = s.cross_force(&f) + ic.mul_motion(&w.psi_dd[row]) + m6_mul_motion(&bc, &w.psi_d[row]);
-            let xv = m6_mul_motion(&bc, &s) + ic.mul_motion(&w.dadv[row]);
+            let xq = s.cross_force(&f) + ici.mul_motion(&psi_dd[row]) + bci.apply(&psi_d[row]);
+            let xv = bci.apply(&s) + ici.mul_motion(&dadv[row]);
             let mut j = m.parents[i];
             while let Some(jj) = j {
-                for c in 0..m.nvs[jj] {
-                    let sj = col(&d.os[jj], c);
-                    w.dtau_dq[(m.idx_v[jj] + c, row)] = sj.dot(&xq);
-                    w.dtau_dv[(m.idx_v[jj] + c, row)] = sj.dot(&xv);
+                for c in m.idx_v[jj]..m.idx_v[jj] + m.nvs[jj] {
+                    tq[row * nv + c] = sw[c].dot(&xq);
+                    tv[row * nv + c] = sw[c].dot(&xv);
                 }
                 j = m.parents[jj];
             }
         }
         if let Some(p) = m.parents[i] {
-            w.ic[p] = w.ic[p].add(&ic);
-            w.bc[p] += bc;
-            w.ff[p] += f;
+            ic[p] = ic[p].add(&ici);
+            bc[p].add(&bci);
+            ff[p] += f;
         }
     }
 }
 
-/// The 6×6 matrix of the map `e ↦ I (e × v) + e ×* (I v) + v ×* (I e)`: the derivative of a body's force
-/// `f = I a + v ×* I v` along a change `e` of its twist that also enters its acceleration as `e × v` (Carpentier
-/// and Mansard 2018, eq. (14): Bᵢ). With X = [v×] the motion cross-product matrix and `[v×*] = −Xᵀ`, it is
-/// `H − I X − (I X)ᵀ`, where H (the map `e ↦ e ×* h`, h = I v) is antisymmetric.
-fn b_matrix(oi: &Inertia, ov: &Motion, h: &Force) -> M6 {
-    let x = motion_cross_matrix(ov);
-    let ix = oi.to_matrix() * x;
-    // e ×* h = (e_ang × h_lin, e_ang × h_ang + e_lin × h_lin) = (−[h_lin] e_ang, −[h_lin] e_lin − [h_ang] e_ang)
-    let (hl, ha) = (skew(&h.lin), skew(&h.ang));
-    let mut b = -(ix + ix.transpose());
-    let mut blk = b.fixed_view_mut::<3, 3>(0, 3);
-    blk -= hl;
-    let mut blk = b.fixed_view_mut::<3, 3>(3, 0);
-    blk -= hl;
-    let mut blk = b.fixed_view_mut::<3, 3>(3, 3);
-    blk -= ha;
-    b
+/// The map `e ↦ I (e × v) + e ×* (I v) + v ×* (I e)` of one body (or a sum of them over a subtree): the derivative
+/// of a body's force `f = I a + v ×* I v` along a change `e` of its twist that also enters its acceleration as
+/// `e × v` (Carpentier and Mansard 2018, eq. (14), Bᵢ). As a 6×6 matrix it is `H − I X − (I X)ᵀ` with X = [v×],
+/// `[v×*] = −Xᵀ` and H the matrix of `e ↦ e ×* h` (h = I v = (h_lin, h_ang)); written out in 3×3 blocks with
+/// `I = [[m 1, −[c]], [[c], I_o]]` (c the first moment) and h_lin = m v_lin − c × ω, its linear-input half vanishes:
+/// `[[0, −2[h_lin]], [0, A + Aᵀ − (v_lin cᵀ + c v_linᵀ) + 2 (c·v_lin) 1 − [h_ang]]]`, A = [ω] I_o. So it is kept
+/// as h_lin and the 3×3 block (both additive over a subtree).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BMap {
+    h_lin: V3,
+    aa: M3,
 }
 
-/// `[v×]`: the matrix of `e ↦ v × e` on motions `[lin; ang]`, `[[ω×, v_lin×], [0, ω×]]`.
-fn motion_cross_matrix(v: &Motion) -> M6 {
-    let (w, l) = (skew(&v.ang), skew(&v.lin));
-    let mut x = M6::zeros();
-    x.fixed_view_mut::<3, 3>(0, 0).copy_from(&w);
-    x.fixed_view_mut::<3, 3>(0, 3).copy_from(&l);
-    x.fixed_view_mut::<3, 3>(3, 3).copy_from(&w);
-    x
+impl BMap {
+    pub(crate) const ZERO: BMap = BMap { h_lin: V3::new(0.0, 0.0, 0.0), aa: M3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
+
+    /// Of a body of inertia `oi` moving with twist `ov` and momentum `h = oi ov`.
+    fn of(oi: &Inertia, ov: &Motion, h: &Force) -> BMap {
+        let (c, vl, w) = (&oi.h, &ov.lin, &ov.ang);
+        let io = &oi.i_o;
+        // A = [ω] I_o, column by column
+        let a = M3::from_columns(&[w.cross(&io.column(0)), w.cross(&io.column(1)), w.cross(&io.column(2))]);
+        let mut aa = a + a.transpose() - (vl * c.transpose() + c * vl.transpose()) - skew(&h.ang);
+        let d2 = 2.0 * c.dot(vl);
+        for r in 0..3 {
+            aa[(r, r)] += d2;
+        }
+        BMap { h_lin: h.lin, aa }
+    }
+
+    fn add(&mut self, o: &BMap) {
+        self.h_lin += o.h_lin;
+        self.aa += o.aa;
+    }
+
+    /// `B e = (2 e_ang × h_lin, A e_ang)`.
+    #[inline]
+    fn apply(&self, e: &Motion) -> Force {
+        Force::new(2.0 * e.ang.cross(&self.h_lin), self.aa * e.ang)
+    }
+
+    /// The angular half of `Bᵀ s` (its linear half is zero): `2 h_lin × s_lin + Aᵀ s_ang`.
+    #[inline]
+    fn tr_apply(&self, s: &Motion) -> V3 {
+        2.0 * self.h_lin.cross(&s.lin) + self.aa.tr_mul(&s.ang)
+    }
 }
 
 /// Cholesky factor `l` of the symmetric positive-definite `a` and `inv = a⁻¹` (full), in place,

@@ -1,0 +1,205 @@
+//! M⁻¹ by the articulated-body algorithm run on all nv unit torques at once (Carpentier, "Analytical inverse of
+//! the joint space inertia matrix", 2018; Featherstone, RBDA §7.3 with τ = eₖ, v = 0, no gravity): O(nv · n)
+//! 6-vector operations instead of CRBA, a Cholesky factor and a triangular inverse (O(nv³)).
+//!
+//! Articulated-body recursion with the bias force pᴬᵢ(τ) and the accelerations linear in τ (inertial frame):
+//! backward, `Uᵢ = Iᴬᵢ Sᵢ`, `Dᵢ = Sᵢᵀ Uᵢ`, `q̈ᵢ ← Dᵢ⁻¹ (τᵢ − Sᵢᵀ pᴬᵢ)` (the part not depending on the parent's
+//! acceleration), `Iᴬ_λ += Iᴬᵢ − Uᵢ Dᵢ⁻¹ Uᵢᵀ`, `pᴬ_λ += pᴬᵢ + Uᵢ q̈ᵢ`; forward, `q̈ᵢ −= Dᵢ⁻¹ Uᵢᵀ a_λ`,
+//! `aᵢ = a_λ + Sᵢ q̈ᵢ` (RBDA eqs. 7.38-7.45). Each of pᴬ and a is kept as a 6 × nv matrix (one column per unit torque).
+//! pᴬᵢ depends only on the torques of i's subtree, so the backward pass works on the columns of that subtree's
+//! velocity range only; by symmetry the forward pass computes the upper triangle only (columns from joint i on).
+
+use super::Derivatives;
+use crate::data::Data;
+use crate::model::Model;
+use crate::spatial::M6;
+
+/// Fill `w.minv` with M(q)⁻¹, after `rnea_derivatives_core` left the inertial-frame inertias in `w.oi` and the
+/// subspaces in `d.os`. False if an articulated joint inertia Dᵢ is not positive definite.
+pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
+    let (n, nv) = (m.nbodies(), m.nv);
+    let Derivatives { fm, ia, mu, mdinv, sub_end, oi, minv, .. } = w;
+    let ms = minv.as_mut_slice();
+    // column c of body i's 6 × nv matrix (pᴬ in the backward pass, a in the forward pass)
+    let at = |i: usize, c: usize| 6 * (nv * i + c);
+    for i in 0..n {
+        fm[at(i, m.idx_v[i])..at(i, sub_end[i])].fill(0.0);
+        ia[i] = oi[i].to_matrix();
+    }
+    for i in (0..n).rev() {
+        let (k, iv, end) = (m.nvs[i], m.idx_v[i], sub_end[i]);
+        let parent = m.parents[i];
+        let s = &d.os[i];
+        if k == 0 {
+            // a welded body passes its whole inertia and bias on
+            if let Some(p) = parent {
+                let iai = ia[i];
+                ia[p] += iai;
+                for c in iv..end {
+                    for r in 0..6 {
+                        fm[at(p, c) + r] += fm[at(i, c) + r];
+                    }
+                }
+            }
+            continue;
+        }
+        if k == 1 {
+            // one degree of freedom: scalar D, rank-one update of the parent (RBDA Table 7.1)
+            let s0 = s.column(0).into_owned();
+            let u0 = ia[i] * s0;
+            let dd = s0.dot(&u0);
+            if !(dd > 0.0) || !dd.is_finite() {
+                return false;
+            }
+            let dinv = 1.0 / dd;
+            for c in iv..end {
+                let f = &fm[at(i, c)..at(i, c) + 6];
+                let e = if c == iv { 1.0 } else { 0.0 };
+                ms[c * nv + iv] = dinv * (e - dot6(s0.as_slice(), f));
+            }
+            for c in end..nv {
+                ms[c * nv + iv] = 0.0;
+            }
+            if let Some(p) = parent {
+                let iai = ia[i];
+                let iap = &mut ia[p];
+                for cc in 0..6 {
+                    let uc = u0[cc] * dinv;
+                    for r in 0..6 {
+                        iap[(r, cc)] += iai[(r, cc)] - u0[r] * uc;
+                    }
+                }
+                for c in iv..end {
+                    let x = ms[c * nv + iv];
+                    let (lo, hi) = fm.split_at_mut(at(i, 0));
+                    let (fp, fi) = (&mut lo[at(p, c)..at(p, c) + 6], &hi[6 * c..6 * c + 6]);
+                    for r in 0..6 {
+                        fp[r] += u0[r].mul_add(x, fi[r]);
+                    }
+                }
+            }
+            let mut uu = M6::zeros();
+            uu.set_column(0, &u0);
+            mu[i] = uu;
+            mdinv[i][(0, 0)] = dinv;
+            continue;
+        }
+        let u = ia[i] * s; // columns 0..k are U = Iᴬ S
+        let Some(dinv) = joint_inverse(s, &u, k) else {
+            return false;
+        };
+        // rows iv..iv+k: Dᵢ⁻¹ (eᵢ − Sᵢᵀ pᴬᵢ) on the subtree columns, 0 beyond (filled by the forward pass)
+        for c in iv..end {
+            let f = &fm[at(i, c)..at(i, c) + 6];
+            let mut t = [0.0; 6];
+            for (sr, tr) in t.iter_mut().enumerate().take(k) {
+                *tr = if c == iv + sr { 1.0 } else { 0.0 } - dot6(s.column(sr).as_slice(), f);
+            }
+            for r in 0..k {
+                ms[c * nv + iv + r] = (0..k).map(|sr| dinv[(r, sr)] * t[sr]).sum();
+            }
+        }
+        for c in end..nv {
+            ms[c * nv + iv..c * nv + iv + k].fill(0.0);
+        }
+        if let Some(p) = parent {
+            // Iᴬ_λ += Iᴬᵢ − U D⁻¹ Uᵀ, pᴬ_λ += pᴬᵢ + U q̈ᵢ
+            let mut ud = M6::zeros();
+            for r in 0..6 {
+                for c in 0..k {
+                    ud[(r, c)] = (0..k).map(|sr| u[(r, sr)] * dinv[(sr, c)]).sum();
+                }
+            }
+            let iai = ia[i];
+            let iap = &mut ia[p];
+            for cc in 0..6 {
+                for r in 0..6 {
+                    iap[(r, cc)] += iai[(r, cc)] - (0..k).map(|sr| ud[(r, sr)] * u[(cc, sr)]).sum::<f64>();
+                }
+            }
+            for c in iv..end {
+                for r in 0..6 {
+                    let mut x = fm[at(i, c) + r];
+                    for sr in 0..k {
+                        x += u[(r, sr)] * ms[c * nv + iv + sr];
+                    }
+                    fm[at(p, c) + r] += x;
+                }
+            }
+        }
+        mu[i] = u;
+        mdinv[i] = dinv;
+    }
+    // Forward pass: aᵢ (6 × nv, in the same buffer: pᴬᵢ is no longer needed) on the columns iv.. only.
+    for i in 0..n {
+        let (k, iv) = (m.nvs[i], m.idx_v[i]);
+        let (s, u, dinv) = (&d.os[i], &mu[i], &mdinv[i]);
+        let Some(p) = m.parents[i] else {
+            // the root: a = S q̈ (no parent acceleration)
+            for c in iv..nv {
+                let mut a = [0.0; 6];
+                for r in 0..k {
+                    let x = ms[c * nv + iv + r];
+                    for (e, sv) in a.iter_mut().zip(s.column(r).iter()) {
+                        *e = sv.mul_add(x, *e);
+                    }
+                }
+                fm[at(i, c)..at(i, c) + 6].copy_from_slice(&a);
+            }
+            continue;
+        };
+        let (lo, hi) = fm.split_at_mut(at(i, 0));
+        for c in iv..nv {
+            let mut a: [f64; 6] = lo[at(p, c)..at(p, c) + 6].try_into().expect("6 entries");
+            if k > 0 {
+                let mut y = [0.0; 6];
+                for (sr, yr) in y.iter_mut().enumerate().take(k) {
+                    *yr = dot6(u.column(sr).as_slice(), &a);
+                }
+                for r in 0..k {
+                    let x = ms[c * nv + iv + r] - (0..k).map(|sr| dinv[(r, sr)] * y[sr]).sum::<f64>();
+                    ms[c * nv + iv + r] = x;
+                    for (e, sv) in a.iter_mut().zip(s.column(r).iter()) {
+                        *e = sv.mul_add(x, *e);
+                    }
+                }
+            }
+            hi[6 * c..6 * c + 6].copy_from_slice(&a);
+        }
+    }
+    for c in 0..nv {
+        for r in c + 1..nv {
+            ms[c * nv + r] = ms[r * nv + c];
+        }
+    }
+    true
+}
+
+#[inline(always)]
+fn dot6(a: &[f64], b: &[f64]) -> f64 {
+    let (a, b) = (&a[..6], &b[..6]);
+    a[2].mul_add(b[2], a[1].mul_add(b[1], a[0] * b[0])) + a[5].mul_add(b[5], a[4].mul_add(b[4], a[3] * b[3]))
+}
+
+/// Dᵢ⁻¹ for `Dᵢ = Sᵢᵀ Uᵢ` (k × k, in the top-left corner; the rest zero), None if Dᵢ is not positive definite.
+fn joint_inverse(s: &M6, u: &M6, k: usize) -> Option<M6> {
+    let mut out = M6::zeros();
+    if k == 1 {
+        let dd = s.column(0).dot(&u.column(0));
+        if !(dd > 0.0) || !dd.is_finite() {
+            return None;
+        }
+        out[(0, 0)] = 1.0 / dd;
+        return Some(out);
+    }
+    // pad to 6 × 6 with the identity so the fixed-size (non-allocating) Cholesky applies to every k
+    let mut dm = M6::identity();
+    for r in 0..k {
+        for c in 0..k {
+            dm[(r, c)] = s.column(r).dot(&u.column(c));
+        }
+    }
+    let inv = nalgebra::Cholesky::new(dm)?.inverse();
+    out.view_mut((0, 0), (k, k)).copy_from(&inv.view((0, 0), (k, k)));
+    Some(out)
+}
