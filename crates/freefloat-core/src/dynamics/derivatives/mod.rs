@@ -178,7 +178,10 @@ pub(crate) fn check_supported(m: &Model) -> Result<()> {
 }
 
 /// `c = α a b + β c` without allocating (nalgebra's dynamic `gemm` packs through a heap buffer);
-/// zero entries of `b` are skipped, which the block-diagonal Jacobians of ⊕ have many of.
+/// zero entries of `b` are skipped, which the block-diagonal Jacobians of ⊕ and the tree-sparse ∂τ/∂x have many of.
+/// Each column of c is summed in register tiles of 8 rows (two 4-lane fused multiply-adds per entry of b): an axpy
+/// per entry of b would load and store the column of c each time, and the compiler unrolls a plain axpy 16 wide
+/// and leaves most of a column of 12 or 26 to its scalar tail.
 pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RStride = nalgebra::U1>>(
     c: &mut nalgebra::Matrix<f64, nalgebra::Dyn, nalgebra::Dyn, S>,
     alpha: f64,
@@ -194,33 +197,89 @@ pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RS
     for j in 0..p {
         let mut cj = c.column_mut(j);
         let cs = cj.as_mut_slice();
-        if beta == 0.0 {
-            cs.fill(0.0);
-        } else if beta != 1.0 {
-            cs.iter_mut().for_each(|x| *x *= beta);
-        }
-        for (k, &bkj) in bsl[j * kk..(j + 1) * kk].iter().enumerate() {
-            if bkj == 0.0 {
-                continue;
-            }
-            let s = alpha * bkj;
-            axpy(cs, s, &asl[k * n..(k + 1) * n]);
+        let bj = &bsl[j * kk..(j + 1) * kk];
+        match (n / 8, n % 8 != 0) {
+            (1, false) => whole_column::<8, false>(cs, alpha, asl, bj, beta),
+            (1, true) => whole_column::<8, true>(cs, alpha, asl, bj, beta),
+            (2, false) => whole_column::<16, false>(cs, alpha, asl, bj, beta),
+            (2, true) => whole_column::<16, true>(cs, alpha, asl, bj, beta),
+            (3, false) => whole_column::<24, false>(cs, alpha, asl, bj, beta),
+            (3, true) => whole_column::<24, true>(cs, alpha, asl, bj, beta),
+            (4, false) => whole_column::<32, false>(cs, alpha, asl, bj, beta),
+            (4, true) => whole_column::<32, true>(cs, alpha, asl, bj, beta),
+            _ => tiled_column(cs, alpha, asl, bj, beta),
         }
     }
 }
 
-/// `y += s x` in chunks of four lanes (one vector fused multiply-add each on AVX2; a plain zip leaves a scalar tail of
-/// up to 15 entries after a 16-wide unrolled body, most of a column of 12 or 26).
+/// Column `c = α a b_j + β c` of 8 ≤ n < 40 rows in one pass over b_j: the first M = 8⌊n/8⌋ rows and, if `TAIL`,
+/// the last 8 rows (overlapping them) summed in registers together.
 #[inline(always)]
-fn axpy(y: &mut [f64], s: f64, x: &[f64]) {
-    let (mut yc, xc) = (y.chunks_exact_mut(4), x.chunks_exact(4));
-    let xr = xc.remainder();
-    for (yv, xv) in (&mut yc).zip(xc) {
-        for l in 0..4 {
-            yv[l] = xv[l].mul_add(s, yv[l]);
+fn whole_column<const M: usize, const TAIL: bool>(c: &mut [f64], alpha: f64, a: &[f64], bj: &[f64], beta: f64) {
+    let n = c.len();
+    let (mut acc, mut tail) = ([0.0; M], [0.0; 8]);
+    for (k, &bkj) in bj.iter().enumerate() {
+        if bkj == 0.0 {
+            continue;
+        }
+        let ak = &a[k * n..(k + 1) * n];
+        let head: &[f64; M] = ak[..M].try_into().expect("M ≤ n rows");
+        for l in 0..M {
+            acc[l] = head[l].mul_add(bkj, acc[l]);
+        }
+        if TAIL {
+            let last: &[f64; 8] = ak[n - 8..].try_into().expect("8 ≤ n rows");
+            for l in 0..8 {
+                tail[l] = last[l].mul_add(bkj, tail[l]);
+            }
         }
     }
-    for (yi, xi) in yc.into_remainder().iter_mut().zip(xr) {
-        *yi = xi.mul_add(s, *yi);
+    store(&mut c[..M], alpha, &acc, beta);
+    if TAIL {
+        store(&mut c[M..], alpha, &tail[8 - (n - M)..], beta);
+    }
+}
+
+/// The same for any number of rows, in tiles of 8, 4 and 1 rows (one pass over b_j each).
+fn tiled_column(cs: &mut [f64], alpha: f64, asl: &[f64], bj: &[f64], beta: f64) {
+    let n = cs.len();
+    let mut r = 0;
+    while r + 8 <= n {
+        let acc = tile::<8>(asl, n, r, bj);
+        store(&mut cs[r..r + 8], alpha, &acc, beta);
+        r += 8;
+    }
+    if r + 4 <= n {
+        let acc = tile::<4>(asl, n, r, bj);
+        store(&mut cs[r..r + 4], alpha, &acc, beta);
+        r += 4;
+    }
+    while r < n {
+        let acc = tile::<1>(asl, n, r, bj);
+        store(&mut cs[r..r + 1], alpha, &acc, beta);
+        r += 1;
+    }
+}
+
+/// Rows `r..r + L` of `a b_j` (a: n rows, column-major), skipping the zero entries of `b_j`.
+#[inline(always)]
+fn tile<const L: usize>(a: &[f64], n: usize, r: usize, bj: &[f64]) -> [f64; L] {
+    let mut acc = [0.0; L];
+    for (k, &bkj) in bj.iter().enumerate() {
+        if bkj == 0.0 {
+            continue;
+        }
+        let ak: &[f64; L] = a[k * n + r..k * n + r + L].try_into().expect("L rows");
+        for l in 0..L {
+            acc[l] = ak[l].mul_add(bkj, acc[l]);
+        }
+    }
+    acc
+}
+
+#[inline(always)]
+fn store(c: &mut [f64], alpha: f64, acc: &[f64], beta: f64) {
+    for (ci, x) in c.iter_mut().zip(acc) {
+        *ci = if beta == 0.0 { alpha * x } else { alpha.mul_add(*x, beta * *ci) };
     }
 }
