@@ -146,9 +146,25 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
                 }
                 fm[at(i, c)..at(i, c) + 6].copy_from_slice(&a);
             }
+            mirror(ms, nv, iv, k);
             continue;
         };
         let (lo, hi) = fm.split_at_mut(at(i, 0));
+        if k == 1 {
+            // q̈ᵢ −= Dᵢ⁻¹ Uᵢᵀ a_λ, aᵢ = a_λ + Sᵢ q̈ᵢ; the finished row is mirrored into column iv at once
+            let (s0, u0, dinv) = (s.column(0), u.column(0), dinv[(0, 0)]);
+            for c in iv..nv {
+                let ap: &[f64; 6] = lo[at(p, c)..at(p, c) + 6].try_into().expect("6 entries");
+                let x = (-dinv).mul_add(dot6(u0.as_slice(), ap), ms[c * nv + iv]);
+                ms[c * nv + iv] = x;
+                ms[iv * nv + c] = x;
+                let ai = &mut hi[6 * c..6 * c + 6];
+                for r in 0..6 {
+                    ai[r] = s0[r].mul_add(x, ap[r]);
+                }
+            }
+            continue;
+        }
         for c in iv..nv {
             let mut a: [f64; 6] = lo[at(p, c)..at(p, c) + 6].try_into().expect("6 entries");
             if k > 0 {
@@ -166,13 +182,18 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
             }
             hi[6 * c..6 * c + 6].copy_from_slice(&a);
         }
-    }
-    for c in 0..nv {
-        for r in c + 1..nv {
-            ms[c * nv + r] = ms[r * nv + c];
-        }
+        mirror(ms, nv, iv, k);
     }
     true
+}
+
+/// Copy rows `iv..iv + k` of the upper triangle (columns from iv on) to the lower triangle, in place.
+fn mirror(ms: &mut [f64], nv: usize, iv: usize, k: usize) {
+    for r in iv..iv + k {
+        for c in r + 1..nv {
+            ms[r * nv + c] = ms[c * nv + r];
+        }
+    }
 }
 
 #[inline(always)]

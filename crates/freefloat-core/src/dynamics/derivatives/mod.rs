@@ -218,11 +218,10 @@ pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RS
 fn whole_column<const M: usize, const TAIL: bool>(c: &mut [f64], alpha: f64, a: &[f64], bj: &[f64], beta: f64) {
     let n = c.len();
     let (mut acc, mut tail) = ([0.0; M], [0.0; 8]);
-    for (k, &bkj) in bj.iter().enumerate() {
+    for (ak, &bkj) in a.chunks_exact(n).zip(bj) {
         if bkj == 0.0 {
             continue;
         }
-        let ak = &a[k * n..(k + 1) * n];
         let head: &[f64; M] = ak[..M].try_into().expect("M ≤ n rows");
         for l in 0..M {
             acc[l] = head[l].mul_add(bkj, acc[l]);
