@@ -84,6 +84,9 @@ pub struct Derivatives {
     pub(crate) psi_d: Vec<Motion>,
     pub(crate) psi_dd: Vec<Motion>,
     pub(crate) dadv: Vec<Motion>,
+    // per velocity index, the previous one on its path to the root: the one before it in its joint, else the last
+    // one of the nearest ancestor joint that has any (None at the root)
+    pub(crate) dof_parent: Vec<Option<usize>>,
     // ---- scratch of the M⁻¹ pass (`minv`): per body Iᴬ, U, D⁻¹, the end of its subtree's velocity range, and
     // pᴬ / a as 6 × nv matrices
     pub(crate) ia: Vec<crate::spatial::M6>,
@@ -122,6 +125,7 @@ impl Derivatives {
             psi_d: vec![Motion::ZERO; nv],
             psi_dd: vec![Motion::ZERO; nv],
             dadv: vec![Motion::ZERO; nv],
+            dof_parent: dof_parents(m),
             ia: vec![crate::spatial::M6::zeros(); n],
             mu: vec![crate::spatial::M6::zeros(); n],
             mdinv: vec![crate::spatial::M6::zeros(); n],
@@ -138,6 +142,21 @@ impl Derivatives {
     pub fn model_id(&self) -> u64 {
         self.model_id
     }
+}
+
+/// `Derivatives::dof_parent`.
+fn dof_parents(m: &Model) -> Vec<Option<usize>> {
+    let mut last: Vec<Option<usize>> = vec![None; m.nbodies()];
+    let mut out = vec![None; m.nv];
+    for i in 0..m.nbodies() {
+        let mut prev = m.parents[i].and_then(|p| last[p]);
+        for c in m.idx_v[i]..m.idx_v[i] + m.nvs[i] {
+            out[c] = prev;
+            prev = Some(c);
+        }
+        last[i] = prev;
+    }
+    out
 }
 
 /// For each body, one past the last velocity index of its subtree (bodies are numbered parents first and velocity

@@ -98,7 +98,8 @@ pub(crate) fn rnea_derivatives_core(
 ) {
     let (n, nv) = (m.nbodies(), m.nv);
     let ag = gravity_acceleration(m);
-    let Derivatives { ov: ovs, oa: oas, oi: ois, ff, ic, bc, sw, psi_d, psi_dd, dadv, dtau_dq, dtau_dv, .. } = w;
+    let Derivatives { ov: ovs, oa: oas, oi: ois, ff, ic, bc, sw, psi_d, psi_dd, dadv, dtau_dq, dtau_dv, dof_parent, .. } =
+        w;
     // Forward pass (Alg. 1, lines 2-9), inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
     // vᵢ = v_λ + Sᵢq̇ᵢ, aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ, fᵢ = Iᵢaᵢ + vᵢ ×* Iᵢvᵢ − fextᵢ; and per joint column ψ
     // the parts of ∂v/∂q and ∂a/∂q that do not merely turn with the moved subtree, Ψ̇ = v_λ × ψ and
@@ -158,23 +159,23 @@ pub(crate) fn rnea_derivatives_core(
             // Sᵢᵀ Icᵢ (Icᵢ is symmetric) and Sᵢᵀ Bcᵢ (angular part only) as covectors
             let u1 = ici.mul_motion(&s);
             let u2 = bci.tr_apply(&s);
-            let mut j = Some(i);
-            while let Some(jj) = j {
-                for c in m.idx_v[jj]..m.idx_v[jj] + m.nvs[jj] {
-                    tq[c * nv + row] = psi_dd[c].dot(&u1) + psi_d[c].ang.dot(&u2);
-                    tv[c * nv + row] = sw[c].ang.dot(&u2) + dadv[c].dot(&u1);
+            // the joint's own columns and its ancestors', walking the path one velocity index at a time
+            let mut c = iv + k - 1;
+            loop {
+                tq[c * nv + row] = psi_dd[c].dot(&u1) + psi_d[c].ang.dot(&u2);
+                tv[c * nv + row] = sw[c].ang.dot(&u2) + dadv[c].dot(&u1);
+                match dof_parent[c] {
+                    Some(pc) => c = pc,
+                    None => break,
                 }
-                j = m.parents[jj];
             }
             let xq = s.cross_force(&f) + ici.mul_motion(&psi_dd[row]) + bci.apply(&psi_d[row]);
             let xv = bci.apply(&s) + ici.mul_motion(&dadv[row]);
-            let mut j = m.parents[i];
-            while let Some(jj) = j {
-                for c in m.idx_v[jj]..m.idx_v[jj] + m.nvs[jj] {
-                    tq[row * nv + c] = sw[c].dot(&xq);
-                    tv[row * nv + c] = sw[c].dot(&xv);
-                }
-                j = m.parents[jj];
+            let mut up = dof_parent[iv];
+            while let Some(c) = up {
+                tq[row * nv + c] = sw[c].dot(&xq);
+                tv[row * nv + c] = sw[c].dot(&xv);
+                up = dof_parent[c];
             }
         }
         if let Some(p) = m.parents[i] {
