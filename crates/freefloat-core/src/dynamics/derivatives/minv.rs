@@ -12,7 +12,7 @@
 use super::Derivatives;
 use crate::data::Data;
 use crate::model::Model;
-use crate::spatial::M6;
+use crate::spatial::{M6, V6};
 
 /// Fill `w.minv` with M(q)⁻¹, after `rnea_derivatives_core` left the inertial-frame inertias in `w.oi` and the
 /// subspaces in `d.os`. False if an articulated joint inertia Dᵢ is not positive definite.
@@ -84,46 +84,37 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
             mdinv[i][(0, 0)] = dinv;
             continue;
         }
-        let u = ia[i] * s; // columns 0..k are U = Iᴬ S
-        let Some(dinv) = joint_inverse(s, &u, k) else {
+        // Several degrees of freedom (2, 3, or the free root's 6): fixed 6 × 6 products, with S padded by zero
+        // columns so that U, D⁻¹ and the rows below are zero past k.
+        let mut sp = *s;
+        sp.columns_mut(k, 6 - k).fill(0.0);
+        let u = ia[i] * sp;
+        let Some(dinv) = joint_inverse(&sp, &u, k) else {
             return false;
         };
         // rows iv..iv+k: Dᵢ⁻¹ (eᵢ − Sᵢᵀ pᴬᵢ) on the subtree columns, 0 beyond (filled by the forward pass)
         for c in iv..end {
-            let f = &fm[at(i, c)..at(i, c) + 6];
-            let mut t = [0.0; 6];
-            for (sr, tr) in t.iter_mut().enumerate().take(k) {
-                *tr = if c == iv + sr { 1.0 } else { 0.0 } - dot6(s.column(sr).as_slice(), f);
+            let mut t = -sp.tr_mul(&V6::from_column_slice(&fm[at(i, c)..at(i, c) + 6]));
+            if c < iv + k {
+                t[c - iv] += 1.0;
             }
-            for r in 0..k {
-                ms[c * nv + iv + r] = (0..k).map(|sr| dinv[(r, sr)] * t[sr]).sum();
-            }
+            let x = dinv * t;
+            ms[c * nv + iv..c * nv + iv + k].copy_from_slice(&x.as_slice()[..k]);
         }
         for c in end..nv {
             ms[c * nv + iv..c * nv + iv + k].fill(0.0);
         }
         if let Some(p) = parent {
             // Iᴬ_λ += Iᴬᵢ − U D⁻¹ Uᵀ, pᴬ_λ += pᴬᵢ + U q̈ᵢ
-            let mut ud = M6::zeros();
-            for r in 0..6 {
-                for c in 0..k {
-                    ud[(r, c)] = (0..k).map(|sr| u[(r, sr)] * dinv[(sr, c)]).sum();
-                }
-            }
-            let iai = ia[i];
-            let iap = &mut ia[p];
-            for cc in 0..6 {
-                for r in 0..6 {
-                    iap[(r, cc)] += iai[(r, cc)] - (0..k).map(|sr| ud[(r, sr)] * u[(cc, sr)]).sum::<f64>();
-                }
-            }
+            let ud = u * dinv;
+            let iai = ia[i] - ud * u.transpose();
+            ia[p] += iai;
             for c in iv..end {
-                for r in 0..6 {
-                    let mut x = fm[at(i, c) + r];
-                    for sr in 0..k {
-                        x += u[(r, sr)] * ms[c * nv + iv + sr];
-                    }
-                    fm[at(p, c) + r] += x;
+                let mut x = V6::zeros();
+                x.as_mut_slice()[..k].copy_from_slice(&ms[c * nv + iv..c * nv + iv + k]);
+                let add = V6::from_column_slice(&fm[at(i, c)..at(i, c) + 6]) + u * x;
+                for (fp, a) in fm[at(p, c)..at(p, c) + 6].iter_mut().zip(add.iter()) {
+                    *fp += a;
                 }
             }
         }
@@ -166,21 +157,18 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
             continue;
         }
         for c in iv..nv {
-            let mut a: [f64; 6] = lo[at(p, c)..at(p, c) + 6].try_into().expect("6 entries");
+            let ap = V6::from_column_slice(&lo[at(p, c)..at(p, c) + 6]);
+            let mut a = ap;
             if k > 0 {
-                let mut y = [0.0; 6];
-                for (sr, yr) in y.iter_mut().enumerate().take(k) {
-                    *yr = dot6(u.column(sr).as_slice(), &a);
-                }
+                // q̈ᵢ −= Dᵢ⁻¹ Uᵢᵀ a_λ (U, D⁻¹ zero past k), aᵢ = a_λ + Sᵢ q̈ᵢ
+                let y = dinv * u.tr_mul(&ap);
                 for r in 0..k {
-                    let x = ms[c * nv + iv + r] - (0..k).map(|sr| dinv[(r, sr)] * y[sr]).sum::<f64>();
+                    let x = ms[c * nv + iv + r] - y[r];
                     ms[c * nv + iv + r] = x;
-                    for (e, sv) in a.iter_mut().zip(s.column(r).iter()) {
-                        *e = sv.mul_add(x, *e);
-                    }
+                    a += s.column(r) * x;
                 }
             }
-            hi[6 * c..6 * c + 6].copy_from_slice(&a);
+            hi[6 * c..6 * c + 6].copy_from_slice(a.as_slice());
         }
         mirror(ms, nv, iv, k);
     }
@@ -202,25 +190,18 @@ fn dot6(a: &[f64], b: &[f64]) -> f64 {
     a[2].mul_add(b[2], a[1].mul_add(b[1], a[0] * b[0])) + a[5].mul_add(b[5], a[4].mul_add(b[4], a[3] * b[3]))
 }
 
-/// Dᵢ⁻¹ for `Dᵢ = Sᵢᵀ Uᵢ` (k × k, in the top-left corner; the rest zero), None if Dᵢ is not positive definite.
+/// Dᵢ⁻¹ for `Dᵢ = Sᵢᵀ Uᵢ` (k × k in the top-left corner; S and U zero past column k, and so is the result), None
+/// if Dᵢ is not positive definite.
 fn joint_inverse(s: &M6, u: &M6, k: usize) -> Option<M6> {
-    let mut out = M6::zeros();
-    if k == 1 {
-        let dd = s.column(0).dot(&u.column(0));
-        if !(dd > 0.0) || !dd.is_finite() {
-            return None;
-        }
-        out[(0, 0)] = 1.0 / dd;
-        return Some(out);
+    // padded with the identity so the fixed-size (non-allocating) Cholesky applies to every k; the inverse of
+    // [[D, 0], [0, 1]] is [[D⁻¹, 0], [0, 1]] exactly
+    let mut dm = s.tr_mul(u);
+    for r in k..6 {
+        dm[(r, r)] = 1.0;
     }
-    // pad to 6 × 6 with the identity so the fixed-size (non-allocating) Cholesky applies to every k
-    let mut dm = M6::identity();
-    for r in 0..k {
-        for c in 0..k {
-            dm[(r, c)] = s.column(r).dot(&u.column(c));
-        }
+    let mut inv = nalgebra::Cholesky::new(dm)?.inverse();
+    for r in k..6 {
+        inv[(r, r)] = 0.0;
     }
-    let inv = nalgebra::Cholesky::new(dm)?.inverse();
-    out.view_mut((0, 0), (k, k)).copy_from(&inv.view((0, 0), (k, k)));
-    Some(out)
+    Some(inv)
 }
