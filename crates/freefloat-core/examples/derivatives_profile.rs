@@ -67,5 +67,10 @@ fn main() {
     }
     let dt = t0.elapsed().as_secs_f64();
     black_box(acc);
-    println!("{algo} derivatives on {} (nv = {}): {count} calls, {:.3} us per call", m.name, m.nv, 1e6 * dt / count as f64);
+    println!(
+        "{algo} derivatives on {} (nv = {}): {count} calls, {:.3} us per call",
+        m.name,
+        m.nv,
+        1e6 * dt / count as f64
+    );
 }

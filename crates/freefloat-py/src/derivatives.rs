@@ -27,11 +27,15 @@ fn with_work<T>(m: &Model, f: impl FnOnce(&mut Derivatives) -> T) -> T {
     })
 }
 
+/// `a` (column-major) into `o` row-major, reading it column by column (no 2-D index arithmetic or bounds check per
+/// entry: the indexed copy was ~7 % of the instructions of a single `aba_derivatives` call on a 12-DoF model,
+/// callgrind).
 fn put(a: &DMatrix<f64>, o: &mut [f64]) {
-    let c = a.ncols();
-    for r in 0..a.nrows() {
-        for j in 0..c {
-            o[r * c + j] = a[(r, j)];
+    let (nr, nc) = a.shape();
+    let o = &mut o[..nr * nc];
+    for (j, col) in a.as_slice().chunks_exact(nr).enumerate() {
+        for (x, dst) in col.iter().zip(o[j..].iter_mut().step_by(nc)) {
+            *dst = *x;
         }
     }
 }

@@ -98,8 +98,22 @@ pub(crate) fn rnea_derivatives_core(
 ) {
     let (n, nv) = (m.nbodies(), m.nv);
     let ag = gravity_acceleration(m);
-    let Derivatives { ov: ovs, oa: oas, oi: ois, ff, ic, bc, sw, psi_d, psi_dd, dadv, dtau_dq, dtau_dv, dof_parent, .. } =
-        w;
+    let Derivatives {
+        ov: ovs,
+        oa: oas,
+        oi: ois,
+        ff,
+        ic,
+        bc,
+        sw,
+        psi_d,
+        psi_dd,
+        dadv,
+        dtau_dq,
+        dtau_dv,
+        dof_parent,
+        ..
+    } = w;
     // Forward pass (Alg. 1, lines 2-9), inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
     // vᵢ = v_λ + Sᵢq̇ᵢ, aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ, fᵢ = Iᵢaᵢ + vᵢ ×* Iᵢvᵢ − fextᵢ; and per joint column ψ
     // the parts of ∂v/∂q and ∂a/∂q that do not merely turn with the moved subtree, Ψ̇ = v_λ × ψ and
@@ -200,7 +214,8 @@ pub(crate) struct BMap {
 }
 
 impl BMap {
-    pub(crate) const ZERO: BMap = BMap { h_lin: V3::new(0.0, 0.0, 0.0), aa: M3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
+    pub(crate) const ZERO: BMap =
+        BMap { h_lin: V3::new(0.0, 0.0, 0.0), aa: M3::new(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0) };
 
     /// Of a body of inertia `oi` moving with twist `ov` and momentum `h = oi ov`.
     fn of(oi: &Inertia, ov: &Motion, h: &Force) -> BMap {
