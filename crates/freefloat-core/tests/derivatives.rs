@@ -107,8 +107,8 @@ fn rnea_and_aba_derivatives_match_finite_differences() {
             );
 
             aba_derivatives(&m, &mut d, &mut w, &q, &v, &tau, fe).unwrap();
-            // It leaves world-frame kinematics in `d`, which callers (the DDP cost Jacobians) read: the CRBA it
-            // calls works relative to the base under a free root, and once left `d.o_mi` there.
+            // It leaves world-frame kinematics in `d`, which callers (the DDP cost Jacobians) read (an earlier
+            // version called CRBA, which works relative to the base under a free root, and left `d.o_mi` there).
             let mut fk = Data::new(&m);
             forward_kinematics(&m, &mut fk, &q).unwrap();
             for (i, (x, y)) in d.o_mi.iter().zip(&fk.o_mi).enumerate() {

@@ -19,27 +19,36 @@
 //! differs from `pin.integrate` at O(dt²) when the base rotates and translates at once.
 //!
 //! # Algorithm
-//! ∂τ/∂q and ∂τ/∂v are computed by exact forward-mode differentiation of the recursive
-//! Newton-Euler algorithm in inertial coordinates (Featherstone, RBDA §5.3, in the form of Carpentier
-//! and Mansard, RSS 2018, §III): a perturbation of joint j along its subspace column ψ = ⁰Sⱼ moves
-//! the subtree of j rigidly, so every inertial-frame quantity fixed to a body of that subtree changes
-//! by `ψ ×` (motions), `ψ ×*` (forces) or `ψ×* I − I ψ×` (inertias); the twists, accelerations and
-//! forces then follow by the chain rule through the two passes. One pass over the subtree (and up its
-//! ancestors) per tangent direction: O(nv · depth) work, no finite differences. Forward dynamics:
-//! `∂a/∂x = −M⁻¹ ∂τ/∂x |_{a = FD(q, v, τ)}` (Carpentier and Mansard, eq. (9)), with M from CRBA and
-//! its Cholesky factor.
+//! ∂τ/∂q and ∂τ/∂v: the single-pass algorithm of Carpentier and Mansard, "Analytical Derivatives of Rigid Body
+//! Dynamics Algorithms", RSS 2018 (Alg. 1), in inertial coordinates (`rnea_derivatives.rs`). A perturbation of
+//! joint j along its subspace column ψ = ⁰Sⱼ turns the subtree of j rigidly, so every inertial-frame quantity fixed
+//! to a body of that subtree changes by `ψ ×` (motions), `ψ ×*` (forces) or `ψ×* I − I ψ×` (inertias), plus a part
+//! that does not depend on the body: Ψ̇ = v_λ(j) × ψ for the twists and Ψ̈ = a_λ(j) × ψ + v_λ(j) × Ψ̇ for the
+//! accelerations. The turning part cancels in `τᵢ = Sᵢᵀ Fᵢ` for i in the subtree, so with the subtree sums Fᵢ,
+//! Icᵢ = Σ I and Bcᵢ = Σ B (B the map `e ↦ I (e × v) + e ×* (I v) + v ×* (I e)`, whose linear-input half is zero):
+//! - `∂τᵢ/∂q_j = Sᵢᵀ (Icᵢ Ψ̈_j + Bcᵢ Ψ̇_j)` for j on the path from the root to i (row i),
+//! - `∂τ_j/∂qᵢ = S_jᵀ (ψ ×* Fᵢ + Icᵢ Ψ̈ᵢ + Bcᵢ Ψ̇ᵢ)` for the strict ancestors j of i (column i),
+//!
+//! and likewise for q̇ with `∂v/∂q̇_j = ψ` and `∂a/∂q̇_j = Ψ̇_j + v_j × ψ` (Bc ψ + Ic (Ψ̇ + Ṡ)); every other entry is
+//! zero (joints on different branches). One forward pass and one backward pass filling whole rows and columns:
+//! O(nv · depth) 6-vector products.
+//!
+//! Forward dynamics: `∂a/∂x = −M⁻¹ ∂τ/∂x |_{a = FD(q, v, τ)}` (Carpentier and Mansard, eq. (9)), with a from the
+//! articulated-body algorithm and M⁻¹ from the articulated-body recursion run on all nv unit torques at once
+//! (`minv.rs`, O(nv · n)), then two products that skip the zero entries of ∂τ/∂x.
 //!
 //! Universal joints are not supported (their subspace depends on q); the entry points say so.
 
+mod dense;
 mod frame;
 mod minv;
 mod rnea_derivatives;
 mod step;
 
 pub use crate::config::{difference, difference_jacobians, integrate, integrate_jacobians};
+pub(crate) use dense::{cholesky_inverse, dot, gemm};
 pub use frame::{frame_dq_pose_derivatives, frame_log_error_derivatives, se3_log, se3_log_jacobian};
 pub use rnea_derivatives::{aba_derivatives, rnea_derivatives};
-pub(crate) use rnea_derivatives::{cholesky_inverse, dot};
 pub use step::{step, step_derivatives, Scheme};
 
 use crate::error::{FfError, Result};
@@ -194,110 +203,4 @@ pub(crate) fn check_supported(m: &Model) -> Result<()> {
         ));
     }
     Ok(())
-}
-
-/// `c = α a b + β c` without allocating (nalgebra's dynamic `gemm` packs through a heap buffer);
-/// zero entries of `b` are skipped, which the block-diagonal Jacobians of ⊕ and the tree-sparse ∂τ/∂x have many of.
-/// Each column of c is summed in register tiles of 8 rows (two 4-lane fused multiply-adds per entry of b): an axpy
-/// per entry of b would load and store the column of c each time, and the compiler unrolls a plain axpy 16 wide
-/// and leaves most of a column of 12 or 26 to its scalar tail.
-pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RStride = nalgebra::U1>>(
-    c: &mut nalgebra::Matrix<f64, nalgebra::Dyn, nalgebra::Dyn, S>,
-    alpha: f64,
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    beta: f64,
-) {
-    let (n, p) = (a.nrows(), b.ncols());
-    debug_assert_eq!(a.ncols(), b.nrows());
-    debug_assert_eq!((c.nrows(), c.ncols()), (n, p));
-    let (asl, bsl) = (a.as_slice(), b.as_slice());
-    let kk = a.ncols();
-    for j in 0..p {
-        let mut cj = c.column_mut(j);
-        let cs = cj.as_mut_slice();
-        let bj = &bsl[j * kk..(j + 1) * kk];
-        match (n / 8, n % 8 != 0) {
-            (1, false) => whole_column::<8, false>(cs, alpha, asl, bj, beta),
-            (1, true) => whole_column::<8, true>(cs, alpha, asl, bj, beta),
-            (2, false) => whole_column::<16, false>(cs, alpha, asl, bj, beta),
-            (2, true) => whole_column::<16, true>(cs, alpha, asl, bj, beta),
-            (3, false) => whole_column::<24, false>(cs, alpha, asl, bj, beta),
-            (3, true) => whole_column::<24, true>(cs, alpha, asl, bj, beta),
-            (4, false) => whole_column::<32, false>(cs, alpha, asl, bj, beta),
-            (4, true) => whole_column::<32, true>(cs, alpha, asl, bj, beta),
-            _ => tiled_column(cs, alpha, asl, bj, beta),
-        }
-    }
-}
-
-/// Column `c = α a b_j + β c` of 8 ≤ n < 40 rows in one pass over b_j: the first M = 8⌊n/8⌋ rows and, if `TAIL`,
-/// the last 8 rows (overlapping them) summed in registers together.
-#[inline(always)]
-fn whole_column<const M: usize, const TAIL: bool>(c: &mut [f64], alpha: f64, a: &[f64], bj: &[f64], beta: f64) {
-    let n = c.len();
-    let (mut acc, mut tail) = ([0.0; M], [0.0; 8]);
-    for (ak, &bkj) in a.chunks_exact(n).zip(bj) {
-        if bkj == 0.0 {
-            continue;
-        }
-        let head: &[f64; M] = ak[..M].try_into().expect("M ≤ n rows");
-        for l in 0..M {
-            acc[l] = head[l].mul_add(bkj, acc[l]);
-        }
-        if TAIL {
-            let last: &[f64; 8] = ak[n - 8..].try_into().expect("8 ≤ n rows");
-            for l in 0..8 {
-                tail[l] = last[l].mul_add(bkj, tail[l]);
-            }
-        }
-    }
-    store(&mut c[..M], alpha, &acc, beta);
-    if TAIL {
-        store(&mut c[M..], alpha, &tail[8 - (n - M)..], beta);
-    }
-}
-
-/// The same for any number of rows, in tiles of 8, 4 and 1 rows (one pass over b_j each).
-fn tiled_column(cs: &mut [f64], alpha: f64, asl: &[f64], bj: &[f64], beta: f64) {
-    let n = cs.len();
-    let mut r = 0;
-    while r + 8 <= n {
-        let acc = tile::<8>(asl, n, r, bj);
-        store(&mut cs[r..r + 8], alpha, &acc, beta);
-        r += 8;
-    }
-    if r + 4 <= n {
-        let acc = tile::<4>(asl, n, r, bj);
-        store(&mut cs[r..r + 4], alpha, &acc, beta);
-        r += 4;
-    }
-    while r < n {
-        let acc = tile::<1>(asl, n, r, bj);
-        store(&mut cs[r..r + 1], alpha, &acc, beta);
-        r += 1;
-    }
-}
-
-/// Rows `r..r + L` of `a b_j` (a: n rows, column-major), skipping the zero entries of `b_j`.
-#[inline(always)]
-fn tile<const L: usize>(a: &[f64], n: usize, r: usize, bj: &[f64]) -> [f64; L] {
-    let mut acc = [0.0; L];
-    for (k, &bkj) in bj.iter().enumerate() {
-        if bkj == 0.0 {
-            continue;
-        }
-        let ak: &[f64; L] = a[k * n + r..k * n + r + L].try_into().expect("L rows");
-        for l in 0..L {
-            acc[l] = ak[l].mul_add(bkj, acc[l]);
-        }
-    }
-    acc
-}
-
-#[inline(always)]
-fn store(c: &mut [f64], alpha: f64, acc: &[f64], beta: f64) {
-    for (ci, x) in c.iter_mut().zip(acc) {
-        *ci = if beta == 0.0 { alpha * x } else { alpha.mul_add(*x, beta * *ci) };
-    }
 }

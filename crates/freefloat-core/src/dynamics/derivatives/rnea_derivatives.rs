@@ -1,5 +1,5 @@
-//! ∂τ/∂q, ∂τ/∂v of the recursive Newton-Euler algorithm and ∂a/∂(q, v, τ) of forward dynamics, by
-//! exact forward-mode differentiation in inertial coordinates (see the module documentation).
+//! ∂τ/∂q, ∂τ/∂v of the recursive Newton-Euler algorithm (Carpentier and Mansard 2018, Alg. 1) and ∂a/∂(q, v, τ) of
+//! forward dynamics, in inertial coordinates (see the module documentation).
 
 use super::minv::minv_core;
 use super::{check_workspace, gemm, Derivatives};
@@ -10,7 +10,6 @@ use crate::error::{FfError, Result};
 use crate::kinematics::forward_kinematics_unchecked;
 use crate::model::Model;
 use crate::spatial::{skew, Force, Inertia, Motion, M3, M6, V3};
-use nalgebra::DMatrix;
 
 /// Column `c` of a 6×k subspace as a motion.
 #[inline]
@@ -247,87 +246,4 @@ impl BMap {
     fn tr_apply(&self, s: &Motion) -> V3 {
         2.0 * self.h_lin.cross(&s.lin) + self.aa.tr_mul(&s.ang)
     }
-}
-
-/// Cholesky factor `l` of the symmetric positive-definite `a` and `inv = a⁻¹` (full), in place,
-/// without allocating. False if `a` is not positive definite.
-pub(crate) fn cholesky_inverse(a: &DMatrix<f64>, l: &mut DMatrix<f64>, inv: &mut DMatrix<f64>) -> bool {
-    let n = a.nrows();
-    l.copy_from(a);
-    // Left-looking, column-major: column j -= Σ_{k<j} L[j,k] L[j.., k], then scale by 1/√pivot.
-    let ls = l.as_mut_slice();
-    for j in 0..n {
-        for k in 0..j {
-            let ljk = ls[k * n + j];
-            if ljk == 0.0 {
-                continue;
-            }
-            let (left, right) = ls.split_at_mut(j * n);
-            let ck = &left[k * n + j..k * n + n];
-            for (x, y) in right[j..n].iter_mut().zip(ck) {
-                *x -= ljk * y;
-            }
-        }
-        let s = ls[j * n + j];
-        if !(s > 0.0) || !s.is_finite() {
-            return false;
-        }
-        let dj = s.sqrt();
-        let inv_d = 1.0 / dj;
-        ls[j * n + j] = dj;
-        for x in ls[j * n + j + 1..(j + 1) * n].iter_mut() {
-            *x *= inv_d;
-        }
-    }
-    // inv = L⁻ᵀ L⁻¹ = Yᵀ Y with Y = L⁻¹ (lower triangular). First Y into inv, column by column by forward
-    // substitution in axpy form (L y = e_c).
-    let ls = l.as_slice();
-    let is = inv.as_mut_slice();
-    for c in 0..n {
-        let x = &mut is[c * n..(c + 1) * n];
-        x.fill(0.0);
-        x[c] = 1.0;
-        for k in c..n {
-            let yk = x[k] / ls[k * n + k];
-            x[k] = yk;
-            for (xi, li) in x[k + 1..].iter_mut().zip(&ls[k * n + k + 1..(k + 1) * n]) {
-                *xi -= yk * li;
-            }
-        }
-    }
-    // Then (Yᵀ Y)ᵢⱼ = Σ_{k ≥ j} Y_ki Y_kj for i ≤ j, in place: column by column, the diagonal last. An entry
-    // written at (i < j) overwrites a zero of Y; the diagonal Y_jj is read only by entries (i, j') with
-    // i, j' ≤ j, all done by then; the strict lower triangle of Y stays until the mirror at the end.
-    for j in 0..n {
-        for i in 0..=j {
-            let (ci, cj) = (i * n, j * n);
-            let t = dot(&is[ci + j..ci + n], &is[cj + j..cj + n]);
-            is[cj + i] = t;
-        }
-    }
-    for j in 0..n {
-        for i in j + 1..n {
-            is[j * n + i] = is[i * n + j];
-        }
-    }
-    true
-}
-
-/// Dot product of two equally long slices with 4 partial sums (vectorises; a plain sum is one long dependency
-/// chain). Also the DDP backward pass's dot product (`control::ddp::dense`).
-#[inline(always)]
-pub(crate) fn dot(x: &[f64], y: &[f64]) -> f64 {
-    let mut s = [0.0_f64; 4];
-    let (xc, yc) = (x.chunks_exact(4), y.chunks_exact(4));
-    let (xr, yr) = (xc.remainder(), yc.remainder());
-    for (a, b) in xc.zip(yc) {
-        for l in 0..4 {
-            s[l] += a[l] * b[l];
-        }
-    }
-    let mut t = (s[0] + s[1]) + (s[2] + s[3]);
-    for (a, b) in xr.iter().zip(yr) {
-        t += a * b;
-    }
-    t
 }
