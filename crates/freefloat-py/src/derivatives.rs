@@ -1,7 +1,7 @@
 //! Dynamics derivatives (freefloat_core::dynamics::derivatives) as Python functions. Each takes one
 //! sample or a leading time axis, like the other algorithms; matrices come back row-major (numpy).
 
-use crate::algorithms::{run_rows, Arr};
+use crate::algorithms::{at_row, run_rows, Arr};
 use crate::batch::{common_rows, model_arg, output, Batch};
 use crate::errors::guard;
 use crate::model::PyModel;
@@ -40,8 +40,9 @@ fn put(a: &DMatrix<f64>, o: &mut [f64]) {
     }
 }
 
-/// Run `f` per sample writing the concatenation of `parts` (each a shape), and split the result
-/// into one array per part.
+/// Run `f` per sample writing the concatenation of `parts` (each a shape) into a scratch row, and append each part
+/// to its own array. (Writing all samples into one buffer and splitting it afterwards made a stacked call touch
+/// every output twice, through memory: fresh pages for a buffer as large as the outputs, then a copy.)
 fn multi<'py, F>(
     py: Python<'py>,
     model: &PyModel,
@@ -55,18 +56,25 @@ where
 {
     let sizes: Vec<usize> = parts.iter().map(|p| p.iter().product()).collect();
     let width: usize = sizes.iter().sum();
-    let flat = run_rows(py, model, rows, stacked, width, |m, d, k, o| with_work(m, |w| f(m, d, w, k, o)))?;
-    let mut out = Vec::with_capacity(parts.len());
-    let mut off = 0;
-    for (p, &s) in parts.iter().zip(&sizes) {
-        let mut v = Vec::with_capacity(rows * s);
-        for k in 0..rows {
-            v.extend_from_slice(&flat[k * width + off..k * width + off + s]);
-        }
-        out.push(output(py, v, rows, stacked, p)?);
-        off += s;
-    }
-    Ok(out)
+    let work = || {
+        model.with_data(|m, d| {
+            guard(|| {
+                let mut out: Vec<Vec<f64>> = sizes.iter().map(|&s| Vec::with_capacity(rows * s)).collect();
+                let mut row = vec![0.0; width];
+                for k in 0..rows {
+                    with_work(m, |w| f(m, d, w, k, &mut row)).map_err(|e| at_row(e, k, stacked))?;
+                    let mut off = 0;
+                    for (o, &s) in out.iter_mut().zip(&sizes) {
+                        o.extend_from_slice(&row[off..off + s]);
+                        off += s;
+                    }
+                }
+                Ok(out)
+            })
+        })
+    };
+    let data = if stacked { py.detach(work) } else { work() }?;
+    data.into_iter().zip(parts).map(|(v, p)| output(py, v, rows, stacked, p)).collect()
 }
 
 fn three<'py>(v: Vec<Bound<'py, PyAny>>) -> (Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>) {
