@@ -27,17 +27,12 @@ fn with_work<T>(m: &Model, f: impl FnOnce(&mut Derivatives) -> T) -> T {
     })
 }
 
-/// `a` (column-major) into `o` row-major, reading it column by column (no 2-D index arithmetic or bounds check per
-/// entry: the indexed copy was ~7 % of the instructions of a single `aba_derivatives` call on a 12-DoF model,
-/// callgrind).
+/// `a` (column-major) into `o` row-major: `o` read as a column-major nc × nr matrix receives aᵀ (nalgebra's
+/// transposed copy; an indexed copy per entry was ~7 % of the instructions of a single `aba_derivatives` call on a
+/// 12-DoF model, callgrind).
 fn put(a: &DMatrix<f64>, o: &mut [f64]) {
     let (nr, nc) = a.shape();
-    let o = &mut o[..nr * nc];
-    for (j, col) in a.as_slice().chunks_exact(nr).enumerate() {
-        for (x, dst) in col.iter().zip(o[j..].iter_mut().step_by(nc)) {
-            *dst = *x;
-        }
-    }
+    nalgebra::DMatrixViewMut::from_slice(&mut o[..nr * nc], nc, nr).tr_copy_from(a);
 }
 
 /// Run `f` per sample writing the concatenation of `parts` (each a shape) into a scratch row, and append each part

@@ -78,9 +78,8 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
                     }
                 }
             }
-            let mut uu = M6::zeros();
-            uu.set_column(0, &u0);
-            mu[i] = uu;
+            // (the forward pass reads column 0 only for k = 1)
+            mu[i].set_column(0, &u0);
             mdinv[i][(0, 0)] = dinv;
             continue;
         }

@@ -131,9 +131,15 @@ pub(crate) fn rnea_derivatives_core(
             sw[iv + c] = s;
             vj += s * v[iv + c];
             aj += s * a[iv + c];
-            let pd = vp.cross_motion(&s);
-            psi_d[iv + c] = pd;
-            psi_dd[iv + c] = ap.cross_motion(&s) + vp.cross_motion(&pd);
+            if m.parents[i].is_some() {
+                let pd = vp.cross_motion(&s);
+                psi_d[iv + c] = pd;
+                psi_dd[iv + c] = ap.cross_motion(&s) + vp.cross_motion(&pd);
+            } else {
+                // the root: v_λ = 0, a_λ = a_g (the base's columns of ∂τ/∂q are gravity's only)
+                psi_d[iv + c] = Motion::ZERO;
+                psi_dd[iv + c] = ap.cross_motion(&s);
+            }
         }
         let ov = vp + vj;
         let oa = ap + aj + ov.cross_motion(&vj);
@@ -182,9 +188,12 @@ pub(crate) fn rnea_derivatives_core(
                     None => break,
                 }
             }
+            let mut up = dof_parent[iv];
+            if up.is_none() {
+                continue;
+            }
             let xq = s.cross_force(&f) + ici.mul_motion(&psi_dd[row]) + bci.apply(&psi_d[row]);
             let xv = bci.apply(&s) + ici.mul_motion(&dadv[row]);
-            let mut up = dof_parent[iv];
             while let Some(c) = up {
                 tq[row * nv + c] = sw[c].dot(&xq);
                 tv[row * nv + c] = sw[c].dot(&xv);
