@@ -5,7 +5,8 @@
 //! Articulated-body recursion with the bias force pᴬᵢ(τ) and the accelerations linear in τ (inertial frame):
 //! backward, `Uᵢ = Iᴬᵢ Sᵢ`, `Dᵢ = Sᵢᵀ Uᵢ`, `q̈ᵢ ← Dᵢ⁻¹ (τᵢ − Sᵢᵀ pᴬᵢ)` (the part not depending on the parent's
 //! acceleration), `Iᴬ_λ += Iᴬᵢ − Uᵢ Dᵢ⁻¹ Uᵢᵀ`, `pᴬ_λ += pᴬᵢ + Uᵢ q̈ᵢ`; forward, `q̈ᵢ −= Dᵢ⁻¹ Uᵢᵀ a_λ`,
-//! `aᵢ = a_λ + Sᵢ q̈ᵢ` (RBDA eqs. 7.38-7.45). Each of pᴬ and a is kept as a 6 × nv matrix (one column per unit torque).
+//! `aᵢ = a_λ + Sᵢ q̈ᵢ` (RBDA §7.3, Table 7.1). Each of pᴬ and a is kept as a 6 × nv matrix (one column per unit
+//! torque).
 //! pᴬᵢ depends only on the torques of i's subtree, so the backward pass works on the columns of that subtree's
 //! velocity range only; by symmetry the forward pass computes the upper triangle only (columns from joint i on).
 

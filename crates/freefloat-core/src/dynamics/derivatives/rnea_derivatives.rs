@@ -113,10 +113,10 @@ pub(crate) fn rnea_derivatives_core(
         dof_parent,
         ..
     } = w;
-    // Forward pass (Alg. 1, lines 2-9), inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
+    // Forward pass (Alg. 1, its first loop), inertial coordinates (Featherstone, RBDA Table 5.1 with X = ⁰Xᵢ):
     // vᵢ = v_λ + Sᵢq̇ᵢ, aᵢ = a_λ + Sᵢq̈ᵢ + vᵢ × Sᵢq̇ᵢ, fᵢ = Iᵢaᵢ + vᵢ ×* Iᵢvᵢ − fextᵢ; and per joint column ψ
     // the parts of ∂v/∂q and ∂a/∂q that do not merely turn with the moved subtree, Ψ̇ = v_λ × ψ and
-    // Ψ̈ = a_λ × ψ + v_λ × Ψ̇ (line 7), and ∂a/∂q̇ = Ψ̇ + vᵢ × ψ (the Ṡ term of line 8).
+    // Ψ̈ = a_λ × ψ + v_λ × Ψ̇, and ∂a/∂q̇ = Ψ̇ + vᵢ × ψ (the Ṡ term).
     for i in 0..n {
         let omi = d.o_mi[i];
         let (k, iv) = (m.nvs[i], m.idx_v[i]);
@@ -160,12 +160,12 @@ pub(crate) fn rnea_derivatives_core(
         ff[i] = oi.mul_motion(&oa) + ov.cross_force(&h) - fe;
     }
 
-    // Backward pass (Alg. 1, lines 10-19). With the subtree composites Fᵢ = Σ f, Icᵢ = Σ I and Bcᵢ = Σ B (line 12),
+    // Backward pass (Alg. 1, its second loop). With the subtree composites Fᵢ = Σ f, Icᵢ = Σ I and Bcᵢ = Σ B,
     // for joint i and any joint j on its path to the root (j ⪯ i; column ψ of j):
     //   ∂τᵢ/∂q_j = Sᵢᵀ (Icᵢ Ψ̈_j + Bcᵢ Ψ̇_j)                ∂τᵢ/∂q̇_j = Sᵢᵀ (Bcᵢ ψ + Icᵢ (Ψ̇_j + Ṡ_j))
-    // (row i, line 15), and for the strict ancestors j of i, with ψ now a column of i,
+    // (row i), and for the strict ancestors j of i, with ψ now a column of i,
     //   ∂τ_j/∂qᵢ = S_jᵀ (ψ ×* Fᵢ + Icᵢ Ψ̈ᵢ + Bcᵢ Ψ̇ᵢ)        ∂τ_j/∂q̇ᵢ = S_jᵀ (Bcᵢ ψ + Icᵢ (Ψ̇ᵢ + Ṡᵢ))
-    // (column i, lines 16-17). Every other entry is zero (joints on different branches).
+    // (column i). Every other entry is zero (joints on different branches).
     let (tq, tv) = (dtau_dq.as_mut_slice(), dtau_dv.as_mut_slice());
     tq.fill(0.0);
     tv.fill(0.0);
@@ -210,7 +210,7 @@ pub(crate) fn rnea_derivatives_core(
 
 /// The map `e ↦ I (e × v) + e ×* (I v) + v ×* (I e)` of one body (or a sum of them over a subtree): the derivative
 /// of a body's force `f = I a + v ×* I v` along a change `e` of its twist that also enters its acceleration as
-/// `e × v` (Carpentier and Mansard 2018, eq. (14), Bᵢ). As a 6×6 matrix it is `H − I X − (I X)ᵀ` with X = [v×],
+/// `e × v` (the B of Carpentier and Mansard 2018, here derived directly). As a 6×6 matrix it is `H − I X − (I X)ᵀ` with X = [v×],
 /// `[v×*] = −Xᵀ` and H the matrix of `e ↦ e ×* h` (h = I v = (h_lin, h_ang)); written out in 3×3 blocks with
 /// `I = [[m 1, −[c]], [[c], I_o]]` (c the first moment) and h_lin = m v_lin − c × ω, its linear-input half vanishes:
 /// `[[0, −2[h_lin]], [0, A + Aᵀ − (v_lin cᵀ + c v_linᵀ) + 2 (c·v_lin) 1 − [h_ang]]]`, A = [ω] I_o. So it is kept
