@@ -6,7 +6,7 @@ use nalgebra::DMatrix;
 
 /// `c = α a b + β c` without allocating (nalgebra's dynamic `gemm` packs through a heap buffer);
 /// zero entries of `b` are skipped, which the block-diagonal Jacobians of ⊕ and the tree-sparse ∂τ/∂x have many of.
-/// Each column of c is summed in register tiles of 8 rows (two 4-lane fused multiply-adds per entry of b): an axpy
+/// Each column of c is summed in registers in one pass over the column of b (up to 39 rows; beyond, tiles of 8 rows): an axpy
 /// per entry of b would load and store the column of c each time, and the compiler unrolls a plain axpy 16 wide
 /// and leaves most of a column of 12 or 26 to its scalar tail.
 pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RStride = nalgebra::U1>>(
@@ -25,26 +25,34 @@ pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RS
         let mut cj = c.column_mut(j);
         let cs = cj.as_mut_slice();
         let bj = &bsl[j * kk..(j + 1) * kk];
-        match (n / 8, n % 8 != 0) {
-            (1, false) => whole_column::<8, false>(cs, alpha, asl, bj, beta),
-            (1, true) => whole_column::<8, true>(cs, alpha, asl, bj, beta),
-            (2, false) => whole_column::<16, false>(cs, alpha, asl, bj, beta),
-            (2, true) => whole_column::<16, true>(cs, alpha, asl, bj, beta),
-            (3, false) => whole_column::<24, false>(cs, alpha, asl, bj, beta),
-            (3, true) => whole_column::<24, true>(cs, alpha, asl, bj, beta),
-            (4, false) => whole_column::<32, false>(cs, alpha, asl, bj, beta),
-            (4, true) => whole_column::<32, true>(cs, alpha, asl, bj, beta),
+        match (n / 4, n % 4 != 0) {
+            (2, false) => whole_column::<8, false>(cs, alpha, asl, bj, beta),
+            (2, true) => whole_column::<8, true>(cs, alpha, asl, bj, beta),
+            (3, false) => whole_column::<12, false>(cs, alpha, asl, bj, beta),
+            (3, true) => whole_column::<12, true>(cs, alpha, asl, bj, beta),
+            (4, false) => whole_column::<16, false>(cs, alpha, asl, bj, beta),
+            (4, true) => whole_column::<16, true>(cs, alpha, asl, bj, beta),
+            (5, false) => whole_column::<20, false>(cs, alpha, asl, bj, beta),
+            (5, true) => whole_column::<20, true>(cs, alpha, asl, bj, beta),
+            (6, false) => whole_column::<24, false>(cs, alpha, asl, bj, beta),
+            (6, true) => whole_column::<24, true>(cs, alpha, asl, bj, beta),
+            (7, false) => whole_column::<28, false>(cs, alpha, asl, bj, beta),
+            (7, true) => whole_column::<28, true>(cs, alpha, asl, bj, beta),
+            (8, false) => whole_column::<32, false>(cs, alpha, asl, bj, beta),
+            (8, true) => whole_column::<32, true>(cs, alpha, asl, bj, beta),
+            (9, false) => whole_column::<36, false>(cs, alpha, asl, bj, beta),
+            (9, true) => whole_column::<36, true>(cs, alpha, asl, bj, beta),
             _ => tiled_column(cs, alpha, asl, bj, beta),
         }
     }
 }
 
-/// Column `c = α a b_j + β c` of 8 ≤ n < 40 rows in one pass over b_j: the first M = 8⌊n/8⌋ rows and, if `TAIL`,
-/// the last 8 rows (overlapping them) summed in registers together.
+/// Column `c = α a b_j + β c` of 8 ≤ n < 40 rows in one pass over b_j: the first M = 4⌊n/4⌋ rows and, if `TAIL`,
+/// the last 4 rows (overlapping them) summed in registers together (at most 10 four-lane accumulators).
 #[inline(always)]
 fn whole_column<const M: usize, const TAIL: bool>(c: &mut [f64], alpha: f64, a: &[f64], bj: &[f64], beta: f64) {
     let n = c.len();
-    let (mut acc, mut tail) = ([0.0; M], [0.0; 8]);
+    let (mut acc, mut tail) = ([0.0; M], [0.0; 4]);
     for (ak, &bkj) in a.chunks_exact(n).zip(bj) {
         if bkj == 0.0 {
             continue;
@@ -54,15 +62,88 @@ fn whole_column<const M: usize, const TAIL: bool>(c: &mut [f64], alpha: f64, a: 
             acc[l] = head[l].mul_add(bkj, acc[l]);
         }
         if TAIL {
-            let last: &[f64; 8] = ak[n - 8..].try_into().expect("8 ≤ n rows");
-            for l in 0..8 {
+            let last: &[f64; 4] = ak[n - 4..].try_into().expect("4 ≤ n rows");
+            for l in 0..4 {
                 tail[l] = last[l].mul_add(bkj, tail[l]);
             }
         }
     }
     store(&mut c[..M], alpha, &acc, beta);
     if TAIL {
-        store(&mut c[M..], alpha, &tail[8 - (n - M)..], beta);
+        store(&mut c[M..], alpha, &tail[4 - (n - M)..], beta);
+    }
+}
+
+/// `c1 = α a b1` and `c2 = α a b2` (b1, b2 of one shape): the two products of the forward-dynamics derivatives with
+/// one M⁻¹, in one pass over the columns of `a` per output column for 8 ≤ n < 28 rows (two sets of register
+/// accumulators, each column of a loaded once for both), else as two `gemm`s.
+pub(crate) fn gemm_pair(
+    c1: &mut DMatrix<f64>,
+    c2: &mut DMatrix<f64>,
+    alpha: f64,
+    a: &DMatrix<f64>,
+    b1: &DMatrix<f64>,
+    b2: &DMatrix<f64>,
+) {
+    let (n, p, kk) = (a.nrows(), b1.ncols(), a.ncols());
+    debug_assert_eq!((b2.nrows(), b2.ncols()), (kk, p));
+    let f = match (n / 4, n % 4 != 0) {
+        (2, false) => column_pair::<8, false>,
+        (2, true) => column_pair::<8, true>,
+        (3, false) => column_pair::<12, false>,
+        (3, true) => column_pair::<12, true>,
+        (4, false) => column_pair::<16, false>,
+        (4, true) => column_pair::<16, true>,
+        (5, false) => column_pair::<20, false>,
+        (5, true) => column_pair::<20, true>,
+        (6, false) => column_pair::<24, false>,
+        (6, true) => column_pair::<24, true>,
+        _ => {
+            gemm(c1, alpha, a, b1, 0.0);
+            gemm(c2, alpha, a, b2, 0.0);
+            return;
+        }
+    };
+    let (asl, b1s, b2s) = (a.as_slice(), b1.as_slice(), b2.as_slice());
+    for (j, (o1, o2)) in c1.as_mut_slice().chunks_exact_mut(n).zip(c2.as_mut_slice().chunks_exact_mut(n)).enumerate() {
+        f(o1, o2, alpha, asl, &b1s[j * kk..(j + 1) * kk], &b2s[j * kk..(j + 1) * kk]);
+    }
+}
+
+/// `whole_column` for two right-hand columns at once (β = 0).
+#[inline(always)]
+fn column_pair<const M: usize, const TAIL: bool>(
+    c1: &mut [f64],
+    c2: &mut [f64],
+    alpha: f64,
+    a: &[f64],
+    b1: &[f64],
+    b2: &[f64],
+) {
+    let n = c1.len();
+    let (mut acc1, mut acc2, mut tail1, mut tail2) = ([0.0; M], [0.0; M], [0.0; 4], [0.0; 4]);
+    for ((ak, &x1), &x2) in a.chunks_exact(n).zip(b1).zip(b2) {
+        if x1 == 0.0 && x2 == 0.0 {
+            continue;
+        }
+        let head: &[f64; M] = ak[..M].try_into().expect("M ≤ n rows");
+        for l in 0..M {
+            acc1[l] = head[l].mul_add(x1, acc1[l]);
+            acc2[l] = head[l].mul_add(x2, acc2[l]);
+        }
+        if TAIL {
+            let last: &[f64; 4] = ak[n - 4..].try_into().expect("4 ≤ n rows");
+            for l in 0..4 {
+                tail1[l] = last[l].mul_add(x1, tail1[l]);
+                tail2[l] = last[l].mul_add(x2, tail2[l]);
+            }
+        }
+    }
+    store(&mut c1[..M], alpha, &acc1, 0.0);
+    store(&mut c2[..M], alpha, &acc2, 0.0);
+    if TAIL {
+        store(&mut c1[M..], alpha, &tail1[4 - (n - M)..], 0.0);
+        store(&mut c2[M..], alpha, &tail2[4 - (n - M)..], 0.0);
     }
 }
 

@@ -46,7 +46,7 @@ mod rnea_derivatives;
 mod step;
 
 pub use crate::config::{difference, difference_jacobians, integrate, integrate_jacobians};
-pub(crate) use dense::{cholesky_inverse, dot, gemm};
+pub(crate) use dense::{cholesky_inverse, dot, gemm, gemm_pair};
 pub use frame::{frame_dq_pose_derivatives, frame_log_error_derivatives, se3_log, se3_log_jacobian};
 pub use rnea_derivatives::{aba_derivatives, rnea_derivatives};
 pub use step::{step, step_derivatives, Scheme};

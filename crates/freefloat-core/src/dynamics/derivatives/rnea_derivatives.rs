@@ -2,7 +2,7 @@
 //! forward dynamics, in inertial coordinates (see the module documentation).
 
 use super::minv::minv_core;
-use super::{check_workspace, gemm, Derivatives};
+use super::{check_workspace, gemm_pair, Derivatives};
 use crate::check::{check_args, with_unit_q, Args};
 use crate::data::Data;
 use crate::dynamics::{gravity_acceleration, hybrid_aba_unchecked};
@@ -79,8 +79,7 @@ pub(crate) fn aba_derivatives_unchecked(
     if !minv_core(m, d, w) {
         return Err(FfError::Numerical("the mass matrix is not positive definite".into()));
     }
-    gemm(&mut w.da_dq, -1.0, &w.minv, &w.dtau_dq, 0.0);
-    gemm(&mut w.da_dv, -1.0, &w.minv, &w.dtau_dv, 0.0);
+    gemm_pair(&mut w.da_dq, &mut w.da_dv, -1.0, &w.minv, &w.dtau_dq, &w.dtau_dv);
     Ok(())
 }
 
