@@ -151,6 +151,8 @@ fn minv_is_the_inverse_of_crbas_mass_matrix() {
             let v = random_vec(m.nv, &mut r);
             let tau = random_vec(m.nv, &mut r);
             aba_derivatives(&m, &mut d, &mut w, &q, &v, &tau, None).unwrap();
+            // exactly symmetric: the Python binding hands its column-major storage over as row-major
+            assert_eq!(w.minv, w.minv.transpose(), "{}: M⁻¹ is not exactly symmetric", m.name);
             let mut dm = Data::new(&m);
             crba(&m, &mut dm, &q).unwrap();
             let inv = dm.mass_matrix.clone().try_inverse().expect("M is invertible");

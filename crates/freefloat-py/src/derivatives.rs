@@ -114,7 +114,8 @@ pub fn aba_derivatives<'py>(
         let n2 = nv * nv;
         put(&w.da_dq, &mut o[..n2]);
         put(&w.da_dv, &mut o[n2..2 * n2]);
-        put(&w.minv, &mut o[2 * n2..]);
+        // M⁻¹ is exactly symmetric (its lower triangle is a copy of the upper): row-major = column-major
+        o[2 * n2..].copy_from_slice(w.minv.as_slice());
         Ok(())
     })?;
     Ok(three(out))
