@@ -12,8 +12,8 @@
 
 use super::Derivatives;
 use crate::data::Data;
-use crate::model::Model;
-use crate::spatial::{M6, V6};
+use crate::model::{JointType, Model};
+use crate::spatial::{Force, Motion, M6, V6};
 
 /// Fill `w.minv` with M(q)⁻¹, after `rnea_derivatives_core` left the inertial-frame inertias in `w.oi` and the
 /// subspaces in `d.os`. False if an articulated joint inertia Dᵢ is not positive definite.
@@ -84,8 +84,37 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
             mdinv[i][(0, 0)] = dinv;
             continue;
         }
-        // Several degrees of freedom (2, 3, or the free root's 6): fixed 6 × 6 products, with S padded by zero
-        // columns so that U, D⁻¹ and the rows below are zero past k.
+        if parent.is_none() && m.joint_types[i] == JointType::Free {
+            // The free root: S = X₀, the base placement's motion transform, is invertible, so with Iᴬ its (complete)
+            // articulated inertia D⁻¹ = X₀⁻¹ Iᴬ⁻¹ X₀⁻ᵀ, and the root's rows and acceleration are q̈ = X₀⁻¹ a with
+            // a = Iᴬ⁻¹ (X₀⁻ᵀ e − pᴬ) (RBDA §7.3 with S = X₀, as `aba` solves the root). Nothing is left for the
+            // forward pass (a_λ = 0).
+            let Some(ch) = nalgebra::Cholesky::new(ia[i]) else {
+                return false;
+            };
+            let (iainv, omi) = (ch.inverse(), &d.o_mi[i]);
+            for c in iv..end {
+                let mut g = -V6::from_column_slice(&fm[at(i, c)..at(i, c) + 6]);
+                if c < iv + 6 {
+                    let mut e = Force::ZERO;
+                    if c < iv + 3 {
+                        e.lin[c - iv] = 1.0;
+                    } else {
+                        e.ang[c - iv - 3] = 1.0;
+                    }
+                    g += omi.act_force(&e).to_v6();
+                }
+                let a = iainv * g;
+                omi.inv_act_motion(&Motion::from_v6(&a)).write(&mut ms[c * nv + iv..c * nv + iv + 6]);
+                fm[at(i, c)..at(i, c) + 6].copy_from_slice(a.as_slice());
+            }
+            for c in end..nv {
+                ms[c * nv + iv..c * nv + iv + 6].fill(0.0);
+            }
+            continue;
+        }
+        // Several degrees of freedom (2 or 3; a free joint is always the root): fixed 6 × 6 products, with S padded
+        // by zero columns so that U, D⁻¹ and the rows below are zero past k.
         let mut sp = *s;
         sp.columns_mut(k, 6 - k).fill(0.0);
         let u = ia[i] * sp;
@@ -126,6 +155,11 @@ pub(crate) fn minv_core(m: &Model, d: &Data, w: &mut Derivatives) -> bool {
         let (k, iv) = (m.nvs[i], m.idx_v[i]);
         let (s, u, dinv) = (&d.os[i], &mu[i], &mdinv[i]);
         let Some(p) = m.parents[i] else {
+            if m.joint_types[i] == JointType::Free {
+                // done in the backward pass
+                mirror(ms, nv, iv, k);
+                continue;
+            }
             // the root: a = S q̈ (no parent acceleration)
             for c in iv..nv {
                 let mut a = [0.0; 6];
