@@ -13,7 +13,7 @@ use freefloat_core::dynamics::derivatives::{
     integrate, integrate_jacobians, rnea_derivatives, se3_log, se3_log_jacobian, step, step_derivatives, Derivatives,
     Scheme,
 };
-use freefloat_core::dynamics::{aba, rnea};
+use freefloat_core::dynamics::{aba, crba, rnea};
 use freefloat_core::kinematics::{forward_kinematics, forward_velocities};
 use freefloat_core::model::{JointType, Model};
 use freefloat_core::spatial::{rpy_to_rot, Se3, V3};
@@ -28,7 +28,8 @@ fn models() -> Vec<Model> {
     let mut r = rng(11);
     let mut out = vec![];
     for base in BASES {
-        for (n, g) in [(4, false), (7, true)] {
+        // 12 bodies: branches several joints deep, whose cross-branch entries the single pass leaves zero
+        for (n, g) in [(4, false), (7, true), (12, true)] {
             out.push(random_model_of(&mut r, base, n, g, &KINDS));
         }
     }
@@ -106,8 +107,8 @@ fn rnea_and_aba_derivatives_match_finite_differences() {
             );
 
             aba_derivatives(&m, &mut d, &mut w, &q, &v, &tau, fe).unwrap();
-            // It leaves world-frame kinematics in `d`, which callers (the DDP cost Jacobians) read: the CRBA it
-            // calls works relative to the base under a free root, and once left `d.o_mi` there.
+            // It leaves world-frame kinematics in `d`, which callers (the DDP cost Jacobians) read (an earlier
+            // version called CRBA, which works relative to the base under a free root, and left `d.o_mi` there).
             let mut fk = Data::new(&m);
             forward_kinematics(&m, &mut fk, &q).unwrap();
             for (i, (x, y)) in d.o_mi.iter().zip(&fk.o_mi).enumerate() {
@@ -134,6 +135,34 @@ fn rnea_and_aba_derivatives_match_finite_differences() {
                 "base {:?}, {} bodies: da/dq {eq:.2e}, da/dv {ev:.2e}, da/dtau {et:.2e}",
                 m.joint_types[0],
                 m.nbodies()
+            );
+        }
+    }
+}
+
+#[test]
+fn minv_is_the_inverse_of_crbas_mass_matrix() {
+    let mut r = rng(5);
+    for m in models() {
+        let mut d = Data::new(&m);
+        let mut w = Derivatives::new(&m);
+        for _ in 0..3 {
+            let q = random_q(&m, &mut r);
+            let v = random_vec(m.nv, &mut r);
+            let tau = random_vec(m.nv, &mut r);
+            aba_derivatives(&m, &mut d, &mut w, &q, &v, &tau, None).unwrap();
+            // exactly symmetric: the Python binding hands its column-major storage over as row-major
+            assert_eq!(w.minv, w.minv.transpose(), "{}: M⁻¹ is not exactly symmetric", m.name);
+            let mut dm = Data::new(&m);
+            crba(&m, &mut dm, &q).unwrap();
+            let inv = dm.mass_matrix.clone().try_inverse().expect("M is invertible");
+            let e = rel(&w.minv, &inv);
+            let id = (&w.minv * &dm.mass_matrix - DMatrix::identity(m.nv, m.nv)).amax();
+            assert!(
+                e < 1e-10 && id < 1e-10,
+                "{} base {:?}: M⁻¹ off by {e:.2e} (relative), M⁻¹ M − 1 by {id:.2e}",
+                m.name,
+                m.joint_types[0]
             );
         }
     }

@@ -194,6 +194,16 @@ pub fn common_rows(batches: &[(&str, &Batch)]) -> PyResult<(usize, bool)> {
     Ok(rows.map(|(r, _)| (r, true)).unwrap_or((1, false)))
 }
 
+/// A fresh numpy array of `shape` (non-empty) holding a copy of `data` (C order).
+pub fn array_copy<'py>(py: Python<'py>, shape: &[usize], data: &[f64]) -> PyResult<Bound<'py, PyAny>> {
+    let arr = PyArrayDyn::<f64>::zeros(py, shape, false);
+    // SAFETY: the array was just created here, is C-contiguous and no one else holds it yet.
+    unsafe { arr.as_slice_mut() }
+        .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("internal array error: {e}")))?
+        .copy_from_slice(data);
+    Ok(arr.into_any())
+}
+
 /// Build the output array: `inner` is the shape of one sample's result.
 pub fn output<'py>(
     py: Python<'py>,
@@ -213,12 +223,7 @@ pub fn output<'py>(
     // Small results are copied into a fresh numpy array: cheaper than handing numpy the Vec, which needs a
     // Python object to own it (binding overhead of single calls, issue 16). Large ones are handed over uncopied.
     if data.len() <= 4096 {
-        let arr = PyArrayDyn::<f64>::zeros(py, shape, false);
-        // SAFETY: the array was just created here, is C-contiguous and no one else holds it yet.
-        unsafe { arr.as_slice_mut() }
-            .map_err(|e| pyo3::exceptions::PyRuntimeError::new_err(format!("internal array error: {e}")))?
-            .copy_from_slice(&data);
-        return Ok(arr.into_any());
+        return array_copy(py, &shape, &data);
     }
     // Build the array with its final shape directly (a reshape would be a second numpy call).
     let arr = numpy::ndarray::ArrayD::from_shape_vec(shape, data)

@@ -1,8 +1,8 @@
 //! Dynamics derivatives (freefloat_core::dynamics::derivatives) as Python functions. Each takes one
 //! sample or a leading time axis, like the other algorithms; matrices come back row-major (numpy).
 
-use crate::algorithms::{run_rows, Arr};
-use crate::batch::{common_rows, model_arg, output, Batch};
+use crate::algorithms::{at_row, run_rows, Arr};
+use crate::batch::{array_copy, common_rows, model_arg, output, Batch};
 use crate::errors::guard;
 use crate::model::PyModel;
 use freefloat_core::dynamics::derivatives::{self as der, Derivatives, Scheme};
@@ -27,17 +27,17 @@ fn with_work<T>(m: &Model, f: impl FnOnce(&mut Derivatives) -> T) -> T {
     })
 }
 
+/// `a` (column-major) into `o` row-major: `o` read as a column-major nc × nr matrix receives aᵀ (nalgebra's
+/// transposed copy; an indexed copy per entry was ~7 % of the instructions of a single `aba_derivatives` call on a
+/// 12-DoF model, callgrind).
 fn put(a: &DMatrix<f64>, o: &mut [f64]) {
-    let c = a.ncols();
-    for r in 0..a.nrows() {
-        for j in 0..c {
-            o[r * c + j] = a[(r, j)];
-        }
-    }
+    let (nr, nc) = a.shape();
+    nalgebra::DMatrixViewMut::from_slice(&mut o[..nr * nc], nc, nr).tr_copy_from(a);
 }
 
-/// Run `f` per sample writing the concatenation of `parts` (each a shape), and split the result
-/// into one array per part.
+/// Run `f` per sample writing the concatenation of `parts` (each a shape) into a scratch row, and append each part
+/// to its own array. (Writing all samples into one buffer and splitting it afterwards made a stacked call touch
+/// every output twice, through memory: fresh pages for a buffer as large as the outputs, then a copy.)
 fn multi<'py, F>(
     py: Python<'py>,
     model: &PyModel,
@@ -49,20 +49,43 @@ fn multi<'py, F>(
 where
     F: Fn(&Model, &mut Data, &mut Derivatives, usize, &mut [f64]) -> Result<(), FfError> + Send + Sync,
 {
-    let sizes: Vec<usize> = parts.iter().map(|p| p.iter().product()).collect();
-    let width: usize = sizes.iter().sum();
-    let flat = run_rows(py, model, rows, stacked, width, |m, d, k, o| with_work(m, |w| f(m, d, w, k, o)))?;
-    let mut out = Vec::with_capacity(parts.len());
-    let mut off = 0;
-    for (p, &s) in parts.iter().zip(&sizes) {
-        let mut v = Vec::with_capacity(rows * s);
-        for k in 0..rows {
-            v.extend_from_slice(&flat[k * width + off..k * width + off + s]);
-        }
-        out.push(output(py, v, rows, stacked, p)?);
-        off += s;
+    let width: usize = parts.iter().map(|p| p.iter().product::<usize>()).sum();
+    if !stacked {
+        // one sample: its parts straight into fresh numpy arrays (no vectors in between, whose allocations and
+        // copies showed in the instruction counts of a single call on a 12-DoF model, callgrind)
+        debug_assert_eq!(rows, 1);
+        let mut row = vec![0.0; width];
+        model.with_data(|m, d| guard(|| with_work(m, |w| f(m, d, w, 0, &mut row))))?;
+        let mut off = 0;
+        return parts
+            .iter()
+            .map(|p| {
+                let s: usize = p.iter().product();
+                off += s;
+                array_copy(py, p, &row[off - s..off])
+            })
+            .collect();
     }
-    Ok(out)
+    let sizes: Vec<usize> = parts.iter().map(|p| p.iter().product()).collect();
+    let work = || {
+        model.with_data(|m, d| {
+            guard(|| {
+                let mut out: Vec<Vec<f64>> = sizes.iter().map(|&s| Vec::with_capacity(rows * s)).collect();
+                let mut row = vec![0.0; width];
+                for k in 0..rows {
+                    with_work(m, |w| f(m, d, w, k, &mut row)).map_err(|e| at_row(e, k, stacked))?;
+                    let mut off = 0;
+                    for (o, &s) in out.iter_mut().zip(&sizes) {
+                        o.extend_from_slice(&row[off..off + s]);
+                        off += s;
+                    }
+                }
+                Ok(out)
+            })
+        })
+    };
+    let data = py.detach(work)?;
+    data.into_iter().zip(parts).map(|(v, p)| output(py, v, rows, stacked, p)).collect()
 }
 
 fn three<'py>(v: Vec<Bound<'py, PyAny>>) -> (Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>) {
@@ -107,7 +130,8 @@ pub fn aba_derivatives<'py>(
         let n2 = nv * nv;
         put(&w.da_dq, &mut o[..n2]);
         put(&w.da_dv, &mut o[n2..2 * n2]);
-        put(&w.minv, &mut o[2 * n2..]);
+        // M⁻¹ is exactly symmetric (its lower triangle is a copy of the upper): row-major = column-major
+        o[2 * n2..].copy_from_slice(w.minv.as_slice());
         Ok(())
     })?;
     Ok(three(out))

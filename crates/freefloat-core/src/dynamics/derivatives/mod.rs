@@ -19,26 +19,36 @@
 //! differs from `pin.integrate` at O(dt²) when the base rotates and translates at once.
 //!
 //! # Algorithm
-//! ∂τ/∂q and ∂τ/∂v are computed by exact forward-mode differentiation of the recursive
-//! Newton-Euler algorithm in inertial coordinates (Featherstone, RBDA §5.3, in the form of Carpentier
-//! and Mansard, RSS 2018, §III): a perturbation of joint j along its subspace column ψ = ⁰Sⱼ moves
-//! the subtree of j rigidly, so every inertial-frame quantity fixed to a body of that subtree changes
-//! by `ψ ×` (motions), `ψ ×*` (forces) or `ψ×* I − I ψ×` (inertias); the twists, accelerations and
-//! forces then follow by the chain rule through the two passes. One pass over the subtree (and up its
-//! ancestors) per tangent direction: O(nv · depth) work, no finite differences. Forward dynamics:
-//! `∂a/∂x = −M⁻¹ ∂τ/∂x |_{a = FD(q, v, τ)}` (Carpentier and Mansard, eq. (9)), with M from CRBA and
-//! its Cholesky factor.
+//! ∂τ/∂q and ∂τ/∂v: the single-pass algorithm of Carpentier and Mansard, "Analytical Derivatives of Rigid Body
+//! Dynamics Algorithms", RSS 2018 (Alg. 1), in inertial coordinates (`rnea_derivatives.rs`). A perturbation of
+//! joint j along its subspace column ψ = ⁰Sⱼ turns the subtree of j rigidly, so every inertial-frame quantity fixed
+//! to a body of that subtree changes by `ψ ×` (motions), `ψ ×*` (forces) or `ψ×* I − I ψ×` (inertias), plus a part
+//! that does not depend on the body: Ψ̇ = v_λ(j) × ψ for the twists and Ψ̈ = a_λ(j) × ψ + v_λ(j) × Ψ̇ for the
+//! accelerations. The turning part cancels in `τᵢ = Sᵢᵀ Fᵢ` for i in the subtree, so with the subtree sums Fᵢ,
+//! Icᵢ = Σ I and Bcᵢ = Σ B (B the map `e ↦ I (e × v) + e ×* (I v) + v ×* (I e)`, whose linear-input half is zero):
+//! - `∂τᵢ/∂q_j = Sᵢᵀ (Icᵢ Ψ̈_j + Bcᵢ Ψ̇_j)` for j on the path from the root to i (row i),
+//! - `∂τ_j/∂qᵢ = S_jᵀ (ψ ×* Fᵢ + Icᵢ Ψ̈ᵢ + Bcᵢ Ψ̇ᵢ)` for the strict ancestors j of i (column i),
+//!
+//! and likewise for q̇ with `∂v/∂q̇_j = ψ` and `∂a/∂q̇_j = Ψ̇_j + v_j × ψ` (Bc ψ + Ic (Ψ̇ + Ṡ)); every other entry is
+//! zero (joints on different branches). One forward pass and one backward pass filling whole rows and columns:
+//! O(nv · depth) 6-vector products.
+//!
+//! Forward dynamics: `∂a/∂x = −M⁻¹ ∂τ/∂x |_{a = FD(q, v, τ)}` (Carpentier and Mansard, eq. (9)), with a from the
+//! articulated-body algorithm and M⁻¹ from the articulated-body recursion run on all nv unit torques at once
+//! (`minv.rs`, O(nv · n)), then two products that skip the zero entries of ∂τ/∂x.
 //!
 //! Universal joints are not supported (their subspace depends on q); the entry points say so.
 
+mod dense;
 mod frame;
+mod minv;
 mod rnea_derivatives;
 mod step;
 
 pub use crate::config::{difference, difference_jacobians, integrate, integrate_jacobians};
+pub(crate) use dense::{cholesky_inverse, dot, gemm, gemm_pair};
 pub use frame::{frame_dq_pose_derivatives, frame_log_error_derivatives, se3_log, se3_log_jacobian};
 pub use rnea_derivatives::{aba_derivatives, rnea_derivatives};
-pub(crate) use rnea_derivatives::{cholesky_inverse, dot};
 pub use step::{step, step_derivatives, Scheme};
 
 use crate::error::{FfError, Result};
@@ -70,25 +80,29 @@ pub struct Derivatives {
     pub fx: DMatrix<f64>,
     /// ∂x⁺/∂u (2nv × nv), u = τ (all nv generalized forces; select columns for an under-actuated base).
     pub fu: DMatrix<f64>,
-    // ---- scratch of the RNEA derivative passes (inertial frame)
+    // ---- scratch of the RNEA derivative passes (inertial frame): per body
     pub(crate) ov: Vec<Motion>,
     pub(crate) oa: Vec<Motion>,
-    pub(crate) vj: Vec<Motion>,
-    pub(crate) aj: Vec<Motion>,
     pub(crate) oi: Vec<Inertia>,
-    pub(crate) h: Vec<Force>,
-    pub(crate) g: Vec<Force>,
-    pub(crate) fe: Vec<Force>,
     pub(crate) ff: Vec<Force>,
-    pub(crate) dov: Vec<Motion>,
-    pub(crate) doa: Vec<Motion>,
-    pub(crate) dff: Vec<Force>,
-    pub(crate) in_sub: Vec<bool>,
     pub(crate) ic: Vec<Inertia>,
-    pub(crate) bc: Vec<crate::spatial::M6>,
-    pub(crate) sb: Vec<crate::spatial::M6>,
-    pub(crate) si: Vec<crate::spatial::M6>,
-    pub(crate) chol: DMatrix<f64>,
+    pub(crate) bc: Vec<rnea_derivatives::BMap>,
+    // per velocity coordinate (column ψ of a joint subspace): ψ in the inertial frame
+    pub(crate) sw: Vec<Motion>,
+    // per velocity coordinate (column ψ of a joint subspace): Ψ̇ = v_λ × ψ, Ψ̈ = a_λ × ψ + v_λ × Ψ̇, Ψ̇ + v × ψ
+    pub(crate) psi_d: Vec<Motion>,
+    pub(crate) psi_dd: Vec<Motion>,
+    pub(crate) dadv: Vec<Motion>,
+    // per velocity index, the previous one on its path to the root: the one before it in its joint, else the last
+    // one of the nearest ancestor joint that has any (None at the root)
+    pub(crate) dof_parent: Vec<Option<usize>>,
+    // ---- scratch of the M⁻¹ pass (`minv`): per body Iᴬ, U, D⁻¹, the end of its subtree's velocity range, and
+    // pᴬ / a as 6 × nv matrices
+    pub(crate) ia: Vec<crate::spatial::M6>,
+    pub(crate) mu: Vec<crate::spatial::M6>,
+    pub(crate) mdinv: Vec<crate::spatial::M6>,
+    pub(crate) sub_end: Vec<usize>,
+    pub(crate) fm: Vec<f64>,
     // ---- scratch of the step derivatives
     pub(crate) rk: step::StepWork,
     model_id: u64,
@@ -112,22 +126,20 @@ impl Derivatives {
             fu: DMatrix::zeros(2 * nv, nv),
             ov: vec![Motion::ZERO; n],
             oa: vec![Motion::ZERO; n],
-            vj: vec![Motion::ZERO; n],
-            aj: vec![Motion::ZERO; n],
             oi: vec![Inertia::zero(); n],
-            h: vec![Force::ZERO; n],
-            g: vec![Force::ZERO; n],
-            fe: vec![Force::ZERO; n],
             ff: vec![Force::ZERO; n],
-            dov: vec![Motion::ZERO; n],
-            doa: vec![Motion::ZERO; n],
-            dff: vec![Force::ZERO; n],
-            in_sub: vec![false; n],
             ic: vec![Inertia::zero(); n],
-            bc: vec![crate::spatial::M6::zeros(); n],
-            sb: vec![crate::spatial::M6::zeros(); n],
-            si: vec![crate::spatial::M6::zeros(); n],
-            chol: z(),
+            bc: vec![rnea_derivatives::BMap::ZERO; n],
+            sw: vec![Motion::ZERO; nv],
+            psi_d: vec![Motion::ZERO; nv],
+            psi_dd: vec![Motion::ZERO; nv],
+            dadv: vec![Motion::ZERO; nv],
+            dof_parent: dof_parents(m),
+            ia: vec![crate::spatial::M6::zeros(); n],
+            mu: vec![crate::spatial::M6::zeros(); n],
+            mdinv: vec![crate::spatial::M6::zeros(); n],
+            sub_end: subtree_ends(m),
+            fm: vec![0.0; 6 * nv * n],
             rk: step::StepWork::new(m),
             model_id: m.id(),
         }
@@ -139,6 +151,33 @@ impl Derivatives {
     pub fn model_id(&self) -> u64 {
         self.model_id
     }
+}
+
+/// `Derivatives::dof_parent`.
+fn dof_parents(m: &Model) -> Vec<Option<usize>> {
+    let mut last: Vec<Option<usize>> = vec![None; m.nbodies()];
+    let mut out = vec![None; m.nv];
+    for i in 0..m.nbodies() {
+        let mut prev = m.parents[i].and_then(|p| last[p]);
+        for c in m.idx_v[i]..m.idx_v[i] + m.nvs[i] {
+            out[c] = prev;
+            prev = Some(c);
+        }
+        last[i] = prev;
+    }
+    out
+}
+
+/// For each body, one past the last velocity index of its subtree (bodies are numbered parents first and velocity
+/// indices follow the body order, so the subtree's indices lie in `idx_v[i]..end`).
+fn subtree_ends(m: &Model) -> Vec<usize> {
+    let mut end: Vec<usize> = (0..m.nbodies()).map(|i| m.idx_v[i] + m.nvs[i]).collect();
+    for i in (0..m.nbodies()).rev() {
+        if let Some(p) = m.parents[i] {
+            end[p] = end[p].max(end[i]);
+        }
+    }
+    end
 }
 
 /// Check that `w` was made for `m` and that `m` has no universal joint.
@@ -164,38 +203,4 @@ pub(crate) fn check_supported(m: &Model) -> Result<()> {
         ));
     }
     Ok(())
-}
-
-/// `c = α a b + β c` without allocating (nalgebra's dynamic `gemm` packs through a heap buffer);
-/// zero entries of `b` are skipped, which the block-diagonal Jacobians of ⊕ have many of.
-pub(crate) fn gemm<S: nalgebra::StorageMut<f64, nalgebra::Dyn, nalgebra::Dyn, RStride = nalgebra::U1>>(
-    c: &mut nalgebra::Matrix<f64, nalgebra::Dyn, nalgebra::Dyn, S>,
-    alpha: f64,
-    a: &DMatrix<f64>,
-    b: &DMatrix<f64>,
-    beta: f64,
-) {
-    let (n, p) = (a.nrows(), b.ncols());
-    debug_assert_eq!(a.ncols(), b.nrows());
-    debug_assert_eq!((c.nrows(), c.ncols()), (n, p));
-    let (asl, bsl) = (a.as_slice(), b.as_slice());
-    let kk = a.ncols();
-    for j in 0..p {
-        let mut cj = c.column_mut(j);
-        let cs = cj.as_mut_slice();
-        if beta == 0.0 {
-            cs.fill(0.0);
-        } else if beta != 1.0 {
-            cs.iter_mut().for_each(|x| *x *= beta);
-        }
-        for (k, &bkj) in bsl[j * kk..(j + 1) * kk].iter().enumerate() {
-            if bkj == 0.0 {
-                continue;
-            }
-            let s = alpha * bkj;
-            for (ci, ai) in cs.iter_mut().zip(&asl[k * n..(k + 1) * n]) {
-                *ci += ai * s;
-            }
-        }
-    }
 }
