@@ -8,7 +8,10 @@ libraries see the same robot): the ch. 8 spacecraft of Valverde 2018 with the RR
 Timed, each on the same N random states, R interleaved repeats (median, min-max):
 
 * ABA derivatives, one Python call per state: `ff.derivatives.aba_derivatives` vs `pin.computeABADerivatives`
-  (both return da/dq, da/dv, M^-1; both pay their binding's overhead).
+  (both return da/dq, da/dv, M^-1; both pay their binding's overhead), in a loop that uses each result and lets it
+  go, as a solver does (the headline row). Pinocchio returns views of its one `Data` (the next call overwrites
+  them), freefloat new arrays; so a second row keeps all N results, Pinocchio's copied (`.copy()`: without it the N
+  kept results would all be the last one), which is what keeping them costs with each library.
 * ABA derivatives, stacked: one `ff.derivatives.aba_derivatives` call on the N states (a Rust loop), per state.
   Pinocchio has no batched entry point for it, so its per-call figure above is its best from Python.
 * The per-node dynamics-plus-derivatives block of a DDP iteration (ch. 8 model only): freefloat's stacked
@@ -183,6 +186,15 @@ def crocoddyl_problem(pm, dt, n, rk4, with_costs, refs):
     return problem
 
 
+def use_each(f, *args):
+    """Call `f(*head, q, v, tau)` on each state in turn, keeping only the latest result (a solver's loop)."""
+    *head, Q, V, T = args
+    r = None
+    for k in range(len(Q)):
+        r = f(*head, Q[k], V[k], T[k])
+    return r
+
+
 def bench_model(name, bodies, base, n, reps, rng, have_croc, results, agreement, md):
     """Check against Pinocchio, then time one model; fills results, agreement and md."""
     import pinocchio as pin
@@ -207,7 +219,14 @@ def bench_model(name, bodies, base, n, reps, rng, have_croc, results, agreement,
         sys.exit(f"{name}: freefloat's ABA derivatives differ from Pinocchio's by {worst:.3g} (relative)")
 
     timings = {
-        k: [] for k in ("ff_aba_derivatives_call", "pin_computeABADerivatives_call", "ff_aba_derivatives_stacked")
+        k: []
+        for k in (
+            "ff_aba_derivatives_call",
+            "pin_computeABADerivatives_call",
+            "ff_aba_derivatives_call_kept",
+            "pin_computeABADerivatives_call_kept",
+            "ff_aba_derivatives_stacked",
+        )
     }
     croc_runs = {}
     if name.startswith("ch8"):
@@ -233,11 +252,20 @@ def bench_model(name, bodies, base, n, reps, rng, have_croc, results, agreement,
                 timings[f"croc_calcDiff_{label}"] = []
 
     for _ in range(reps):
-        timings["ff_aba_derivatives_call"].append(
+        timings["ff_aba_derivatives_call"].append(per_item(lambda: use_each(D.aba_derivatives, m, Q, V, T), n))
+        timings["pin_computeABADerivatives_call"].append(
+            per_item(lambda: use_each(pin.computeABADerivatives, pm, pd, Q, V, T), n)
+        )
+        timings["ff_aba_derivatives_call_kept"].append(
             per_item(lambda: [D.aba_derivatives(m, Q[k], V[k], T[k]) for k in range(n)], n)
         )
-        timings["pin_computeABADerivatives_call"].append(
-            per_item(lambda: [pin.computeABADerivatives(pm, pd, Q[k], V[k], T[k]) for k in range(n)], n)
+        timings["pin_computeABADerivatives_call_kept"].append(
+            per_item(
+                lambda: [
+                    tuple(x.copy() for x in pin.computeABADerivatives(pm, pd, Q[k], V[k], T[k])) for k in range(n)
+                ],
+                n,
+            )
         )
         timings["ff_aba_derivatives_stacked"].append(per_item(lambda: D.aba_derivatives(m, Q, V, T), n))
         if name.startswith("ch8"):
@@ -264,6 +292,7 @@ def bench_model(name, bodies, base, n, reps, rng, have_croc, results, agreement,
     ratios = {
         "ff_call_over_pin_call": med["ff_aba_derivatives_call"] / med["pin_computeABADerivatives_call"],
         "ff_stacked_over_pin_call": med["ff_aba_derivatives_stacked"] / med["pin_computeABADerivatives_call"],
+        "ff_kept_over_pin_copied": med["ff_aba_derivatives_call_kept"] / med["pin_computeABADerivatives_call_kept"],
     }
     if "croc_calcDiff_euler_costs" in med:
         ratios["ff_euler_block_over_croc_calcDiff"] = med["ff_euler_block_stacked"] / med["croc_calcDiff_euler_costs"]

@@ -73,7 +73,8 @@ from freefloat import estimation as est  # noqa: E402
 MODEL = "naveen_dual_arm"
 DRIVEN = ["J1", "J2", "J3", "J4", "J5", "J6", "Wx", "Wy", "Wz"]
 NOISE = 0.1
-TARGETS = {"regressor": 5.0, "end_to_end": 10.0, "regressor_kin": 5.0, "end_to_end_kin": 10.0}
+# end to end: >= 6x since issue 36 (the 10x target retired on the floor analysis in BENCHMARKS.md, "Identification")
+TARGETS = {"regressor": 5.0, "end_to_end": 6.0, "regressor_kin": 5.0, "end_to_end_kin": 6.0}
 
 
 def multisine(m, seed=1):
