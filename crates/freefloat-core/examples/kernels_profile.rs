@@ -1,13 +1,15 @@
-//! A fixed workload for instruction counting of the dynamics kernels (ABA, RNEA, CRBA): `count` calls on a
-//! cycle of 64 random states of one model. Instruction counts, unlike wall time, do not depend on what else the
+//! A fixed workload for instruction counting of the dynamics kernels (ABA, RNEA, CRBA) and their derivatives
+//! (`aba_derivatives`, `rnea_derivatives`): `count` calls on a cycle of 64 random states of one model. Instruction counts, unlike wall time, do not depend on what else the
 //! shared machine is doing.
 //!
 //!     cargo build --release --example kernels_profile
 //!     valgrind --tool=callgrind target/release/examples/kernels_profile aba naveen_dual_arm_consistent 10000
 //!     target/release/examples/kernels_profile rnea path/to/tree.yaml 100000     # a model file also works
+//!     valgrind --tool=callgrind target/release/examples/kernels_profile aba_derivatives naveen_dual_arm_consistent 2000
 //!
 //! Prints the wall time per call too (indicative only on a loaded machine).
 
+use freefloat_core::dynamics::derivatives::{aba_derivatives, rnea_derivatives, Derivatives};
 use freefloat_core::dynamics::{aba, crba, rnea};
 use freefloat_core::model::{builtin, yaml};
 use freefloat_core::{Data, Model};
@@ -48,6 +50,7 @@ fn main() {
         })
         .collect();
     let mut d = Data::new(&m);
+    let mut w = Derivatives::new(&m);
     let t0 = Instant::now();
     let mut acc = 0.0;
     for k in 0..count {
@@ -65,7 +68,15 @@ fn main() {
                 crba(&m, &mut d, q).expect("crba");
                 acc += d.mass_matrix[(0, 0)];
             }
-            other => panic!("unknown algorithm {other} (aba, rnea, crba)"),
+            "aba_derivatives" => {
+                aba_derivatives(&m, &mut d, &mut w, q, v, u, None).expect("aba_derivatives");
+                acc += w.da_dq[(m.nv - 1, m.nv - 1)];
+            }
+            "rnea_derivatives" => {
+                rnea_derivatives(&m, &mut d, &mut w, q, v, u, None).expect("rnea_derivatives");
+                acc += w.dtau_dq[(m.nv - 1, m.nv - 1)];
+            }
+            other => panic!("unknown algorithm {other} (aba, rnea, crba, aba_derivatives, rnea_derivatives)"),
         }
     }
     let dt = t0.elapsed().as_secs_f64();
