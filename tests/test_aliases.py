@@ -57,3 +57,15 @@ def test_cli_accepts_an_alias_and_lists_new_names():
     assert r.output.startswith("naveen_dual_arm: 52 minimal parameters")
     r = CliRunner().invoke(main, ["scenarios"])
     assert r.exit_code == 0 and "zhang2020_2d_medium" in r.output and "seed000" not in r.output
+
+
+def test_controller_modules_are_attributes_of_the_control_package_without_an_import_line():
+    import importlib
+
+    import freefloat as ff
+
+    assert ff.control.ddp is importlib.import_module("freefloat.control.ddp")
+    assert ff.control.ddp_closed_loop is importlib.import_module("freefloat.control.ddp_closed_loop")
+    assert not hasattr(ff.control, "no_such_controller")
+    with pytest.raises(AttributeError, match="no_such_controller"):
+        ff.control.no_such_controller  # noqa: B018

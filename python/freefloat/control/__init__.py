@@ -17,25 +17,26 @@ entries are the base-frame thruster wrench), so it plugs into `ff.simulate(..., 
 controller_period=dt)`; its numbers (laws, gradients) belong in the engine (`crates/freefloat-core/src/control/`),
 with this package driving them.
 
-Every module of this package is reachable as an attribute (`ff.control.ddp`) without being listed here: a new
+Every module of this package is reachable as an attribute (`ff.control.ddp`) without being imported here: a new
 controller module needs no line in this file (docs/architecture.md, "Where new code goes").
 """
 
 import importlib
-import pkgutil
 
 from .._core import AdaptivePoseController
 from . import adaptive
 from .adaptive import realisability
 
-#: the controller modules of this package (found on disk, so a new one is listed without editing this file)
-MODULES = sorted(m.name for m in pkgutil.iter_modules(__path__) if not m.name.startswith("_"))
-
-__all__: list[str] = ["AdaptivePoseController", "adaptive", "realisability", *(m for m in MODULES if m != "adaptive")]
+__all__: list[str] = ["AdaptivePoseController", "adaptive", "realisability"]
 
 
 def __getattr__(name: str):
-    # import a controller module on first use (PEP 562): `ff.control.ddp` works without an import line here
-    if name in MODULES:
-        return importlib.import_module(f"{__name__}.{name}")
+    # a controller module imported on first use (PEP 562): `ff.control.ddp` works without an import line here, and
+    # importing freefloat lists no folder and imports no controller it does not need
+    if not name.startswith("_"):
+        try:
+            return importlib.import_module(f"{__name__}.{name}")
+        except ModuleNotFoundError as e:
+            if e.name != f"{__name__}.{name}":  # the module exists but something it imports does not: say so
+                raise
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
