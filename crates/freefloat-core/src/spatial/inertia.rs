@@ -122,7 +122,11 @@ impl Inertia {
     /// transformed first moment): only the six independent entries of the symmetric result are computed, each as one
     /// chain of fused multiply-adds (the skew-matrix products would cost 54 multiplications by zero, which the
     /// compiler may not drop for floats). Featherstone, RBDA (2008), eq. 2.63.
-    #[inline]
+    ///
+    /// Always inlined: ABA forms one per body and stage, and as a call its result went through memory (the
+    /// caller re-read it at once to expand it to 6×6): inlined, the 10-body RK4 simulation `sim10s_table` runs
+    /// 6.5 % faster in CPU time (median of 25 interleaved runs) for 0.8 % fewer instructions.
+    #[inline(always)]
     pub fn transformed(&self, x: &Se3) -> Inertia {
         // Written on whole columns (lane j of a column is row j; `F4`), each entry still the one chain of fused
         // multiply-adds above, so the result is the same to the bit as entry-by-entry code. The compiler keeps the
