@@ -31,7 +31,9 @@ mod rls_kernel;
 mod streaming;
 
 pub use analysis::{unexcited_directions, Direction, RANK_RTOL};
-pub use gram::{gram_rows_upper, GramLs, GRAM_TILE};
+#[cfg(target_arch = "x86_64")]
+pub use gram::gram_rows_upper_avx512;
+pub use gram::{avx512, gram_rows_upper, gram_rows_upper_avx2, GramLs, GRAM_TILE};
 pub use modified_rls::{CoupledSample, Coupling, ModifiedRls};
 pub use momentum::{
     identify_momentum, identify_momentum_interruptible, identify_momentum_with, momentum_regressor_pass,
