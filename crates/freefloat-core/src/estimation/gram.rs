@@ -152,7 +152,7 @@ const GRAM_CHUNK: usize = 24;
 /// set (read once per process), the x86-64-v3 kernel [`gram_rows_upper_avx2`]. Every entry on and above the
 /// diagonal is the same chain of fused multiply-adds, row by row, in both: the results are the same to the bit.
 /// On 192 rows × 53 columns (`examples/identify_profile.rs gram 20000`, AMD Zen 5): 174 ns per sample (AVX2)
-/// and 83 ns (AVX-512), against 277 for [`GramLs`]. Public for that benchmark; the identification calls it
+/// and 109 ns (AVX-512), against 270 for [`GramLs`]. Public for that benchmark; the identification calls it
 /// through its own pass.
 pub fn gram_rows_upper(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
     #[cfg(target_arch = "x86_64")]
