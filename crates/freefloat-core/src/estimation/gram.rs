@@ -134,8 +134,12 @@ pub(super) fn gram_update(g: &mut DMatrix<f64>, block: &DMatrix<f64>, start: usi
 /// Width of the column tiles of [`gram_rows_upper`]: two 4-wide FMA registers. Row-major blocks fed to it are
 /// padded to a multiple of this (the padding columns left zero).
 pub const GRAM_TILE: usize = 8;
-/// Rows per pass of the tiles in [`gram_rows_upper`]: 24 rows of 56 columns are 10.5 kB, which stay in L1.
+/// Rows per pass of the tiles in [`gram_rows_upper_avx2`]: 24 rows of 56 columns are 10.5 kB, which stay in L1.
 const GRAM_CHUNK: usize = 24;
+/// Rows per pass of the strips in [`gram_rows_upper_avx512`]: 48 rows (21 kB at 56 columns; the identification's
+/// half-block) load and store each strip's accumulators half as often as 24 did: 106 -> 100 ns per sample in
+/// `identify_profile gram` (96 rows: the same, 192: 101).
+const GRAM_CHUNK_512: usize = 48;
 
 /// `g += BᵀB` on and above the diagonal, for B = the `rows` rows of the row-major block `b` (row r at
 /// `b[r·w..]`), its first `cols` columns (a multiple of 4, at most `w`); `g` is w × w, row-major (entry (i, j) at
@@ -152,7 +156,7 @@ const GRAM_CHUNK: usize = 24;
 /// set (read once per process), the x86-64-v3 kernel [`gram_rows_upper_avx2`]. Every entry on and above the
 /// diagonal is the same chain of fused multiply-adds, row by row, in both: the results are the same to the bit.
 /// On 192 rows × 53 columns (`examples/identify_profile.rs gram 20000`, AMD Zen 5): 174 ns per sample (AVX2)
-/// and 109 ns (AVX-512), against 270 for [`GramLs`]. Public for that benchmark; the identification calls it
+/// and 100 ns (AVX-512), against 270 for [`GramLs`]. Public for that benchmark; the identification calls it
 /// through its own pass.
 pub fn gram_rows_upper(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
     #[cfg(target_arch = "x86_64")]
@@ -223,7 +227,7 @@ pub fn gram_rows_upper_avx2(g: &mut [f64], b: &[f64], w: usize, rows: usize, col
 #[target_feature(enable = "avx512f")]
 pub unsafe fn gram_rows_upper_avx512(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
     assert!(cols.is_multiple_of(4) && cols <= w && g.len() == w * w && b.len() >= rows * w, "Gram rows: shapes");
-    for chunk in b[..rows * w].chunks(GRAM_CHUNK * w) {
+    for chunk in b[..rows * w].chunks(GRAM_CHUNK_512 * w) {
         let n = chunk.len() / w;
         for j0 in (0..cols).step_by(8) {
             // the strip's columns j0..j0 + 8, or the last four
@@ -330,7 +334,7 @@ mod tests {
             kernels.push(("avx512", |g, b, w, r, c| unsafe { gram_rows_upper_avx512(g, b, w, r, c) }));
         }
         for (name, kernel) in kernels {
-            for rows in [1, 7, GRAM_CHUNK, GRAM_CHUNK + 1, 3 * GRAM_CHUNK + 5] {
+            for rows in [1, 7, GRAM_CHUNK, GRAM_CHUNK + 1, GRAM_CHUNK_512 + 1, 3 * GRAM_CHUNK_512 + 5] {
                 for cols in (4..=w).step_by(4) {
                     let b: Vec<f64> = (0..rows * w).map(|k| mix(k / w, k % w)).collect();
                     let mut g = vec![1.0; w * w]; // accumulates onto what is there
@@ -361,7 +365,7 @@ mod tests {
             return;
         }
         let w = 56;
-        for (rows, cols) in [(24, 56), (24, 20), (1, 4), (53, 44), (100, 56)] {
+        for (rows, cols) in [(24, 56), (24, 20), (1, 4), (53, 44), (100, 56), (48, 20)] {
             let b: Vec<f64> = (0..rows * w).map(|k| mix(k / w, k % w) * (1.0 + (k % 13) as f64 / 7.0)).collect();
             let start: Vec<f64> = (0..w * w).map(|k| mix(k, 5)).collect();
             let (mut g2, mut g5) = (start.clone(), start);
