@@ -55,9 +55,10 @@ def identify_here(**env) -> str:
     return r.stdout
 
 
-def test_the_gram_kernels_give_the_same_bits():
-    # FREEFLOAT_NO_AVX512 forces the x86-64-v3 Gram kernel where the AVX-512 one would run (on a processor without
-    # AVX-512 both runs take the same kernel): every entry is the same chain of fused multiply-adds
+def test_the_avx512_and_baseline_kernels_give_the_same_bits():
+    # FREEFLOAT_NO_AVX512 forces the x86-64-v3 Gram kernel and the four-sample block builder where the AVX-512 Gram
+    # kernel and the eight-sample builder would run (on a processor without AVX-512 both runs take the same path):
+    # every entry is the same chain of operations either way
     fast, portable = identify_here(), identify_here(FREEFLOAT_NO_AVX512="1")
     assert fast.startswith("normal equations") and fast == portable
 
@@ -96,7 +97,7 @@ def test_runs_on_a_2013_processor():
         pytest.skip("this engine was built for AVX-512 (target-cpu=native?), not the portable baseline")
     r = run_on("Haswell")
     assert r.returncode == 0 and r.stdout.startswith("ok 15"), r.stdout + r.stderr
-    # the identification's run-time kernel choice falls back to the x86-64-v3 kernel there: the same estimate
+    # the identification's run-time choice falls back to the x86-64-v3 kernel and builder there: the same estimate
     r = run_on("Haswell", IDENTIFY)
     assert r.returncode == 0, r.stderr[-2000:]
     assert r.stdout == identify_here(FREEFLOAT_NO_AVX512="1")

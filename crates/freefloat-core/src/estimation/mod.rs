@@ -10,7 +10,7 @@
 //! - [`GramLs`]: the Gram matrix `[A y]ᵀ[A y]`, accumulated with cache-blocked matrix products (several times
 //!   faster; the identification's own pass writes its rows in the layout of a triangle-only kernel,
 //!   [`gram_rows_upper`], AVX-512 or x86-64-v3 as the processor allows, and folds each small block while it is
-//!   still in L1). Plain normal equations lose twice
+//!   still in L1; it forms the rows eight samples per sweep under AVX-512, four otherwise). Plain normal equations lose twice
 //!   the digits (error ∝ κ²·ε), so [`identify_momentum`] only keeps this route when the measured,
 //!   column-equilibrated condition number is small, and then adds one refinement pass on the true residual
 //!   (corrected semi-normal equations, Björck), which restores QR-grade accuracy. Otherwise it re-streams the data
