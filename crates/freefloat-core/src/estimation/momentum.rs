@@ -398,10 +398,13 @@ impl<'a> BlockBuilder<'a> {
     fn fill_block_lanes(&mut self, s: usize, cnt: usize) -> Result<usize> {
         let mut slot = 0;
         // each sweep is taken out of `self` for its pass (its samples are written into `self.block`) and put back
-        #[cfg(target_arch = "x86_64")]
         if let Some(mut kin) = self.kin8.take() {
             // SAFETY: `kin8` is built only where `avx512_lanes()` found AVX-512F, VL and DQ (see `new`).
+            #[cfg(target_arch = "x86_64")]
             let r = unsafe { self.fill_groups_avx512(&mut kin, s, cnt) };
+            // (elsewhere `kin8` is never built; the generic body keeps the field in use for the compiler)
+            #[cfg(not(target_arch = "x86_64"))]
+            let r = self.fill_groups(&mut kin, s, 0, cnt);
             self.kin8 = Some(kin);
             slot = r?;
         }
