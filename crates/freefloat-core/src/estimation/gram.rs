@@ -134,8 +134,12 @@ pub(super) fn gram_update(g: &mut DMatrix<f64>, block: &DMatrix<f64>, start: usi
 /// Width of the column tiles of [`gram_rows_upper`]: two 4-wide FMA registers. Row-major blocks fed to it are
 /// padded to a multiple of this (the padding columns left zero).
 pub const GRAM_TILE: usize = 8;
-/// Rows per pass of the tiles in [`gram_rows_upper`]: 24 rows of 56 columns are 10.5 kB, which stay in L1.
+/// Rows per pass of the tiles in [`gram_rows_upper_avx2`]: 24 rows of 56 columns are 10.5 kB, which stay in L1.
 const GRAM_CHUNK: usize = 24;
+/// Rows per pass of the strips in [`gram_rows_upper_avx512`]: 48 rows (21 kB at 56 columns; the identification's
+/// half-block) load and store each strip's accumulators half as often as 24 did: 106 -> 100 ns per sample in
+/// `identify_profile gram` (96 rows: the same, 192: 101).
+const GRAM_CHUNK_512: usize = 48;
 
 /// `g += BᵀB` on and above the diagonal, for B = the `rows` rows of the row-major block `b` (row r at
 /// `b[r·w..]`), its first `cols` columns (a multiple of 4, at most `w`); `g` is w × w, row-major (entry (i, j) at
@@ -144,16 +148,45 @@ const GRAM_CHUNK: usize = 24;
 /// Why not the BLAS-style product of [`gram_update`]: that computes both triangles and packs both operands into
 /// panels on every call (in `perf` of the identification, packing took 38 % of the product's time). Here the block
 /// builder writes the rows in the layout the kernel reads, so nothing is packed, and only the tiles that reach the
-/// diagonal or lie above it are formed. Each tile of G is 4 rows × 8 columns, held in eight 4-wide registers while
-/// the rows stream past: per row, two vector loads, four broadcasts, eight FMAs. On 192 rows × 53 columns: 210 ns
-/// per sample against 470 for [`GramLs`] (`examples/identify_profile.rs gram 3000`, same checksum). Where a
+/// diagonal or lie above it are formed.
+///
+/// Two kernels, chosen at run time (as OpenBLAS picks its kernels for the processor): on a processor with AVX-512
+/// (`avx512f`), [`gram_rows_upper_avx512`] (8-wide registers, up to 24 of them accumulating, each multiply-add
+/// reading its broadcast operand from memory); elsewhere, or with the environment variable `FREEFLOAT_NO_AVX512`
+/// set (read once per process), the x86-64-v3 kernel [`gram_rows_upper_avx2`]. Every entry on and above the
+/// diagonal is the same chain of fused multiply-adds, row by row, in both: the results are the same to the bit.
+/// On 192 rows × 53 columns (`examples/identify_profile.rs gram 20000`, AMD Zen 5): 174 ns per sample (AVX2)
+/// and 100 ns (AVX-512), against 270 for [`GramLs`]. Public for that benchmark; the identification calls it
+/// through its own pass.
+pub fn gram_rows_upper(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if avx512() {
+        // SAFETY: `avx512()` is true only where the processor has AVX-512F (detected at run time).
+        return unsafe { gram_rows_upper_avx512(g, b, w, rows, cols) };
+    }
+    gram_rows_upper_avx2(g, b, w, rows, cols)
+}
+
+/// Whether the AVX-512 kernels run: the processor has AVX-512F and `FREEFLOAT_NO_AVX512` is not set (it forces the
+/// x86-64-v3 kernels, e.g. to compare them). Decided once per process.
+pub fn avx512() -> bool {
+    static USE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *USE.get_or_init(|| {
+        #[cfg(target_arch = "x86_64")]
+        let has = std::arch::is_x86_feature_detected!("avx512f");
+        #[cfg(not(target_arch = "x86_64"))]
+        let has = false;
+        has && std::env::var_os("FREEFLOAT_NO_AVX512").is_none()
+    })
+}
+
+/// The x86-64-v3 kernel of [`gram_rows_upper`] (same contract). Each tile of G is 4 rows × 8 columns, held in eight
+/// 4-wide registers while the rows stream past: per row, two vector loads, four broadcasts, eight FMAs. Where a
 /// whole 4 × 8 tile would mostly lie below the diagonal or in the padding, a 4 × 4 tile does: the lower half of a
 /// diagonal 8 × 8 block needs only its right four columns, and `cols` that is 4 past a multiple of 8 ends with a
-/// 4-wide column strip (the identification's 17 linear columns are then padded to 20, not 24). That drops a fifth
-/// of the multiply-adds of the identification's Gram pass; every entry on and above the diagonal is the same chain
-/// of fused multiply-adds, row by row, as with whole tiles (the same bits). Public for that benchmark; the
-/// identification calls it through its own pass.
-pub fn gram_rows_upper(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
+/// 4-wide column strip (the identification's linear columns are then padded to a multiple of 4, not 8). That drops
+/// a fifth of the multiply-adds of the identification's Gram pass.
+pub fn gram_rows_upper_avx2(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
     assert!(cols.is_multiple_of(4) && cols <= w && g.len() == w * w && b.len() >= rows * w, "Gram rows: shapes");
     // Rows are taken GRAM_CHUNK at a time so that they stay in L1 while every tile of G passes over them.
     for chunk in b[..rows * w].chunks(GRAM_CHUNK * w) {
@@ -174,6 +207,85 @@ pub fn gram_rows_upper(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: us
                 }
                 j0 += 4;
             }
+        }
+    }
+}
+
+/// The AVX-512 kernel of [`gram_rows_upper`] (same contract; the caller makes sure the processor has AVX-512F).
+///
+/// G is swept in strips of 8 columns (one 8-wide register; a last strip of 4 through a masked load and store),
+/// and in each strip the rows of G from 0 to the strip's diagonal block in groups of up to 24: 24 accumulators,
+/// so that the two FMA units (4 cycles of latency) always have independent work; per data row, one load of the
+/// strip's 8 entries and one multiply-add per row of G with its factor broadcast from memory (no separate
+/// broadcast instruction). The diagonal 8 × 8 block is formed whole, its lower half (28 of 64 entries) wasted: on
+/// the identification's 56-wide rows that is 224 8-wide multiply-adds per row against 420 4-wide ones for the AVX2
+/// kernel.
+///
+/// # Safety
+/// The processor must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+pub unsafe fn gram_rows_upper_avx512(g: &mut [f64], b: &[f64], w: usize, rows: usize, cols: usize) {
+    assert!(cols.is_multiple_of(4) && cols <= w && g.len() == w * w && b.len() >= rows * w, "Gram rows: shapes");
+    for chunk in b[..rows * w].chunks(GRAM_CHUNK_512 * w) {
+        let n = chunk.len() / w;
+        for j0 in (0..cols).step_by(8) {
+            // the strip's columns j0..j0 + 8, or the last four
+            let mask: u8 = if j0 + 8 <= cols { 0xff } else { 0x0f };
+            // rows 0..j0 + 8 of G (0..cols in a last four-wide strip), 24 at a time
+            let end = (j0 + 8).min(cols);
+            let mut i0 = 0;
+            while i0 < end {
+                let k = (end - i0).min(24);
+                // SAFETY: the processor has AVX-512F (this function's contract); the shapes are the ones asserted
+                // above and `strip` checks its own bounds.
+                unsafe {
+                    match k {
+                        24 => strip::<24>(g, chunk, w, n, i0, j0, mask),
+                        20 => strip::<20>(g, chunk, w, n, i0, j0, mask),
+                        16 => strip::<16>(g, chunk, w, n, i0, j0, mask),
+                        12 => strip::<12>(g, chunk, w, n, i0, j0, mask),
+                        8 => strip::<8>(g, chunk, w, n, i0, j0, mask),
+                        _ => strip::<4>(g, chunk, w, n, i0, j0, mask),
+                    }
+                }
+                i0 += k;
+            }
+        }
+    }
+}
+
+/// Rows `i0..i0 + R` of G, columns `j0..j0 + 8` (those of `mask`), plus Bᵀ B over the `n` rows of `chunk`.
+///
+/// # Safety
+/// The processor must support AVX-512F.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+#[inline]
+unsafe fn strip<const R: usize>(g: &mut [f64], chunk: &[f64], w: usize, n: usize, i0: usize, j0: usize, mask: u8) {
+    use std::arch::x86_64::*;
+    // every row i0..i0 + R and column j0..j0 + (8 or 4, as masked) lies inside the w-wide rows of G and of the chunk
+    let width = if mask == 0xff { 8 } else { 4 };
+    assert!(i0 + R <= w && j0 + width <= w && g.len() == w * w && chunk.len() >= n * w, "Gram strip: shapes");
+    let gp = g.as_mut_ptr();
+    let bp = chunk.as_ptr();
+    // SAFETY: G's row i0 + r at column j0 is at (i0 + r)·w + j0, and a masked load or store touches only the
+    // entries of `mask` (j0..j0 + width), inside G (asserted); the chunk's row r is at r·w, its entries j0..j0 +
+    // width and i0..i0 + R inside it (asserted), r < n.
+    unsafe {
+        let mut acc: [__m512d; R] = [_mm512_setzero_pd(); R];
+        for (r, a) in acc.iter_mut().enumerate() {
+            *a = _mm512_maskz_loadu_pd(mask, gp.add((i0 + r) * w + j0));
+        }
+        for row in 0..n {
+            let x = bp.add(row * w);
+            let bj = _mm512_maskz_loadu_pd(mask, x.add(j0));
+            for (r, a) in acc.iter_mut().enumerate() {
+                *a = _mm512_fmadd_pd(_mm512_set1_pd(*x.add(i0 + r)), bj, *a);
+            }
+        }
+        for (r, a) in acc.iter().enumerate() {
+            _mm512_mask_storeu_pd(gp.add((i0 + r) * w + j0), mask, *a);
         }
     }
 }
@@ -211,25 +323,59 @@ mod tests {
 
     #[test]
     fn row_kernel_is_the_upper_triangle_of_the_product() {
-        // row counts below, at and across the L1 chunk; column tiles narrower than the row
-        let w = 24;
-        for rows in [1, 7, GRAM_CHUNK, GRAM_CHUNK + 1, 3 * GRAM_CHUNK + 5] {
-            for cols in [4, 8, 12, 16, 20, 24] {
-                let b: Vec<f64> = (0..rows * w).map(|k| mix(k / w, k % w)).collect();
-                let mut g = vec![1.0; w * w]; // accumulates onto what is there
-                gram_rows_upper(&mut g, &b, w, rows, cols);
-                for i in 0..cols {
-                    for j in i..cols {
-                        let want = 1.0 + (0..rows).map(|r| b[r * w + i] * b[r * w + j]).sum::<f64>();
-                        let got = g[i * w + j];
-                        assert!(
-                            (got - want).abs() <= 1e-13 * (1.0 + want.abs()),
-                            "rows {rows} ({i},{j}): {got} vs {want}"
-                        );
+        // row counts below, at and across the L1 chunk; column tiles narrower than the row; both kernels (the
+        // AVX-512 one where the processor has it)
+        let w = 56;
+        type Kernel = fn(&mut [f64], &[f64], usize, usize, usize);
+        let mut kernels: Vec<(&str, Kernel)> = vec![("avx2", gram_rows_upper_avx2), ("dispatched", gram_rows_upper)];
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the processor has AVX-512F (just detected)
+            kernels.push(("avx512", |g, b, w, r, c| unsafe { gram_rows_upper_avx512(g, b, w, r, c) }));
+        }
+        for (name, kernel) in kernels {
+            for rows in [1, 7, GRAM_CHUNK, GRAM_CHUNK + 1, GRAM_CHUNK_512 + 1, 3 * GRAM_CHUNK_512 + 5] {
+                for cols in (4..=w).step_by(4) {
+                    let b: Vec<f64> = (0..rows * w).map(|k| mix(k / w, k % w)).collect();
+                    let mut g = vec![1.0; w * w]; // accumulates onto what is there
+                    kernel(&mut g, &b, w, rows, cols);
+                    for i in 0..cols {
+                        for j in i..cols {
+                            let want = 1.0 + (0..rows).map(|r| b[r * w + i] * b[r * w + j]).sum::<f64>();
+                            let got = g[i * w + j];
+                            assert!(
+                                (got - want).abs() <= 1e-13 * (1.0 + want.abs()),
+                                "{name}: rows {rows} ({i},{j}): {got} vs {want}"
+                            );
+                        }
                     }
+                    // outside the column range nothing is touched
+                    assert!((0..w).all(|i| (cols..w).all(|j| g[i * w + j] == 1.0)), "{name}");
                 }
-                // outside the column range nothing is touched
-                assert!((0..w).all(|i| (cols..w).all(|j| g[i * w + j] == 1.0)));
+            }
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn the_avx512_kernel_gives_the_avx2_kernels_bits() {
+        // every entry on and above the diagonal is the same chain of fused multiply-adds in both kernels
+        if !std::arch::is_x86_feature_detected!("avx512f") {
+            eprintln!("no AVX-512F on this processor: only the AVX2 kernel runs here");
+            return;
+        }
+        let w = 56;
+        for (rows, cols) in [(24, 56), (24, 20), (1, 4), (53, 44), (100, 56), (48, 20)] {
+            let b: Vec<f64> = (0..rows * w).map(|k| mix(k / w, k % w) * (1.0 + (k % 13) as f64 / 7.0)).collect();
+            let start: Vec<f64> = (0..w * w).map(|k| mix(k, 5)).collect();
+            let (mut g2, mut g5) = (start.clone(), start);
+            gram_rows_upper_avx2(&mut g2, &b, w, rows, cols);
+            // SAFETY: the processor has AVX-512F (checked above)
+            unsafe { gram_rows_upper_avx512(&mut g5, &b, w, rows, cols) };
+            for i in 0..cols {
+                for j in i..cols {
+                    assert_eq!(g2[i * w + j].to_bits(), g5[i * w + j].to_bits(), "rows {rows} cols {cols} ({i},{j})");
+                }
             }
         }
     }

@@ -1,6 +1,6 @@
 //! Identification from momentum (Naveen, Shah, Misra, eqs. 26–27): `h_k = K(q_k, v_k) P`, streamed over samples.
 
-use super::analysis::{check_rank, finish};
+use super::analysis::{finish, RANK_RTOL};
 use super::gram::{gram_rows_upper, GramLs, GRAM_TILE};
 use super::{LsResult, Method, StreamingLs};
 use crate::check::check_vec;
@@ -8,10 +8,10 @@ use crate::check::{check_finite, check_len};
 use crate::data::Data;
 use crate::error::{FfError, Result};
 use crate::interrupt::{Hook, POLL_INTERVAL};
-use crate::kinematics::{forward_velocities_unchecked, Kin4};
+use crate::kinematics::{forward_velocities_unchecked, Kin, Kin4};
 use crate::model::Model;
 use crate::regressors::{body_momentum_columns, momentum_columns_into};
-use crate::spatial::lanes::{Real, F4, LANES};
+use crate::spatial::lanes::{Lanes, Real};
 use nalgebra::{DMatrix, DVector};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::Instant;
@@ -19,10 +19,12 @@ use std::time::Instant;
 /// Samples per block of the QR and refinement passes ([`Layout::Columns`]): 64 samples = 384 rows × (n+1) columns
 /// (≈160 kB for n = 52), long columns for their reflectors and products, small enough to stay in L2.
 const BLOCK_SAMPLES: usize = 64;
-/// Samples per block of the Gram pass ([`Layout::Rows`]): 8 samples are 24 linear and 24 angular rows, about
-/// 21 kB for n = 52, so the Gram kernel reads them from L1 right after they are written (64-sample blocks, 163 kB,
-/// went out to L2 in between).
-const ROW_BLOCK_SAMPLES: usize = 8;
+/// Samples per block of the Gram pass ([`Layout::Rows`]): 16 samples are 48 linear and 48 angular rows, about
+/// 43 kB for n = 52, so the Gram kernel reads them from L1 (48 kB on Zen 5) right after they are written (64-sample
+/// blocks, 163 kB, went out to L2 in between). 16 rather than 8: the AVX-512 kernel loads and stores its
+/// accumulators once per 48 rows instead of 24 (identification 2-3 % less CPU time, `identify_profile identify`,
+/// five interleaved pairs).
+const ROW_BLOCK_SAMPLES: usize = 16;
 /// Normal equations are kept when the equilibrated κ is at most this: then κ²ε ≈ 2e-6, and one
 /// refinement step on the true residual brings the error down to the QR level (∝ κε).
 pub const GRAM_KAPPA_MAX: f64 = 1e5;
@@ -41,6 +43,8 @@ const PARALLEL_MIN_SAMPLES: usize = 4096;
 /// multiple of both block sizes, so that only the last chunk ends with a partial block.
 const CHUNK_SAMPLES: usize = 2048;
 const _: () = assert!(CHUNK_SAMPLES.is_multiple_of(BLOCK_SAMPLES) && CHUNK_SAMPLES.is_multiple_of(ROW_BLOCK_SAMPLES));
+// the normal equations are only kept far from the rank threshold (see `identify_momentum_interruptible`)
+const _: () = assert!(GRAM_KAPPA_MAX * RANK_RTOL <= 1e-5);
 
 /// A momentum identification problem, all arrays flat and row-major over samples.
 #[derive(Debug, Clone, Copy)]
@@ -63,7 +67,7 @@ pub struct MomentumProblem<'a> {
 impl MomentumProblem<'_> {
     fn samples(&self, m: &Model) -> Result<usize> {
         let t = self.h.len() / 6;
-        // sizes here; finiteness sample by sample in the passes (`BlockBuilder::fill`, `fill4`: on the worker
+        // sizes here; finiteness sample by sample in the passes (`BlockBuilder::fill`, `fill_lanes`: on the worker
         // threads, naming the sample), where a scan of every entry here held up the start of every pass
         check_len("h", self.h.len(), 6 * t)?;
         check_len("q", self.q.len(), m.nq * t)?;
@@ -137,10 +141,13 @@ struct BlockBuilder<'a> {
     p: &'a MomentumProblem<'a>,
     d: Data,
     qbuf: Vec<f64>,
-    /// the four-sample sweep, if the model is of its kind (then four samples at a time go through `fill4`), and
-    /// its configuration buffers
+    /// the four-sample sweep, if the model is of its kind (then four samples at a time go through `fill_lanes`)
     kin: Option<Kin4>,
-    qbufs: [Vec<f64>; LANES],
+    /// the eight-sample sweep, if the model is of its kind and the processor runs AVX-512 ([`avx512_lanes`]):
+    /// then eight samples at a time go through `fill_lanes`, compiled for AVX-512 (`fill_groups_avx512`)
+    kin8: Option<Kin<8>>,
+    /// the configuration buffers of the samples of one sweep
+    qbufs: [Vec<f64>; 8],
     block: DMatrix<f64>,
     /// entry (row, block column) of the block is at `row·strides.0 + column·strides.1` of its storage
     strides: (usize, usize),
@@ -152,7 +159,7 @@ struct BlockBuilder<'a> {
     bodies: Vec<BodyColumns>,
     sw: [f64; 6],
     /// v and h of the samples being streamed are known to be finite (one scan per range in `run`): the per-sample
-    /// checks of `fill` and `fill4` are left to a range that has a non-finite entry, where they name it
+    /// checks of `fill` and `fill_lanes` are left to a range that has a non-finite entry, where they name it
     vh_finite: bool,
 }
 
@@ -170,7 +177,7 @@ struct BodyColumns {
     kept_angular: Vec<(usize, usize)>,
     /// (column k of the body, parameter) of the known, nonzero standard parameters (moved to the right-hand side)
     known: Vec<(usize, f64)>,
-    /// bit k set: column k is used (kept or known), the columns `fill4` forms
+    /// bit k set: column k is used (kept or known), the columns `fill_lanes` forms
     need: u16,
 }
 
@@ -204,7 +211,7 @@ impl<'a> BlockBuilder<'a> {
             .filter(|b| !b.kept.is_empty() || !b.kept_angular.is_empty() || !b.known.is_empty())
             .collect();
         let sw = p.weights.map_or([1.0; 6], |w| w.map(f64::sqrt));
-        // every block column written lies inside the block (what `fill4`'s unchecked stores rely on)
+        // every block column written lies inside the block (what `fill_lanes`'s unchecked stores rely on)
         let (rs, cs) = strides;
         let last = |j: usize| (6 * block_samples - 1) * rs + j * cs;
         let cols = bodies.iter().flat_map(|b| b.kept.iter().chain(&b.kept_angular).map(|&(_, j)| j));
@@ -214,6 +221,7 @@ impl<'a> BlockBuilder<'a> {
             m,
             p,
             kin: Kin4::for_model(m, &d),
+            kin8: if avx512_lanes() { Kin::for_model(m, &d) } else { None },
             d,
             qbuf: Vec::new(),
             qbufs: Default::default(),
@@ -277,50 +285,56 @@ impl<'a> BlockBuilder<'a> {
         Ok(())
     }
 
-    /// [`fill`](Self::fill) for the four samples s..s+4 at slots slot..slot+4: their kinematics and regressor
-    /// columns side by side, one sample per lane ([`Kin4`], [`momentum_columns_into`]), every entry the same to the bit
-    /// as `fill` would write it (the same operations in the same order, lane by lane). Four samples per step cost
+    /// [`fill`](Self::fill) for the L samples s..s+L at slots slot..slot+L: their kinematics and regressor
+    /// columns side by side, one sample per lane ([`Kin`], [`momentum_columns_into`]), every entry the same to the
+    /// bit as `fill` would write it (the same operations in the same order, lane by lane). Four samples per step cost
     /// less than half the instructions of four one-sample steps (11 982 → 5 570 per sample in `identify_profile
-    /// pass`, callgrind).
-    fn fill4(&mut self, s: usize, slot: usize, cnt: usize) -> Result<()> {
+    /// pass`, callgrind). Inlined, so that the eight-lane copy is compiled for AVX-512 in `fill_groups_avx512`.
+    #[inline(always)]
+    fn fill_lanes<const L: usize>(&mut self, kin: &mut Kin<L>, s: usize, slot: usize, cnt: usize) -> Result<()> {
         let (m, p) = (self.m, self.p);
-        let Some(kin) = self.kin.as_mut() else { unreachable!("fill4 runs only with the four-sample sweep") };
         let (nq, nv) = (m.nq, m.nv);
         let vh_finite = self.vh_finite;
-        let [b0, b1, b2, b3] = &mut self.qbufs;
-        let v: [&[f64]; LANES] = std::array::from_fn(|l| &p.v[(s + l) * nv..(s + l + 1) * nv]);
         // each sample's q (size, finite, unit quaternions), v and h (finite), in sample order as `fill` checks them
         let check = |l: usize, buf| {
             let q = m.checked_q(&p.q[(s + l) * nq..(s + l + 1) * nq], buf);
             let vh = |q| if vh_finite { Ok(q) } else { vh_finite_at(p, nv, s + l).map(|_| q) };
             q.and_then(vh).map_err(|e| at_sample(e, s + l))
         };
-        let q = [check(0, b0)?, check(1, b1)?, check(2, b2)?, check(3, b3)?];
+        // (loops rather than `std::array::from_fn`, which with eight lanes stayed a call: see `Lanes::from_fn`)
+        let (mut q, mut v): ([&[f64]; L], [&[f64]; L]) = ([&[]; L], [&[]; L]);
+        for (l, (ql, buf)) in q.iter_mut().zip(&mut self.qbufs).enumerate() {
+            *ql = check(l, buf)?;
+            v[l] = &p.v[(s + l) * nv..(s + l + 1) * nv];
+        }
         kin.run(m, &mut self.d, q, v);
-        assert!(slot + LANES <= cnt && cnt <= self.block_samples);
+        assert!(slot + L <= cnt && cnt <= self.block_samples);
         let bs = self.block.as_mut_slice();
         let (rs, cs) = self.strides;
-        let sw: [F4; 6] = self.sw.map(F4::splat);
+        let sw = [0, 1, 2, 3, 4, 5].map(|r| Lanes::<L>::splat(self.sw[r]));
         // SAFETY: every store below is at `row[l][r] + j·cs` with a row below 6·cnt ≤ 6·block_samples (asserted just
         // above) and j a block column (a slot of `bodies` or `y_col`, checked against the block's width in `new`):
         // inside the block, which `new` sized for exactly that. The bounds checks cost about a sixth of the pass
         // (callgrind), one store being a load, an add and the check.
         let mut put = |at: usize, x: f64| unsafe { *bs.get_unchecked_mut(at) = x };
         // where each lane's six rows start: linear rows at 3·slot.., angular rows at 3·cnt + 3·slot.. (see `fill`)
-        let row: [[usize; 6]; LANES] = std::array::from_fn(|l| {
-            std::array::from_fn(|r| if r < 3 { 3 * (slot + l) + r } else { 3 * cnt + 3 * (slot + l) + r - 3 } * rs)
-        });
-        let mut y: [F4; 6] = std::array::from_fn(|r| F4::from_fn(|l| p.h[6 * (s + l) + r]));
+        let mut row = [[0; 6]; L];
+        for (l, row) in row.iter_mut().enumerate() {
+            for (r, at) in row.iter_mut().enumerate() {
+                *at = if r < 3 { 3 * (slot + l) + r } else { 3 * cnt + 3 * (slot + l) + r - 3 } * rs;
+            }
+        }
+        let mut y = [0, 1, 2, 3, 4, 5].map(|r| Lanes::<L>::from_fn(|l| p.h[6 * (s + l) + r]));
         // one buffer for every body: each body reads only the columns it has just written (its `need`)
-        let mut cols = [[F4::splat(0.0); 6]; 10];
+        let mut cols = [[Lanes::splat(0.0); 6]; 10];
         for b in &self.bodies {
             let i = b.body;
             momentum_columns_into(&mut cols, &kin.rot[i], &kin.pos[i], &kin.lin[i], &kin.ang[i], b.need);
-            // weighted four lanes at once (the same product per lane as `fill`), then one store per lane
+            // weighted L lanes at once (the same product per lane as `fill`), then one store per lane
             for &(k, j) in &b.kept {
                 for r in 0..6 {
                     let x = sw[r] * cols[k][r];
-                    for l in 0..LANES {
+                    for l in 0..L {
                         put(row[l][r] + j * cs, x.0[l]);
                     }
                 }
@@ -328,25 +342,78 @@ impl<'a> BlockBuilder<'a> {
             for &(k, j) in &b.kept_angular {
                 for r in 3..6 {
                     let x = sw[r] * cols[k][r];
-                    for l in 0..LANES {
+                    for l in 0..L {
                         put(row[l][r] + j * cs, x.0[l]);
                     }
                 }
             }
             for &(k, pk) in &b.known {
                 for r in 0..6 {
-                    y[r] = y[r] - cols[k][r] * F4::splat(pk);
+                    y[r] = y[r] - cols[k][r] * Lanes::splat(pk);
                 }
             }
         }
         let j = self.y_col;
         for r in 0..6 {
             let x = sw[r] * y[r];
-            for l in 0..LANES {
+            for l in 0..L {
                 put(row[l][r] + j * cs, x.0[l]);
             }
         }
         Ok(())
+    }
+
+    /// The samples s+slot.. of a block of `cnt` through [`fill_lanes`](Self::fill_lanes), L at a time while L
+    /// remain; the first slot left.
+    #[inline(always)]
+    fn fill_groups<const L: usize>(
+        &mut self,
+        kin: &mut Kin<L>,
+        s: usize,
+        mut slot: usize,
+        cnt: usize,
+    ) -> Result<usize> {
+        while slot + L <= cnt {
+            self.fill_lanes(kin, s + slot, slot, cnt)?;
+            slot += L;
+        }
+        Ok(slot)
+    }
+
+    /// [`fill_groups`](Self::fill_groups) with eight lanes, compiled for AVX-512 (one register per [`Lanes<8>`]):
+    /// half the sweeps of four-lane groups, each about as many instructions. `identify_profile identify` (67,000
+    /// samples of naveen_dual_arm, 2 cores, AMD Zen 5): 1149 → 982 ms process CPU per 40 runs (−15 %, median of 5
+    /// interleaved pairs, `perf stat -e task-clock`), same checksum.
+    ///
+    /// # Safety
+    /// The processor must have AVX-512F, VL and DQ ([`avx512_lanes`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
+    unsafe fn fill_groups_avx512(&mut self, kin: &mut Kin<8>, s: usize, cnt: usize) -> Result<usize> {
+        self.fill_groups(kin, s, 0, cnt)
+    }
+
+    /// The samples of the block s..s+cnt that go through a many-sample sweep: eight at a time where the processor
+    /// runs AVX-512, then four; the first slot left for [`fill`](Self::fill).
+    fn fill_block_lanes(&mut self, s: usize, cnt: usize) -> Result<usize> {
+        let mut slot = 0;
+        // each sweep is taken out of `self` for its pass (its samples are written into `self.block`) and put back
+        if let Some(mut kin) = self.kin8.take() {
+            // SAFETY: `kin8` is built only where `avx512_lanes()` found AVX-512F, VL and DQ (see `new`).
+            #[cfg(target_arch = "x86_64")]
+            let r = unsafe { self.fill_groups_avx512(&mut kin, s, cnt) };
+            // (elsewhere `kin8` is never built; the generic body keeps the field in use for the compiler)
+            #[cfg(not(target_arch = "x86_64"))]
+            let r = self.fill_groups(&mut kin, s, 0, cnt);
+            self.kin8 = Some(kin);
+            slot = r?;
+        }
+        if let Some(mut kin) = self.kin.take() {
+            let r = self.fill_groups(&mut kin, s, slot, cnt);
+            self.kin = Some(kin);
+            slot = r?;
+        }
+        Ok(slot)
     }
 
     /// Stream samples `range` block by block into `feed(block, rows)`.
@@ -367,13 +434,7 @@ impl<'a> BlockBuilder<'a> {
                 return Err(FfError::interrupted(format!("identification stopped after {s} samples of a pass")));
             }
             let cnt = self.block_samples.min(range.end - s);
-            let mut slot = 0;
-            if self.kin.is_some() {
-                while slot + LANES <= cnt {
-                    self.fill4(s + slot, slot, cnt)?;
-                    slot += LANES;
-                }
-            }
+            let slot = self.fill_block_lanes(s, cnt)?;
             for slot in slot..cnt {
                 self.fill(s + slot, slot, cnt)?;
             }
@@ -427,7 +488,21 @@ impl SplitGram {
     }
 }
 
-/// v and h of sample s are finite (the per-sample check of `fill` and `fill4`, for a range whose one scan in `run`
+/// Whether the block builder's eight-sample sweep runs (compiled for AVX-512F, VL and DQ): where the Gram pass takes
+/// its AVX-512 kernel ([`super::gram::avx512`], which `FREEFLOAT_NO_AVX512` turns off) and the processor also has
+/// VL and DQ. Decided once per process.
+fn avx512_lanes() -> bool {
+    static USE: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *USE.get_or_init(|| {
+        #[cfg(target_arch = "x86_64")]
+        let has = std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("avx512dq");
+        #[cfg(not(target_arch = "x86_64"))]
+        let has = false;
+        has && super::gram::avx512()
+    })
+}
+
+/// v and h of sample s are finite (the per-sample check of `fill` and `fill_lanes`, for a range whose one scan in `run`
 /// found a non-finite entry).
 fn vh_finite_at(p: &MomentumProblem, nv: usize, s: usize) -> Result<()> {
     check_finite("v", &p.v[s * nv..(s + 1) * nv]).and_then(|_| check_finite("h", &p.h[6 * s..6 * s + 6]))
@@ -566,7 +641,11 @@ pub fn identify_momentum_interruptible(
         let mut g = grams.next().expect("one thread");
         grams.for_each(|o| g.merge(&o));
         if let Some(f) = g.factor().filter(|f| f.kappa_scaled <= GRAM_KAPPA_MAX) {
-            check_rank(&f.r)?;
+            // No rank check here: κ_s ≤ GRAM_KAPPA_MAX puts the smallest singular value of the equilibrated factor
+            // at ≥ 1e-5 of the largest, and `check_rank` judges that same matrix (R with unit columns, equal to
+            // `factor`'s to round-off) against RANK_RTOL = 1e-11: it cannot fail, and its SVD with singular vectors
+            // was a serial 0.1 ms after the parallel pass. A rank-deficient problem fails the Cholesky or the κ
+            // test and goes to the QR pass, which checks.
             if f.kappa_scaled <= GRAM_DIRECT_KAPPA_MAX {
                 let (rss, yty) = g.rss_at(&f.x);
                 if rss * GRAM_DIRECT_RSS_RTOL >= n as f64 * f64::EPSILON * yty {
@@ -718,9 +797,10 @@ mod tests {
     }
 
     #[test]
-    fn four_samples_side_by_side_fill_a_block_as_one_at_a_time_does() {
-        // `fill4` against `fill` on the same samples, every entry of the block to the bit: both layouts, known
-        // bodies moved to the right-hand side, weights, a robot with a fixed joint (the captured target).
+    fn samples_side_by_side_fill_a_block_as_one_at_a_time_does() {
+        // `fill_lanes` against `fill` on the same samples, every entry of the block to the bit: both layouts, known
+        // bodies moved to the right-hand side, weights, a robot with a fixed joint (the captured target); four
+        // lanes, eight compiled for the baseline, and eight compiled for AVX-512 where the processor has it.
         for name in ["naveen_dual_arm", "zhang2020_3d"] {
             let m = builtin::load(name).unwrap();
             let t = 64;
@@ -728,20 +808,35 @@ mod tests {
             let p = case.problem();
             for layout in [Layout::Rows, Layout::Columns] {
                 let mut bb = BlockBuilder::new(&m, &p, layout);
-                assert!(bb.kin.is_some(), "{name}: no four-sample sweep");
+                let (Some(mut kin4), Some(mut kin8)) = (bb.kin.take(), Kin::<8>::for_model(&m, &bb.d)) else {
+                    panic!("{name}: no many-sample sweep")
+                };
+                assert_eq!(bb.kin8.is_some(), avx512_lanes());
                 let cnt = bb.block_samples;
                 for start in [0, t - cnt] {
-                    for g in 0..cnt / LANES {
-                        bb.fill4(start + LANES * g, LANES * g, cnt).unwrap();
-                    }
-                    let lanes = bb.block.clone();
                     bb.block.fill(0.0);
                     for slot in 0..cnt {
                         bb.fill(start + slot, slot, cnt).unwrap();
                     }
-                    assert!(lanes.iter().any(|x| *x != 0.0));
-                    for (a, b) in lanes.iter().zip(bb.block.iter()) {
-                        assert_eq!(a.to_bits(), b.to_bits(), "{name} {layout:?}");
+                    let one = bb.block.clone();
+                    assert!(one.iter().any(|x| *x != 0.0));
+                    // the AVX-512 way only where the processor has it
+                    let ways = if avx512_lanes() { 3 } else { 2 };
+                    for way in ["4 lanes", "8 lanes", "8 lanes, AVX-512"].into_iter().take(ways) {
+                        bb.block.fill(0.0);
+                        let filled = match way {
+                            "4 lanes" => bb.fill_groups(&mut kin4, start, 0, cnt),
+                            "8 lanes" => bb.fill_groups(&mut kin8, start, 0, cnt),
+                            // SAFETY: `avx512_lanes()` found AVX-512F, VL and DQ (`ways`).
+                            #[cfg(target_arch = "x86_64")]
+                            _ => unsafe { bb.fill_groups_avx512(&mut kin8, start, cnt) },
+                            #[cfg(not(target_arch = "x86_64"))]
+                            _ => unreachable!(),
+                        };
+                        assert_eq!(filled.unwrap(), cnt, "{way}");
+                        for (a, b) in bb.block.iter().zip(one.iter()) {
+                            assert_eq!(a.to_bits(), b.to_bits(), "{name} {layout:?} {way}");
+                        }
                     }
                 }
             }

@@ -1,7 +1,8 @@
-//! Body placements and twists of four samples at once (one sample per lane of [`F4`]), for passes over many
-//! independent samples: the identification's regressor stream. Written for the robots identification is about,
+//! Body placements and twists of L samples at once (one sample per lane of [`Lanes<L>`]; four, or eight in code
+//! compiled for AVX-512), for passes over many independent samples: the identification's regressor stream.
+//! Written for the robots identification is about,
 //! a base joint at the root (free, planar or fixed) and, elsewhere, revolute joints about a principal axis of
-//! their frame and fixed joints (a captured target); [`Kin4::for_model`] says `None` for any other model, whose
+//! their frame and fixed joints (a captured target); [`Kin::for_model`] says `None` for any other model, whose
 //! callers take the one-sample path.
 //!
 //! Every lane's result is, bit for bit, what `forward_velocities_unchecked` gives for that sample: the same
@@ -11,12 +12,12 @@
 use super::fk::{joint_placement_at, joint_velocity};
 use crate::data::Data;
 use crate::model::{JointType, Model};
-use crate::spatial::lanes::{cross, mat_t_vec, Real, Vec3, F4, LANES};
+use crate::spatial::lanes::{cross, mat_t_vec, Lanes, Real, Vec3, LANES};
 use crate::spatial::so3::quat_rotation_rows;
-use crate::spatial::trig::sin_cos4;
+use crate::spatial::trig::sin_cos_lanes;
 use crate::spatial::M6;
 
-/// A joint away from the root, as the four-sample sweep uses it.
+/// A joint away from the root, as the L-sample sweep uses it.
 struct Joint {
     body: usize,
     parent: usize,
@@ -33,15 +34,15 @@ struct Joint {
     axis: [f64; 3],
 }
 
-/// Placements (inertial frame) and body-frame twists of every body for four samples.
-pub(crate) struct Kin4 {
+/// Placements (inertial frame) and body-frame twists of every body for L samples.
+pub(crate) struct Kin<const L: usize> {
     /// per body: the columns of its rotation, its origin, its body-frame linear and angular velocity
-    pub rot: Vec<[Vec3<F4>; 3]>,
-    pub pos: Vec<Vec3<F4>>,
-    pub lin: Vec<Vec3<F4>>,
-    pub ang: Vec<Vec3<F4>>,
+    pub rot: Vec<[Vec3<Lanes<L>>; 3]>,
+    pub pos: Vec<Vec3<Lanes<L>>>,
+    pub lin: Vec<Vec3<Lanes<L>>>,
+    pub ang: Vec<Vec3<Lanes<L>>>,
     joints: Vec<Joint>,
-    /// a free root, in four lanes too; `None`: another base joint, placed by the one-sample code lane by lane
+    /// a free root, in L lanes too; `None`: another base joint, placed by the one-sample code lane by lane
     free_root: Option<FreeRoot>,
 }
 
@@ -55,10 +56,13 @@ struct FreeRoot {
     s: [[f64; 6]; 6],
 }
 
-impl Kin4 {
+/// The four-sample sweep (the x86-64-v3 width).
+pub(crate) type Kin4 = Kin<LANES>;
+
+impl<const L: usize> Kin<L> {
     /// The sweep for `m`, or `None` if `m` is not of the kind it handles (see the module's text). `d`: a `Data`
     /// of `m`, whose fixed joint subspaces give the revolute axes.
-    pub fn for_model(m: &Model, d: &Data) -> Option<Kin4> {
+    pub fn for_model(m: &Model, d: &Data) -> Option<Self> {
         let n = m.nbodies();
         if n == 0 || m.parents[0].is_some() || !m.joint_types[0].is_base() {
             return None;
@@ -94,28 +98,34 @@ impl Kin4 {
                 s: std::array::from_fn(|c| std::array::from_fn(|r| d.s[0][(r, c)])),
             }
         });
-        let z = [F4::splat(0.0); 3];
-        Some(Kin4 { rot: vec![[z; 3]; n], pos: vec![z; n], lin: vec![z; n], ang: vec![z; n], joints, free_root })
+        let z = [Lanes::splat(0.0); 3];
+        Some(Kin { rot: vec![[z; 3]; n], pos: vec![z; n], lin: vec![z; n], ang: vec![z; n], joints, free_root })
     }
 
-    /// The placements and twists of the four samples `(q[l], v[l])` (checked: sizes, finite, unit quaternions).
+    /// The placements and twists of the L samples `(q[l], v[l])` (checked: sizes, finite, unit quaternions).
     /// `d` is the model's `Data`, used for the root lane by lane (its placements and twists are left changed).
-    pub fn run(&mut self, m: &Model, d: &mut Data, q: [&[f64]; LANES], v: [&[f64]; LANES]) {
-        let zero = F4::splat(0.0);
+    /// Inlined into its caller, so that the eight-lane sweep is compiled with the AVX-512 caller's registers.
+    #[inline(always)]
+    pub fn run(&mut self, m: &Model, d: &mut Data, q: [&[f64]; L], v: [&[f64]; L]) {
+        let zero = Lanes::splat(0.0);
         if let Some(r) = &self.free_root {
             // a free root: its joint transform (`JointType::transform`: the quaternion's rotation, the position)
             // placed by the root frame (`Se3::compose`), its twist S v (`joint_velocity`'s sums, from zero)
-            let qq = |k: usize| F4::from_fn(|l| q[l][r.iq + k]);
+            let qq = |k: usize| Lanes::from_fn(|l| q[l][r.iq + k]);
             let rq = quat_rotation_rows(qq(3), qq(4), qq(5), qq(6));
-            let pr = r.rot.map(|c| c.map(F4::splat));
+            let pr = splat33(&r.rot);
             let col = |c: usize| [rq[0][c], rq[1][c], rq[2][c]];
-            self.rot[0] = [0, 1, 2].map(|c| rotate_add(&pr, &col(c), [zero; 3]));
-            self.pos[0] = rotate_add(&pr, &[qq(0), qq(1), qq(2)], r.trans.map(F4::splat));
-            let vv: [F4; 6] = std::array::from_fn(|c| F4::from_fn(|l| v[l][r.iv + c]));
+            self.rot[0] = [
+                rotate_add(&pr, &col(0), [zero; 3]),
+                rotate_add(&pr, &col(1), [zero; 3]),
+                rotate_add(&pr, &col(2), [zero; 3]),
+            ];
+            self.pos[0] = rotate_add(&pr, &[qq(0), qq(1), qq(2)], splat3(&r.trans));
+            let vv = [0, 1, 2, 3, 4, 5].map(|c| Lanes::<L>::from_fn(|l| v[l][r.iv + c]));
             let mut tw = [zero; 6];
             for c in 0..6 {
                 for (row, t) in tw.iter_mut().enumerate() {
-                    *t = *t + F4::splat(r.s[c][row]) * vv[c];
+                    *t = *t + Lanes::splat(r.s[c][row]) * vv[c];
                 }
             }
             self.lin[0] = [tw[0], tw[1], tw[2]];
@@ -123,7 +133,7 @@ impl Kin4 {
         }
         if self.free_root.is_none() {
             // another base joint: the one-sample code, lane by lane (it is one body of many)
-            for l in 0..LANES {
+            for l in 0..L {
                 let x = joint_placement_at(m, &mut d.s[0], 0, q[l], [0.0, 1.0]);
                 let vj = joint_velocity(m, d, 0, v[l]);
                 for a in 0..3 {
@@ -139,39 +149,58 @@ impl Kin4 {
         for j in &self.joints {
             // the joint in its parent: a revolute one turns the placement's columns a, b by the angle about eₖ
             // (`rotate_about_principal_axis`: a c + b s and b c − a s, one fused multiply-add each)
-            let mut lr = j.rot.map(|col| col.map(F4::splat));
-            let mut qd = F4::splat(0.0);
+            let mut lr = splat33(&j.rot);
+            let mut qd = Lanes::splat(0.0);
             if let Some((ca, cb)) = j.turns {
-                let (s, c) = sin_cos4(std::array::from_fn(|l| q[l][j.iq]));
-                let (s, c) = (F4(s), F4(c));
+                let (s, c) = sin_cos_lanes(Lanes::<L>::from_fn(|l| q[l][j.iq]).0);
+                let (s, c) = (Lanes(s), Lanes(c));
                 for row in 0..3 {
-                    let (a, b) = (F4::splat(j.rot[ca][row]), F4::splat(j.rot[cb][row]));
+                    let (a, b) = (Lanes::splat(j.rot[ca][row]), Lanes::splat(j.rot[cb][row]));
                     lr[ca][row] = a.mul_add(c, b * s);
                     lr[cb][row] = b.mul_add(c, -(a * s));
                 }
-                qd = F4::from_fn(|l| v[l][j.iv]);
+                qd = Lanes::from_fn(|l| v[l][j.iv]);
             }
             // placement in the inertial frame: the parent's composed with the joint's (`Se3::compose`)
             let (rp, tp) = (self.rot[j.parent], self.pos[j.parent]);
-            self.rot[j.body] = [0, 1, 2].map(|c| rotate_add(&rp, &lr[c], [zero; 3]));
-            self.pos[j.body] = rotate_add(&rp, &j.trans.map(F4::splat), tp);
+            self.rot[j.body] = [
+                rotate_add(&rp, &lr[0], [zero; 3]),
+                rotate_add(&rp, &lr[1], [zero; 3]),
+                rotate_add(&rp, &lr[2], [zero; 3]),
+            ];
+            self.pos[j.body] = rotate_add(&rp, &splat3(&j.trans), tp);
             // body twist: the parent's carried into the joint frame (`Se3::inv_act_motion`), plus the joint's
             // [0; axis q̇] (`joint_velocity`; a fixed joint's is zero, added as 0 · 0 here and as a zero twist there)
             let (vp, wp) = (self.lin[j.parent], self.ang[j.parent]);
-            let t = j.trans.map(F4::splat);
+            let t = splat3(&j.trans);
             let tw = cross(&t, &wp);
             let lin = mat_t_vec(&lr, &[vp[0] - tw[0], vp[1] - tw[1], vp[2] - tw[2]]);
             let ang = mat_t_vec(&lr, &wp);
             self.lin[j.body] = [lin[0] + zero, lin[1] + zero, lin[2] + zero];
-            self.ang[j.body] = std::array::from_fn(|a| ang[a] + F4::splat(j.axis[a]) * qd);
+            let joint = |a: usize| ang[a] + Lanes::splat(j.axis[a]) * qd;
+            self.ang[j.body] = [joint(0), joint(1), joint(2)];
         }
     }
 }
 
 /// `R x + b` for R by its columns, as `Se3::compose` sums it: `r₂ x₂ + (r₁ x₁ + (r₀ x₀ + b))`, fused.
 #[inline(always)]
-fn rotate_add(r: &[Vec3<F4>; 3], x: &Vec3<F4>, b: Vec3<F4>) -> Vec3<F4> {
-    std::array::from_fn(|a| r[2][a].mul_add(x[2], r[1][a].mul_add(x[1], r[0][a].mul_add(x[0], b[a]))))
+fn rotate_add<T: Real>(r: &[Vec3<T>; 3], x: &Vec3<T>, b: Vec3<T>) -> Vec3<T> {
+    // written out, not `std::array::from_fn` (as `lanes::mat_vec`): with eight lanes that stayed a call
+    let row = |a: usize| r[2][a].mul_add(x[2], r[1][a].mul_add(x[1], r[0][a].mul_add(x[0], b[a])));
+    [row(0), row(1), row(2)]
+}
+
+/// `x` in every lane, entry by entry (written out for the reason of `rotate_add`).
+#[inline(always)]
+fn splat3<T: Real>(x: &[f64; 3]) -> Vec3<T> {
+    [T::splat(x[0]), T::splat(x[1]), T::splat(x[2])]
+}
+
+/// [`splat3`] of every column.
+#[inline(always)]
+fn splat33<T: Real>(x: &[[f64; 3]; 3]) -> [Vec3<T>; 3] {
+    [splat3(&x[0]), splat3(&x[1]), splat3(&x[2])]
 }
 
 #[cfg(test)]
@@ -186,11 +215,18 @@ mod tests {
 
     #[test]
     fn every_lane_is_the_one_sample_sweep_bit_for_bit() {
+        // four lanes (the x86-64-v3 width) and eight (the AVX-512 width, here compiled for the baseline: the same
+        // operations, so the same bits; the identification's test runs the AVX-512-compiled sweep)
+        every_lane::<4>();
+        every_lane::<8>();
+    }
+
+    fn every_lane<const L: usize>() {
         let (mut handled, mut declined) = (Vec::new(), Vec::new());
         for name in builtin::names() {
             let m = builtin::load(name).unwrap();
             let mut d = Data::new(&m);
-            let Some(mut kin) = Kin4::for_model(&m, &d) else {
+            let Some(mut kin) = Kin::<L>::for_model(&m, &d) else {
                 // declined only for a joint other than a principal-axis revolute one away from the root
                 let other = |i: usize| match m.joint_types[i] {
                     JointType::Revolute => m.principal_revolute()[i].is_none(),
@@ -202,10 +238,10 @@ mod tests {
             };
             handled.push(name);
             for round in 0..50 {
-                let qs: Vec<Vec<f64>> = (0..LANES)
+                let qs: Vec<Vec<f64>> = (0..L)
                     .map(|l| {
                         let mut q = m.neutral();
-                        q.iter_mut().enumerate().for_each(|(k, x)| *x += 4.0 * mix(round * 4 + l, k));
+                        q.iter_mut().enumerate().for_each(|(k, x)| *x += 4.0 * mix(round * L + l, k));
                         for &(_, o) in m.quaternions() {
                             let nrm = q[o..o + 4].iter().map(|x| x * x).sum::<f64>().sqrt();
                             q[o..o + 4].iter_mut().for_each(|x| *x /= nrm);
@@ -214,9 +250,9 @@ mod tests {
                     })
                     .collect();
                 let vs: Vec<Vec<f64>> =
-                    (0..LANES).map(|l| (0..m.nv).map(|k| 3.0 * mix(round * 4 + l + 7, k)).collect()).collect();
+                    (0..L).map(|l| (0..m.nv).map(|k| 3.0 * mix(round * L + l + 7, k)).collect()).collect();
                 kin.run(&m, &mut d, std::array::from_fn(|l| &qs[l][..]), std::array::from_fn(|l| &vs[l][..]));
-                for l in 0..LANES {
+                for l in 0..L {
                     forward_velocities_unchecked(&m, &mut d, &qs[l], &vs[l]);
                     for b in 0..m.nbodies() {
                         for a in 0..3 {

@@ -17,7 +17,7 @@ pub(crate) use fk::{
 };
 pub(crate) use jacobian::jacobian_from_data;
 pub use jacobian::{frame_jacobian, frame_placement, generalized_jacobian, Reference};
-pub(crate) use lanes::Kin4;
+pub(crate) use lanes::{Kin, Kin4};
 pub use momentum::{
     centroidal_momentum_matrix, kinetic_energy, kinetic_energy_from_data, momentum, momentum_from_data,
     world_composite_inertias, world_motion_subspaces,

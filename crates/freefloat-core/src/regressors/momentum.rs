@@ -75,7 +75,7 @@ pub(crate) fn body_momentum_columns(d: &Data, i: usize) -> [[f64; 6]; 10] {
 
 /// The ten momentum-regressor columns of a body with rotation R (columns `r`), origin `p` and body-frame twist
 /// `(vb, wb)`, all inertial-frame but the twist: the one copy of Naveen, Shah, Misra's eq. 10, for one sample
-/// (`f64`) or four side by side (`F4`, the identification's stream), with the same operations in the same order
+/// (`f64`) or four or eight side by side (`Lanes<L>`, the identification's stream), with the same operations in the same order
 /// (nalgebra's, which this replaced: the results did not change by a bit).
 #[inline(always)]
 pub(crate) fn momentum_columns<T: Real>(r: &[Vec3<T>; 3], p: &Vec3<T>, vb: &Vec3<T>, wb: &Vec3<T>) -> [[T; 6]; 10] {

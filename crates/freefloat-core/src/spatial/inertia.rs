@@ -1,4 +1,4 @@
-use super::lanes::{Real, F4};
+use super::lanes::{Lanes, Real, F4};
 use super::{cross_fma, skew, Force, Motion, Se3, M3, M6, V3};
 
 /// Rigid-body inertia in the parameters the whole project uses (ARCHITECTURE.md): mass, first
@@ -134,11 +134,11 @@ impl Inertia {
         // entry-by-entry form: ABA forms one per body, 48,107 → 47,257 instructions per RK4 step of `sim10s_table`
         // (callgrind).
         let (r, io, m) = (&x.rot, &self.i_o, self.mass);
-        let col = |k: usize| F4([r[(0, k)], r[(1, k)], r[(2, k)], 0.0]);
+        let col = |k: usize| Lanes([r[(0, k)], r[(1, k)], r[(2, k)], 0.0]);
         let (r0, r1, r2) = (col(0), col(1), col(2));
         let s = F4::splat;
         let pa = [x.trans.x, x.trans.y, x.trans.z];
-        let p = F4([pa[0], pa[1], pa[2], 0.0]);
+        let p = Lanes([pa[0], pa[1], pa[2], 0.0]);
         // h_r = R h, h' = h_r + m p
         let h_r = r2.mul_add(s(self.h.z), r1.mul_add(s(self.h.y), r0 * s(self.h.x)));
         let hp = p.mul_add(s(m), h_r);

@@ -70,19 +70,27 @@ pub fn sin_cos(x: f64) -> (f64, f64) {
 /// lanes went to the stack and back (10-body RK4 `sim10s_table`: CPU time −5 %, median of 31 interleaved runs).
 #[inline(always)]
 pub fn sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
-    let mut k = [0.0; LANES];
+    sin_cos_lanes(x)
+}
+
+/// [`sin_cos4`] for L angles (L = 8 fills an AVX-512 register where the caller is compiled for AVX-512): the same
+/// operations in every lane, so lane l equals `sin_cos` of angle l to the bit, whatever L. Inlined into its caller
+/// so that it is compiled with the caller's target features.
+#[inline(always)]
+pub fn sin_cos_lanes<const L: usize>(x: [f64; L]) -> ([f64; L], [f64; L]) {
+    let mut k = [0.0; L];
     let mut in_range = true;
-    for l in 0..LANES {
+    for l in 0..L {
         // `abs() <= LIMIT` is false for NaN, so non-finite angles take the library path too
         in_range &= x[l].abs() <= LIMIT;
         k[l] = (x[l] * FRAC_2_PI).round_ties_even();
     }
     if !in_range {
-        return library_sin_cos4(x);
+        return library_sin_cos(x);
     }
     // r = x − k π/2 as r_hi + r_lo
-    let (mut r_hi, mut r_lo) = ([0.0; LANES], [0.0; LANES]);
-    for l in 0..LANES {
+    let (mut r_hi, mut r_lo) = ([0.0; L], [0.0; L]);
+    for l in 0..L {
         // r1 = x − k P1 is exact (module comment), k P2 = t_hi + t_lo exactly, and r1 − t_hi = hi + err exactly
         // (Knuth's two-sum: near a multiple of π/2, |r1| can be below |t_hi|)
         let r1 = (-k[l]).mul_add(P1, x[l]);
@@ -94,8 +102,8 @@ pub fn sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
         r_hi[l] = hi;
         r_lo[l] = (err - t_lo) - k[l] * P3;
     }
-    let (mut s, mut c) = ([0.0; LANES], [0.0; LANES]);
-    for l in 0..LANES {
+    let (mut s, mut c) = ([0.0; L], [0.0; L]);
+    for l in 0..L {
         let (h, lo) = (r_hi[l], r_lo[l]);
         let z = h * h;
         let mut ps = S[7];
@@ -116,8 +124,8 @@ pub fn sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
         c[l] = w + tail_c;
     }
     // quadrant m = k mod 4: (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s)
-    let (mut sin, mut cos) = ([0.0; LANES], [0.0; LANES]);
-    for l in 0..LANES {
+    let (mut sin, mut cos) = ([0.0; L], [0.0; L]);
+    for l in 0..L {
         let m = k[l] - 4.0 * (0.25 * k[l]).floor();
         let swap = m == 1.0 || m == 3.0;
         let (a, b) = if swap { (c[l], s[l]) } else { (s[l], c[l]) };
@@ -128,9 +136,9 @@ pub fn sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
 }
 
 #[cold]
-fn library_sin_cos4(x: [f64; LANES]) -> ([f64; LANES], [f64; LANES]) {
-    let (mut s, mut c) = ([0.0; LANES], [0.0; LANES]);
-    for l in 0..LANES {
+fn library_sin_cos<const L: usize>(x: [f64; L]) -> ([f64; L], [f64; L]) {
+    let (mut s, mut c) = ([0.0; L], [0.0; L]);
+    for l in 0..L {
         // the in-range lanes must not change with their neighbours: they take the routine, one lane at a time
         (s[l], c[l]) = if x[l].abs() <= LIMIT { sin_cos(x[l]) } else { x[l].sin_cos() };
     }
@@ -173,6 +181,15 @@ mod tests {
                 worst = worst.max(d);
                 differ += usize::from(d > 0);
                 count += 1;
+            }
+        }
+        // eight lanes (the AVX-512 width): every lane the single call's bits
+        for chunk in xs.chunks(8) {
+            let mut lane = [0.0; 8];
+            lane[..chunk.len()].copy_from_slice(chunk);
+            let (s, c) = sin_cos_lanes(lane);
+            for (l, &x) in chunk.iter().enumerate() {
+                assert_eq!(sin_cos(x), (s[l], c[l]), "lane {l} of eight, {x:e}");
             }
         }
         (worst, differ, count)
@@ -226,5 +243,9 @@ mod tests {
         assert!(s[1].is_nan() && c[1].is_nan() && s[2].is_nan() && c[2].is_nan());
         assert_eq!((s[0], c[0]), sin_cos(0.3));
         assert_eq!((s[3], c[3]), sin_cos(-2.0));
+        let (s, c) = sin_cos_lanes([0.3, -2.0, 1.0, 2.0, 3.0, 4.0, 5.0, f64::NAN]);
+        assert!(s[7].is_nan() && c[7].is_nan());
+        assert_eq!((s[0], c[0]), sin_cos(0.3));
+        assert_eq!((s[6], c[6]), sin_cos(5.0));
     }
 }
