@@ -56,11 +56,17 @@ import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
+# OpenBLAS's idle worker threads busy-wait (~0.1 s) after each of the peer's BLAS calls before they sleep, and on a
+# 2-core machine they took the core that freefloat's two-thread evaluation needed next: its median was 6.1 ms against
+# a minimum of 3.6 ms (bimodal), and 2.7 ms with the shortest wait OpenBLAS allows, the peer's time unchanged (26.7 and
+# 26.8 ms; 15 interleaved repeats each, 2026-12-07). The same setting as benches/identify_vs_numpy.py.
+os.environ.setdefault("OPENBLAS_THREAD_TIMEOUT", "4")
 
-import freefloat as ff
-from freefloat import excitation as exc
-from freefloat.identification.estimation import absolute_columns
+import numpy as np  # noqa: E402
+
+import freefloat as ff  # noqa: E402
+from freefloat import excitation as exc  # noqa: E402
+from freefloat.identification.estimation import absolute_columns  # noqa: E402
 
 MODEL = "naveen_dual_arm_offset"
 #: the issue's targets: one evaluation of eq. 32 over 256 intervals, and the whole three-step design
@@ -463,7 +469,9 @@ def main():
         f"| 13 sequential `d.evaluate(x_i)` calls | {ms(sg['sequential_13_calls'])} | "
         f"{1e3 * sg['sequential_13_calls']['min']:.2f} |",
         "",
-        f"Sequential / batch: {ratios['sequential_over_batch']:.2f}x (with 2 cores the ceiling is 2x).",
+        f"Sequential / batch: {ratios['sequential_over_batch']:.2f}x (each sequential call already splits its points "
+        "over the 2 worker threads, so the batch can gain only what those calls leave idle: about 1x is the "
+        "ceiling on 2 cores).",
         "",
         "## Full design (`d.design(progress=False)`)",
         "",
